@@ -1,0 +1,70 @@
+#include <exception>
+#include <iostream>
+#include <map>
+
+#include "machine/description.hpp"
+#include "verbs.hpp"
+#include "version.hpp"
+
+namespace {
+
+struct Verb {
+  int (*run)(const weilgen::cli::Args&);
+  const char* summary;
+};
+
+const std::map<std::string, Verb>& verbs() {
+  static const std::map<std::string, Verb> v = {
+      {"generate", {weilgen::cli::verb_generate,
+                    "generate <machine>... [--order r] [--out DIR] [--check]\n"
+                    "      multiply the error HTMs over the Weil algebra and write the C++ header\n"
+                    "      and the closed-form report (generated/<machine>.hpp, .md)"}},
+      {"show", {weilgen::cli::verb_show,
+                "show <machine> [--output dx] [--format text|latex|json] [--notation iso|alias]\n"
+                "      [--order r]\n"
+                "      print the closed-form error expressions"}},
+      {"list", {weilgen::cli::verb_list, "list\n      list the shipped machines"}},
+  };
+  return v;
+}
+
+void print_help() {
+  std::cout << "weilgen " << weilgen::kVersion
+            << " — symbolic-to-numeric code generator for machine-tool error models\n\n"
+               "Usage: weilgen <verb> [options]     weilgen <verb> --help for a verb's options\n\n"
+               "Verbs:\n";
+  for (const auto& [name, v] : verbs()) std::cout << "  " << v.summary << "\n\n";
+  std::cout << "<machine> is a path to a machine file (machines/README.md documents the format)\n"
+               "or the name of a shipped machine (see `weilgen list`).\n"
+               "Exit status: 0 success, 1 failure or stale files (--check), 2 bad arguments,\n"
+               "3 bad input file.\n";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2 || std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h" ||
+      std::string(argv[1]) == "help") {
+    print_help();
+    return argc < 2 ? 2 : 0;
+  }
+  if (std::string(argv[1]) == "--version") {
+    std::cout << "weilgen " << weilgen::kVersion << "\n";
+    return 0;
+  }
+  const auto it = verbs().find(argv[1]);
+  if (it == verbs().end()) {
+    std::cerr << "weilgen: unknown verb '" << argv[1] << "' (try weilgen --help)\n";
+    return 2;
+  }
+  weilgen::cli::Args args(argv + 2, argv + argc);
+  try {
+    return it->second.run(args);
+  } catch (const weilgen::InputError& e) {
+    std::cerr << e.what() << "\n";
+    return 3;
+  } catch (const std::exception& e) {
+    std::cerr << "weilgen " << argv[1] << ": " << e.what() << "\n";
+    return 1;
+  }
+}

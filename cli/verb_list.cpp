@@ -1,0 +1,30 @@
+#include <filesystem>
+#include <iostream>
+#include <set>
+
+#include "machine/yaml_loader.hpp"
+#include "verbs.hpp"
+
+namespace weilgen::cli {
+
+int verb_list(const Args& args) {
+  if (!args.empty() && (args[0] == "--help" || args[0] == "-h")) {
+    std::cout << "weilgen list\n\nLists the shipped machines (" << WEILGEN_MACHINES_DIR
+              << "): name, axes, errors, title.\n";
+    return 0;
+  }
+  if (!args.empty()) return usage_error("list", "takes no arguments");
+  std::set<std::string> files;
+  for (const auto& e : std::filesystem::directory_iterator(WEILGEN_MACHINES_DIR))
+    if (e.path().extension() == ".yaml") files.insert(e.path().string());
+  for (const auto& f : files) {
+    const Description d = load_machine_file(f);
+    std::string axes;
+    for (int b : d.axes()) axes += d.bodies[b].joint.coordinate;
+    std::cout << d.name << "  axes " << axes << ", " << d.errors.size() << " errors, order "
+              << d.algebra.order << "  — " << d.title << "\n";
+  }
+  return 0;
+}
+
+}  // namespace weilgen::cli

@@ -1,0 +1,123 @@
+#include "cse.hpp"
+
+#include <algorithm>
+#include <unordered_map>
+
+namespace weilgen::gen {
+
+using GiNaC::ex;
+
+namespace {
+bool is_atom(const ex& e) {
+  return GiNaC::is_a<GiNaC::symbol>(e) || GiNaC::is_a<GiNaC::numeric>(e) ||
+         GiNaC::is_a<GiNaC::constant>(e);
+}
+// A product's numeric factor is not worth a temporary of its own: c·(rest) shares `rest`.
+ex strip_coefficient(const ex& e) {
+  if (!GiNaC::is_a<GiNaC::mul>(e)) return e;
+  ex rest = 1;
+  for (std::size_t i = 0; i < e.nops(); ++i)
+    if (!GiNaC::is_a<GiNaC::numeric>(e.op(i))) rest *= e.op(i);
+  return rest;
+}
+}  // namespace
+
+const std::string& CanonicalText::of(const ex& e) {
+  auto it = memo_.find(e);
+  if (it != memo_.end()) return it->second;
+  std::string s;
+  if (is_atom(e)) {
+    std::ostringstream os;
+    os << e;
+    s = os.str();
+  } else {
+    std::vector<std::string> parts;
+    for (std::size_t i = 0; i < e.nops(); ++i) parts.push_back(of(e.op(i)));
+    if (GiNaC::is_a<GiNaC::add>(e) || GiNaC::is_a<GiNaC::mul>(e))
+      std::sort(parts.begin(), parts.end());
+    if (GiNaC::is_a<GiNaC::add>(e)) {
+      s = "add(";
+    } else if (GiNaC::is_a<GiNaC::mul>(e)) {
+      s = "mul(";
+    } else if (GiNaC::is_a<GiNaC::power>(e)) {
+      s = "pow(";
+    } else if (GiNaC::is_a<GiNaC::function>(e)) {
+      s = GiNaC::ex_to<GiNaC::function>(e).get_name() + "(";
+    } else {
+      s = "node(";
+    }
+    for (std::size_t i = 0; i < parts.size(); ++i) s += (i ? "," : "") + parts[i];
+    s += ")";
+  }
+  return memo_.emplace(e, std::move(s)).first->second;
+}
+
+std::vector<ex> CanonicalText::sorted_ops(const ex& e) {
+  std::vector<ex> ops;
+  for (std::size_t i = 0; i < e.nops(); ++i) ops.push_back(e.op(i));
+  if (GiNaC::is_a<GiNaC::add>(e) || GiNaC::is_a<GiNaC::mul>(e))
+    std::stable_sort(ops.begin(), ops.end(),
+                     [&](const ex& a, const ex& b) { return of(a) < of(b); });
+  return ops;
+}
+
+namespace {
+struct Eliminator {
+  CanonicalText canon;
+  std::unordered_map<std::string, int> count;
+  std::unordered_map<std::string, ex> replaced;
+  CseResult result;
+  std::string prefix;
+
+  void tally(const ex& node) {
+    if (is_atom(node)) return;
+    const ex core = strip_coefficient(node);
+    if (!core.is_equal(node)) {
+      tally(core);
+      return;
+    }
+    if (count[canon.of(node)]++ > 0) return;
+    for (const ex& op : canon.sorted_ops(node)) tally(op);
+  }
+
+  ex rewrite(const ex& node) {
+    if (is_atom(node)) return node;
+    const ex core = strip_coefficient(node);
+    if (!core.is_equal(node)) return rewrite(core) * (node / core).expand();
+    const std::string& key = canon.of(node);
+    if (auto it = replaced.find(key); it != replaced.end()) return it->second;
+    ex rebuilt;
+    if (GiNaC::is_a<GiNaC::add>(node)) {
+      GiNaC::exvector v;
+      for (const ex& op : canon.sorted_ops(node)) v.push_back(rewrite(op));
+      rebuilt = GiNaC::add(v);
+    } else if (GiNaC::is_a<GiNaC::mul>(node)) {
+      GiNaC::exvector v;
+      for (const ex& op : canon.sorted_ops(node)) v.push_back(rewrite(op));
+      rebuilt = GiNaC::mul(v);
+    } else {
+      rebuilt = node;
+      for (std::size_t i = 0; i < node.nops(); ++i) rebuilt.let_op(i) = rewrite(node.op(i));
+    }
+    if (count[key] >= 2) {
+      GiNaC::symbol t(prefix + std::to_string(result.temps.size()));
+      result.temps.push_back({t, rebuilt});
+      replaced.emplace(key, t);
+      return t;
+    }
+    replaced.emplace(key, rebuilt);
+    return rebuilt;
+  }
+};
+}  // namespace
+
+CseResult eliminate_common_subexpressions(const std::vector<ex>& outputs,
+                                          const std::string& prefix) {
+  Eliminator el;
+  el.prefix = prefix;
+  for (const ex& e : outputs) el.tally(e);
+  for (const ex& e : outputs) el.result.outputs.push_back(el.rewrite(e));
+  return std::move(el.result);
+}
+
+}  // namespace weilgen::gen

@@ -1,0 +1,39 @@
+// Common-subexpression elimination over GiNaC expression trees (GiNaC has none).
+//
+// One pass over all outputs of a function: every non-atomic subtree that occurs twice or more
+// becomes a temporary `_tmpN`. Traversal follows a canonical operand order (by canonical text),
+// not GiNaC's hash order, so temporaries are numbered identically on every run.
+#pragma once
+
+#include <ginac/ginac.h>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace weilgen::gen {
+
+// Text of an expression with add/mul operands sorted: identical for equal expressions regardless
+// of symbol creation order.
+class CanonicalText {
+ public:
+  const std::string& of(const GiNaC::ex& e);
+  // Operands of e in canonical order.
+  std::vector<GiNaC::ex> sorted_ops(const GiNaC::ex& e);
+
+ private:
+  std::map<GiNaC::ex, std::string, GiNaC::ex_is_less> memo_;
+};
+
+struct CseResult {
+  struct Temp {
+    GiNaC::symbol symbol;  // named _tmpN
+    GiNaC::ex value;       // may refer to earlier temporaries
+  };
+  std::vector<Temp> temps;
+  std::vector<GiNaC::ex> outputs;  // rewritten in terms of temporaries
+};
+
+CseResult eliminate_common_subexpressions(const std::vector<GiNaC::ex>& outputs,
+                                          const std::string& prefix = "_tmp");
+
+}  // namespace weilgen::gen

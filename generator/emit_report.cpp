@@ -1,0 +1,212 @@
+#include "emit_report.hpp"
+
+#include <sstream>
+
+#include "printer.hpp"
+#include "version.hpp"
+
+namespace weilgen::gen {
+
+using GiNaC::ex;
+
+namespace {
+
+std::string latex_name(const std::string& n) {
+  // E_XX -> E_{XX}; other underscores escaped.
+  const auto u = n.find('_');
+  if (u == std::string::npos) return n;
+  std::string head = n.substr(0, u), tail = n.substr(u + 1);
+  std::string esc;
+  for (char c : tail) esc += (c == '_') ? std::string("\\_") : std::string(1, c);
+  return head + "_{" + esc + "}";
+}
+
+// Display name and sign of error i in the chosen notation.
+std::pair<std::string, int> display(const SymbolicModel& m, std::size_t i, Notation n,
+                                    FormStyle style) {
+  const ErrorDef& e = m.desc.errors[i];
+  if (n == Notation::Alias && !e.aliases.empty()) {
+    const Alias& a = e.aliases.front();
+    return {a.name, a.sign};
+  }
+  return {style == FormStyle::Latex ? latex_name(e.name) : e.name, 1};
+}
+
+std::string join_term(const std::string& acc, ex coeff, const std::string& name,
+                      ExprPrinter& pr, FormStyle style) {
+  const std::string times = style == FormStyle::Latex ? "\\," : "·";
+  bool negative = false;
+  std::string c;
+  if (GiNaC::is_a<GiNaC::add>(coeff)) {
+    c = (style == FormStyle::Latex ? "\\left(" : "(") + pr.print(coeff) +
+        (style == FormStyle::Latex ? "\\right)" : ")");
+  } else {
+    c = pr.print(coeff);
+    if (!c.empty() && c[0] == '-') {
+      negative = true;
+      c.erase(0, 1);
+    }
+  }
+  std::string t = (c == "1") ? name : c + times + name;
+  if (acc.empty()) return negative ? "-" + t : t;
+  return acc + (negative ? " - " : " + ") + t;
+}
+
+std::map<std::string, std::string> symbol_names(const SymbolicModel& m, FormStyle style) {
+  std::map<std::string, std::string> names;
+  if (style != FormStyle::Latex) return names;
+  for (const auto& a : m.axes) {
+    if (!a.revolute) continue;
+    names[a.cos.get_name()] = "\\cos " + a.coordinate.get_name();
+    names[a.sin.get_name()] = "\\sin " + a.coordinate.get_name();
+  }
+  for (const auto& p : m.params) names[p.get_name()] = latex_name(p.get_name());
+  return names;
+}
+
+}  // namespace
+
+std::string closed_form(const SymbolicModel& m, int o, FormStyle style, Notation notation) {
+  ExprPrinter pr(style == FormStyle::Latex ? ExprPrinter::Style::Latex : ExprPrinter::Style::Text,
+                 symbol_names(m, style));
+  std::string s;
+  for (std::size_t i = 0; i < m.errors.size(); ++i) {
+    const ex c = m.coefficient(o, {static_cast<std::uint16_t>(i)});
+    if (c.is_zero()) continue;
+    const auto [name, sign] = display(m, i, notation, style);
+    s = join_term(s, (c * sign).expand(), name, pr, style);
+  }
+  for (const auto& mono : m.higher_monomials()) {
+    const ex c = m.coefficient(o, mono);
+    if (c.is_zero()) continue;
+    std::string name;
+    int sign = 1;
+    for (auto i : mono) {
+      const auto [n, sg] = display(m, i, notation, style);
+      name += (name.empty() ? "" : (style == FormStyle::Latex ? "\\," : "·")) + n;
+      sign *= sg;
+    }
+    s = join_term(s, (c * sign).expand(), name, pr, style);
+  }
+  const std::string lhs = style == FormStyle::Latex ? std::string("\\delta_{") + (kOutputNames[o] + 1) + "}"
+                                                     : kOutputNames[o];
+  return lhs + " = " + (s.empty() ? "0" : s);
+}
+
+nlohmann::json closed_forms_json(const SymbolicModel& m, Notation notation) {
+  nlohmann::json j;
+  j["machine"] = m.desc.name;
+  j["order"] = m.order;
+  j["notation"] = notation == Notation::Iso ? "iso" : "alias";
+  ExprPrinter pr(ExprPrinter::Style::Text);
+  for (int o = 0; o < kNumOutputs; ++o) {
+    nlohmann::json out;
+    out["unit"] = kOutputUnits[o];
+    out["closed_form"] = closed_form(m, o, FormStyle::Text, notation);
+    out["latex"] = closed_form(m, o, FormStyle::Latex, notation);
+    nlohmann::json lin = nlohmann::json::object();
+    for (std::size_t i = 0; i < m.errors.size(); ++i) {
+      const ex c = m.coefficient(o, {static_cast<std::uint16_t>(i)});
+      if (c.is_zero()) continue;
+      const auto [name, sign] = display(m, i, notation, FormStyle::Text);
+      lin[name] = pr.print((c * sign).expand());
+    }
+    out["linear"] = lin;
+    nlohmann::json hi = nlohmann::json::array();
+    for (const auto& mono : m.higher_monomials()) {
+      const ex c = m.coefficient(o, mono);
+      if (c.is_zero()) continue;
+      nlohmann::json names = nlohmann::json::array();
+      int sign = 1;
+      for (auto i : mono) {
+        const auto [n, sg] = display(m, i, notation, FormStyle::Text);
+        names.push_back(n);
+        sign *= sg;
+      }
+      hi.push_back({{"monomial", names}, {"coefficient", pr.print((c * sign).expand())}});
+    }
+    out["higher"] = hi;
+    j["outputs"][kOutputNames[o]] = out;
+  }
+  return j;
+}
+
+std::string emit_report_markdown(const SymbolicModel& m, const std::string& source_label) {
+  const Description& d = m.desc;
+  std::ostringstream os;
+  os << "<!-- GENERATED by weilgen " << kVersion << " from " << source_label
+     << ". Do not edit: edit the machine file and run `weilgen generate`. -->\n\n";
+  os << "# " << d.name << (d.title.empty() ? "" : " — " + d.title) << "\n\n";
+  os << "Closed-form error model generated from `" << source_label << "`.\n\n";
+  os << "- Algebra: R[e_1..e_" << d.errors.size() << "] / I, I = ⟨all monomials of degree "
+     << m.order + 1 << "⟩";
+  if (!m.relations.empty()) {
+    os << " + ⟨";
+    for (std::size_t k = 0; k < m.relations.size(); ++k)
+      os << (k ? ", " : "") << m.monomial_name(m.relations[k]);
+    os << "⟩";
+  }
+  os << " (order " << m.order << (m.order == 1 ? ": dual numbers" : "") << ").\n";
+  os << "- Outputs: tool point relative to the workpiece, in the workpiece frame: dx, dy, dz in mm; "
+        "da, db, dc in rad. Errors in base units (mm, rad).\n";
+  os << "- Coordinates print in lower case (`X` → `x`); revolute coordinates appear as "
+        "`cos(c)`, `sin(c)` of the angle.\n\n";
+
+  os << "## Closed forms\n\n```text\n";
+  for (int o = 0; o < kNumOutputs; ++o)
+    os << closed_form(m, o, FormStyle::Text, Notation::Iso) << "\n";
+  os << "```\n\n";
+  bool has_alias = false;
+  for (const auto& e : d.errors) has_alias |= !e.aliases.empty();
+  if (has_alias) {
+    os << "### In the source's notation (first alias of each error)\n\n```text\n";
+    for (int o = 0; o < kNumOutputs; ++o)
+      os << closed_form(m, o, FormStyle::Text, Notation::Alias) << "\n";
+    os << "```\n\n";
+  }
+
+  os << "## First-order coefficients ∂output/∂error\n\n| error | dx | dy | dz | da | db | dc |\n"
+        "| --- | --- | --- | --- | --- | --- | --- |\n";
+  ExprPrinter pr(ExprPrinter::Style::Text);
+  for (std::size_t i = 0; i < d.errors.size(); ++i) {
+    os << "| " << d.errors[i].name;
+    for (int o = 0; o < kNumOutputs; ++o) {
+      const ex c = m.coefficient(o, {static_cast<std::uint16_t>(i)});
+      os << " | " << (c.is_zero() ? "·" : pr.print(c));
+    }
+    os << " |\n";
+  }
+
+  os << "\n## Errors\n\n| name | aliases | body | group | placement | PIGE/PDGE | unit | "
+        "distribution |\n| --- | --- | --- | --- | --- | --- | --- | --- |\n";
+  for (const auto& e : d.errors) {
+    std::string al;
+    for (const auto& a : e.aliases)
+      al += (al.empty() ? "" : ", ") + std::string(a.sign < 0 ? "−" : "") + a.name;
+    const char* pl = e.placement == ErrorPlacement::After
+                         ? "after"
+                         : (e.placement == ErrorPlacement::Before ? "before" : "axis");
+    os << "| " << e.name << " | " << al << " | " << d.bodies[e.body].name << " | " << e.group
+       << " | " << pl << " | " << (e.dependence == Dependence::PDGE ? "PDGE" : "PIGE") << " | "
+       << e.unit << " | " << e.distribution.str() << " |\n";
+  }
+  os << "\n## Axes\n\n| coordinate | type | axis | unit | range |\n| --- | --- | --- | --- | --- |\n";
+  for (const auto& a : m.axes) {
+    const Joint& j = d.bodies[a.body].joint;
+    os << "| " << j.coordinate << " | " << (a.revolute ? "revolute" : "prismatic") << " | ["
+       << format_double(j.axis[0]) << ", " << format_double(j.axis[1]) << ", "
+       << format_double(j.axis[2]) << "] | " << j.unit << " | " << format_double(j.min) << " … "
+       << format_double(j.max) << " |\n";
+  }
+  if (!d.parameters.empty()) {
+    os << "\n## Parameters\n\n| name | default | unit | description |\n| --- | --- | --- | --- |\n";
+    const auto defaults = d.parameter_defaults();
+    for (const auto& p : d.parameters)
+      os << "| " << p.name << " | " << format_double(defaults.at(p.name)) << " | " << p.unit
+         << " | " << p.description << " |\n";
+  }
+  if (!d.notes.empty()) os << "\n## Notes\n\n" << d.notes << (d.notes.back() == '\n' ? "" : "\n");
+  return os.str();
+}
+
+}  // namespace weilgen::gen

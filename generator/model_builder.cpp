@@ -1,0 +1,283 @@
+#include "model_builder.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+namespace weilgen::gen {
+
+using GiNaC::ex;
+
+GiNaC::numeric exact_decimal(double v) {
+  if (!std::isfinite(v)) throw std::invalid_argument("non-finite number in machine description");
+  char buf[64];
+  for (int digits = 1; digits <= 17; ++digits) {
+    std::snprintf(buf, sizeof buf, "%.*e", digits - 1, v);
+    if (std::strtod(buf, nullptr) == v) break;
+  }
+  // buf = "-d.ddde±XX": mantissa digits and a decimal exponent, both exact.
+  std::string s(buf);
+  const auto epos = s.find('e');
+  const int exponent = std::stoi(s.substr(epos + 1));
+  std::string mant = s.substr(0, epos);
+  const bool negative = !mant.empty() && mant[0] == '-';
+  if (negative) mant.erase(0, 1);
+  int frac_digits = 0;
+  if (auto dot = mant.find('.'); dot != std::string::npos) {
+    frac_digits = static_cast<int>(mant.size() - dot - 1);
+    mant.erase(dot, 1);
+  }
+  GiNaC::numeric r(mant.c_str());
+  const int scale = exponent - frac_digits;
+  r *= GiNaC::ex_to<GiNaC::numeric>(GiNaC::pow(GiNaC::numeric(10), scale));
+  return negative ? -r : r;
+}
+
+ex to_ginac(const Expr& e, const Description& desc, const std::vector<GiNaC::symbol>& params) {
+  switch (e.kind) {
+    case Expr::Kind::Number:
+      return exact_decimal(e.number);
+    case Expr::Kind::Param: {
+      if (e.name == "pi") return GiNaC::Pi;
+      for (std::size_t i = 0; i < desc.parameters.size(); ++i)
+        if (desc.parameters[i].name == e.name) return params[i];
+      throw std::invalid_argument("unknown parameter '" + e.name + "'");
+    }
+    case Expr::Kind::Neg:
+      return -to_ginac(*e.a, desc, params);
+    case Expr::Kind::Add:
+      return to_ginac(*e.a, desc, params) + to_ginac(*e.b, desc, params);
+    case Expr::Kind::Sub:
+      return to_ginac(*e.a, desc, params) - to_ginac(*e.b, desc, params);
+    case Expr::Kind::Mul:
+      return to_ginac(*e.a, desc, params) * to_ginac(*e.b, desc, params);
+    case Expr::Kind::Div:
+      return to_ginac(*e.a, desc, params) / to_ginac(*e.b, desc, params);
+    case Expr::Kind::Pow:
+      return GiNaC::pow(to_ginac(*e.a, desc, params), to_ginac(*e.b, desc, params));
+  }
+  return 0;
+}
+
+namespace {
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
+  return s;
+}
+
+struct Builder {
+  const Description& d;
+  SymbolicModel& model;
+  const Algebra& alg;
+
+  void unit_vector(const Vec3& v, ex (&u)[3]) const {
+    for (int i = 0; i < 3; ++i) u[i] = exact_decimal(v[i]);
+  }
+
+  Mat4 offset(const Offset& off) const {
+    ex t[3];
+    for (int i = 0; i < 3; ++i) t[i] = to_ginac(off.translation[i], d, model.params);
+    Mat4 m = translation(t);
+    for (const auto& rot : off.rotations) {
+      ex u[3];
+      unit_vector(rot.axis, u);
+      const ex angle = to_ginac(rot.angle_deg, d, model.params) * GiNaC::Pi / 180;
+      m = m.mul(rotation_cs(u, GiNaC::cos(angle), GiNaC::sin(angle), alg), alg);
+    }
+    return m;
+  }
+
+  Mat4 error_transform(int body, ErrorPlacement placement) const {
+    Mat4 m = Mat4::identity();
+    for (int ei : d.bodies[body].errors) {
+      const ErrorDef& e = d.errors[ei];
+      if (e.placement != placement) continue;
+      ex u[3];
+      unit_vector(e.direction, u);
+      const Poly sym = Poly::error(static_cast<std::uint16_t>(ei));
+      m = m.mul(e.effect == ErrorEffect::Translation ? translation_by(sym, u, alg)
+                                                     : rotation_small(u, sym, alg),
+                alg);
+    }
+    return m;
+  }
+
+  Mat4 joint(int body) const {
+    const Joint& j = d.bodies[body].joint;
+    if (j.type == JointType::Fixed) return Mat4::identity();
+    const auto it = std::find_if(model.axes.begin(), model.axes.end(),
+                                 [&](const AxisSymbols& a) { return a.body == body; });
+    ex u[3];
+    unit_vector(j.axis, u);
+    if (j.type == JointType::Prismatic) {
+      const Poly q(it->coordinate * exact_decimal(j.to_base));
+      return translation_by(q, u, alg);
+    }
+    return rotation_cs(u, it->cos, it->sin, alg);
+  }
+
+  // T = Offset · E_before · (E_axis · J · E_axis⁻¹) · E_after
+  Mat4 body_transform(int body) const {
+    Mat4 m = offset(d.bodies[body].offset);
+    m = m.mul(error_transform(body, ErrorPlacement::Before), alg);
+    const Mat4 axis = error_transform(body, ErrorPlacement::Axis);
+    m = m.mul(axis, alg).mul(joint(body), alg).mul(neumann_inverse(axis, alg), alg);
+    return m.mul(error_transform(body, ErrorPlacement::After), alg);
+  }
+
+  Mat4 branch(int leaf, const PointSpec& point) const {
+    Mat4 m = Mat4::identity();
+    for (int b : d.chain_to(leaf)) m = m.mul(body_transform(b), alg);
+    ex t[3];
+    for (int i = 0; i < 3; ++i) t[i] = to_ginac(point.point[i], d, model.params);
+    return m.mul(translation(t), alg);
+  }
+};
+
+std::vector<Monomial> relation_monomials(const Description& d) {
+  std::vector<Monomial> out;
+  auto in_group = [&](const std::string& g) {
+    std::vector<std::uint16_t> idx;
+    for (std::size_t i = 0; i < d.errors.size(); ++i)
+      if (d.errors[i].group == g) idx.push_back(static_cast<std::uint16_t>(i));
+    return idx;
+  };
+  auto index = [&](const std::string& n) {
+    const int i = d.error_index(n);
+    if (i < 0) throw InputError(SourceLoc{d.source_file, 0, 0}, "relation names no error: " + n);
+    return static_cast<std::uint16_t>(i);
+  };
+  for (const Relation& r : d.algebra.relations) {
+    switch (r.kind) {
+      case Relation::Kind::Squares:
+        if (r.names.empty()) {
+          for (std::size_t i = 0; i < d.errors.size(); ++i)
+            out.push_back({static_cast<std::uint16_t>(i), static_cast<std::uint16_t>(i)});
+        } else {
+          for (const auto& n : r.names) out.push_back({index(n), index(n)});
+        }
+        break;
+      case Relation::Kind::Within: {
+        for (const auto& g : r.names) {
+          const auto idx = in_group(g);
+          for (std::size_t a = 0; a < idx.size(); ++a)
+            for (std::size_t b = a; b < idx.size(); ++b) out.push_back({idx[a], idx[b]});
+        }
+        break;
+      }
+      case Relation::Kind::Between: {
+        const auto ga = in_group(r.names.at(0)), gb = in_group(r.names.at(1));
+        for (auto a : ga)
+          for (auto b : gb) out.push_back({std::min(a, b), std::max(a, b)});
+        break;
+      }
+      case Relation::Kind::Pair:
+      case Relation::Kind::Monomial: {
+        Monomial m;
+        for (const auto& n : r.names) m.push_back(index(n));
+        std::sort(m.begin(), m.end());
+        out.push_back(m);
+        break;
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+ex SymbolicModel::coefficient(int o, const Monomial& m) const {
+  const auto& t = outputs[o].terms();
+  auto it = t.find(m);
+  return it == t.end() ? ex(0) : it->second;
+}
+
+std::vector<Monomial> SymbolicModel::higher_monomials() const {
+  std::vector<Monomial> out;
+  for (const auto& p : outputs)
+    for (const auto& [m, c] : p.terms())
+      if (m.size() >= 2) out.push_back(m);
+  std::sort(out.begin(), out.end(), [](const Monomial& a, const Monomial& b) {
+    return a.size() != b.size() ? a.size() < b.size() : a < b;
+  });
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+std::string SymbolicModel::monomial_name(const Monomial& m) const {
+  std::string s;
+  for (std::size_t i = 0; i < m.size();) {
+    std::size_t j = i;
+    while (j < m.size() && m[j] == m[i]) ++j;
+    if (!s.empty()) s += "·";
+    s += desc.errors[m[i]].name;
+    if (j - i > 1) s += "^" + std::to_string(j - i);
+    i = j;
+  }
+  return s.empty() ? "1" : s;
+}
+
+SymbolicModel build_model(const Description& desc, int order_override) {
+  SymbolicModel model;
+  model.desc = desc;
+  model.order = order_override > 0 ? order_override : desc.algebra.order;
+  if (model.order < 1) throw std::invalid_argument("algebra order must be >= 1");
+
+  GiNaC::exmap trig_rules;
+  for (int b : desc.axes()) {
+    const Joint& j = desc.bodies[b].joint;
+    AxisSymbols a;
+    a.body = b;
+    a.revolute = j.type == JointType::Revolute;
+    const std::string n = lower(j.coordinate);
+    a.coordinate = GiNaC::symbol(n);
+    if (a.revolute) {
+      a.cos = GiNaC::symbol("cos(" + n + ")", "\\cos " + n);
+      a.sin = GiNaC::symbol("sin(" + n + ")", "\\sin " + n);
+      trig_rules[GiNaC::pow(a.cos, 2)] = 1 - GiNaC::pow(a.sin, 2);
+    }
+    model.axes.push_back(a);
+  }
+  for (const auto& e : desc.errors) model.errors.emplace_back(e.name);
+  for (const auto& p : desc.parameters) model.params.emplace_back(p.name);
+
+  const Algebra alg(model.order, relation_monomials(desc), trig_rules);
+  model.relations = alg.relations();
+  const Builder b{desc, model, alg};
+
+  const Mat4 tool = b.branch(desc.tool.body, desc.tool);
+  const Mat4 work = b.branch(desc.workpiece.body, PointSpec{desc.workpiece.body,
+                                                            desc.workpiece.point, {}});
+  // P: the tool frame (at the tool point) in the workpiece frame.
+  const Mat4 p = neumann_inverse(work, alg).mul(tool, alg);
+
+  for (int i = 0; i < 3; ++i) model.outputs[i] = p.m[i][3].without_constant();
+
+  // Orientation: rotation vector of ΔR = R·R0ᵀ, via log(I + A) = Σ (−1)^{k+1} A^k / k.
+  Mat4 r = p, r0t;
+  for (int i = 0; i < 3; ++i) {
+    r.m[i][3] = Poly();
+    for (int j = 0; j < 3; ++j) r0t.m[i][j] = Poly(p.m[j][i].constant());
+  }
+  r.m[3][3] = Poly(1);
+  r0t.m[3][3] = Poly(1);
+  const Mat4 a = r.mul(r0t, alg) - Mat4::identity();
+  Mat4 log = Mat4::zero(), power = a;
+  for (int k = 1; k <= model.order; ++k) {
+    Mat4 term;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        term.m[i][j] = power.m[i][j].scaled(GiNaC::numeric(k % 2 == 1 ? 1 : -1, k), alg);
+    log = log + term;
+    power = power.mul(a, alg);
+  }
+  const GiNaC::numeric half(1, 2);
+  model.outputs[3] = (log.m[2][1] - log.m[1][2]).scaled(half, alg);
+  model.outputs[4] = (log.m[0][2] - log.m[2][0]).scaled(half, alg);
+  model.outputs[5] = (log.m[1][0] - log.m[0][1]).scaled(half, alg);
+  return model;
+}
+
+}  // namespace weilgen::gen

@@ -1,0 +1,52 @@
+// Description → symbolic error model over the Weil algebra.
+#pragma once
+
+#include <array>
+#include <ginac/ginac.h>
+#include <string>
+#include <vector>
+
+#include "machine/description.hpp"
+#include "weil.hpp"
+
+namespace weilgen::gen {
+
+inline constexpr int kNumOutputs = 6;
+inline const std::array<const char*, kNumOutputs> kOutputNames = {"dx", "dy", "dz",
+                                                                   "da", "db", "dc"};
+inline const std::array<const char*, kNumOutputs> kOutputUnits = {"mm",  "mm",  "mm",
+                                                                   "rad", "rad", "rad"};
+
+struct AxisSymbols {
+  int body = -1;
+  GiNaC::symbol coordinate;  // the joint variable in its unit (mm, deg, ...)
+  GiNaC::symbol cos, sin;    // revolute only: cos/sin of the angle in rad
+  bool revolute = false;
+};
+
+struct SymbolicModel {
+  Description desc;
+  int order = 1;
+  std::vector<Monomial> relations;  // minimal relation monomials (besides degree > order)
+  std::vector<AxisSymbols> axes;    // in Description::axes() order
+  std::vector<GiNaC::symbol> errors;
+  std::vector<GiNaC::symbol> params;
+  std::array<Poly, kNumOutputs> outputs;  // deviation, as algebra elements (no constant term)
+
+  // Coefficient of a monomial in output o (0 when absent).
+  GiNaC::ex coefficient(int o, const Monomial& m) const;
+  // All monomials of degree >= 2 that appear in some output, sorted by degree then indices.
+  std::vector<Monomial> higher_monomials() const;
+  // Monomial as text with error names: "E_AX·E_BY", "E_AX^2".
+  std::string monomial_name(const Monomial& m) const;
+};
+
+// Builds the model; order_override > 0 replaces the file's algebra order.
+SymbolicModel build_model(const Description& desc, int order_override = 0);
+
+// Exact rational for a decimal double (0.1 → 1/10): the shortest decimal that round-trips.
+GiNaC::numeric exact_decimal(double v);
+// Expr (machine file scalar) → GiNaC, with parameters mapped to `params` by name.
+GiNaC::ex to_ginac(const Expr& e, const Description& desc, const std::vector<GiNaC::symbol>& params);
+
+}  // namespace weilgen::gen

@@ -1,0 +1,14 @@
+// Writes files so that readers never see a partial file and failures leave the old one intact:
+// write to a temporary file in the same directory, then rename over the target.
+#pragma once
+
+#include <string>
+
+namespace weilgen {
+
+// Throws std::runtime_error naming the path on failure.
+void write_file_atomically(const std::string& path, const std::string& contents);
+// Reads a whole file; returns false when it cannot be opened.
+bool read_file(const std::string& path, std::string& contents);
+
+}  // namespace weilgen

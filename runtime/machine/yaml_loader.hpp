@@ -1,0 +1,22 @@
+// Reads a machine description (machines/README.md) into a Description. Every problem in the input
+// is reported as an InputError carrying the file and the 1-based line:column of the YAML node at
+// fault; nothing is partially loaded.
+#pragma once
+
+#include <string>
+
+#include "machine/description.hpp"
+
+namespace weilgen {
+
+// Reads and checks the machine file at `path`. Throws InputError.
+Description load_machine_file(const std::string& path);
+
+// Same, from YAML text; `filename` is used in messages and as Description::source_file.
+Description load_machine_text(const std::string& yaml, const std::string& filename);
+
+// A path to a file, or the name of a shipped machine (WEILGEN_MACHINES_DIR "/<name>.yaml").
+// Throws InputError (loc.file = the argument) when neither exists.
+std::string resolve_machine(const std::string& name_or_path);
+
+}  // namespace weilgen
