@@ -95,9 +95,15 @@ struct Eliminator {
       GiNaC::exvector v;
       for (const ex& op : canon.sorted_ops(node)) v.push_back(rewrite(op));
       rebuilt = GiNaC::mul(v);
+    } else if (GiNaC::is_a<GiNaC::power>(node)) {
+      rebuilt = GiNaC::pow(rewrite(node.op(0)), rewrite(node.op(1)));
     } else {
-      rebuilt = node;
-      for (std::size_t i = 0; i < node.nops(); ++i) rebuilt.let_op(i) = rewrite(node.op(i));
+      struct Rewriter : GiNaC::map_function {
+        Eliminator* self;
+        explicit Rewriter(Eliminator* s) : self(s) {}
+        ex operator()(const ex& e) override { return self->rewrite(e); }
+      } rewriter(this);
+      rebuilt = node.map(rewriter);
     }
     if (count[key] >= 2) {
       GiNaC::symbol t(prefix + std::to_string(result.temps.size()));

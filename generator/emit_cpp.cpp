@@ -98,6 +98,30 @@ struct OutputGroup {
   std::vector<ex> values;
 };
 
+// Named coefficient polynomials of a Deviation-style function. Products c·monomial with a sum c
+// are built on a placeholder symbol whose sign is chosen canonically: GiNaC would otherwise
+// normalise the sign of a sum inside a product by its hash order, which varies between runs.
+struct Coefficients {
+  std::vector<std::pair<GiNaC::symbol, ex>> defs;
+  std::map<std::string, GiNaC::symbol> by_text;
+  CanonicalText canon;
+
+  ex term(const ex& c, const ex& monomial) {
+    if (!GiNaC::is_a<GiNaC::add>(c)) return c * monomial;
+    const ex neg = (-c).expand();
+    const bool flip = canon.of(neg) < canon.of(c);
+    const ex rep = flip ? neg : c;
+    const std::string& key = canon.of(rep);
+    auto it = by_text.find(key);
+    if (it == by_text.end()) {
+      GiNaC::symbol sym("_coef" + std::to_string(defs.size()));
+      defs.emplace_back(sym, rep);
+      it = by_text.emplace(key, sym).first;
+    }
+    return flip ? -it->second * monomial : it->second * monomial;
+  }
+};
+
 struct FunctionCode {
   std::string body;
   OpCount ops;
@@ -105,8 +129,11 @@ struct FunctionCode {
 };
 
 // Body of a generated function: used inputs, one CSE pass over all groups, guarded outputs.
-FunctionCode function_body(const InputTable& inputs, const std::vector<OutputGroup>& groups) {
+FunctionCode function_body(const InputTable& inputs, const std::vector<OutputGroup>& groups,
+                           const Coefficients* coefficients = nullptr) {
   std::vector<ex> all;
+  const std::size_t ncoef = coefficients ? coefficients->defs.size() : 0;
+  for (std::size_t k = 0; k < ncoef; ++k) all.push_back(coefficients->defs[k].second);
   for (const auto& g : groups) all.insert(all.end(), g.values.begin(), g.values.end());
   const CseResult cse = eliminate_common_subexpressions(all);
 
@@ -139,8 +166,12 @@ FunctionCode function_body(const InputTable& inputs, const std::vector<OutputGro
   os << "\n  // Intermediate terms (" << cse.temps.size() << ")\n";
   for (const auto& t : cse.temps)
     os << "  const Scalar " << t.symbol.get_name() << " = " << printer.print(t.value) << ";\n";
+  if (ncoef > 0) os << "\n  // Coefficients of the error monomials (" << ncoef << ")\n";
+  for (std::size_t k = 0; k < ncoef; ++k)
+    os << "  const Scalar " << coefficients->defs[k].first.get_name() << " = "
+       << printer.print(cse.outputs[k]) << ";\n";
   os << "\n  // Outputs\n";
-  std::size_t k = 0;
+  std::size_t k = ncoef;
   for (const auto& g : groups) {
     os << "  if (" << g.pointer << " != nullptr) {\n";
     os << "    auto& _" << g.pointer << " = *" << g.pointer << ";\n";
@@ -171,10 +202,19 @@ std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_la
   const std::vector<Monomial> higher = m.higher_monomials();
 
   // Deviation: the full algebra element of each output.
+  Coefficients coefs;
   std::vector<ex> pos, rot;
-  for (int o = 0; o < 3; ++o) pos.push_back(m.outputs[o].to_ex(m.errors));
-  for (int o = 3; o < 6; ++o) rot.push_back(m.outputs[o].to_ex(m.errors));
-  const FunctionCode dev = function_body(inputs, {{"position", pos}, {"orientation", rot}});
+  for (int o = 0; o < 6; ++o) {
+    GiNaC::exvector terms;
+    for (const auto& [mono, c] : m.outputs[o].terms()) {
+      ex monomial = 1;
+      for (auto i : mono) monomial *= m.errors[i];
+      terms.push_back(coefs.term(c, monomial));
+    }
+    (o < 3 ? pos : rot).push_back(GiNaC::add(terms));
+  }
+  const FunctionCode dev =
+      function_body(inputs, {{"position", pos}, {"orientation", rot}}, &coefs);
 
   // Coefficients: ∂output/∂error at zero error, row-major [output][error].
   std::vector<ex> cpos, crot;

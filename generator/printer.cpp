@@ -1,5 +1,6 @@
 #include "printer.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <stdexcept>
 
@@ -76,7 +77,16 @@ std::string ExprPrinter::print(const ex& e) {
   if (GiNaC::is_a<GiNaC::add>(e)) {
     std::string s;
     bool first = true;
-    for (const ex& op : canon_.sorted_ops(e)) {
+    const OpCount counted = ops_;  // the partition's trial printing must not count
+    // Canonical order, positive terms first: "(tool_length - z)" rather than "(-z + tool_length)".
+    std::vector<ex> ops = canon_.sorted_ops(e);
+    std::stable_partition(ops.begin(), ops.end(), [this](const ex& op) {
+      bool neg = false;
+      term(op, neg);
+      return !neg;
+    });
+    ops_ = counted;
+    for (const ex& op : ops) {
       bool neg = false;
       std::string t = term(op, neg);
       if (first) {

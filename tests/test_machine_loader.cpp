@@ -85,7 +85,7 @@ TEST_CASE("expr: parses, evaluates and prints") {
 }
 
 TEST_CASE("expr: errors name the position") {
-  CHECK(expr_error("") .find("empty") != std::string::npos);
+  CHECK(expr_error("").find("empty") != std::string::npos);
   CHECK(expr_error("1 +").find("position 4") != std::string::npos);
   CHECK(expr_error("(1 + 2").find("expected ')'") != std::string::npos);
   CHECK(expr_error("a $ b").find("unexpected '$' at position 3") != std::string::npos);
@@ -199,12 +199,13 @@ TEST_CASE("loader: a good machine") {
   // Base first, parents before children, otherwise file order.
   std::vector<std::string> order;
   for (const Body& b : d.bodies) order.push_back(b.name);
-  CHECK(order ==
-        std::vector<std::string>{"bed", "x_carriage", "y_slide", "c_table", "z_ram", "tool", "table"});
+  CHECK(order == std::vector<std::string>{"bed", "x_carriage", "y_slide", "c_table", "z_ram",
+                                          "tool", "table"});
   CHECK(d.bodies[0].parent == -1);
   CHECK(d.bodies[6].parent == d.body_index("x_carriage"));
-  CHECK(d.chain_to(d.body_index("tool")) ==
-        std::vector<int>{0, d.body_index("y_slide"), d.body_index("c_table"), d.body_index("tool")});
+  CHECK(d.chain_to(d.body_index("tool")) == std::vector<int>{0, d.body_index("y_slide"),
+                                                             d.body_index("c_table"),
+                                                             d.body_index("tool")});
   CHECK(d.axes() == std::vector<int>{1, 2, 3, 4});
   CHECK(d.bodies[d.tool.body].name == "tool");
   CHECK(d.bodies[d.workpiece.body].name == "table");
@@ -225,8 +226,8 @@ TEST_CASE("loader: a good machine") {
   std::vector<std::string> names;
   for (const ErrorDef& e : d.errors) names.push_back(e.name);
   CHECK(names == std::vector<std::string>{"E_XX", "E_YX", "E_BX", "E_C0Y", "E_X0C", "E_C0C",
-                                          "E_Z0C", "pitch", "E_XZ", "E_YZ", "E_ZZ", "E_AZ",
-                                          "E_BZ", "E_CZ"});
+                                          "E_Z0C", "pitch", "E_XZ", "E_YZ", "E_ZZ", "E_AZ", "E_BZ",
+                                          "E_CZ"});
   CHECK(x.errors == std::vector<int>{0, 1, 2});
   CHECK(d.errors[4].body == 3);
 
@@ -340,7 +341,7 @@ TEST_CASE("loader: shipped machines load and resolve by name") {
     CHECK_NOTHROW(load_machine_file(resolved));
     ++count;
   }
-  CHECK(count >= 0);
+  CHECK(count > 0);
 }
 
 TEST_CASE("loader: resolve_machine names the missing machine") {
@@ -384,7 +385,8 @@ bodies:
 tool: {body: x}
 workpiece: {body: bed}
 )",
-               "bad.yaml:7:5", {"bodies.x", "unknown key 'colour'", "parent, offset, joint, errors"});
+               "bad.yaml:7:5",
+               {"bodies.x", "unknown key 'colour'", "parent, offset, joint, errors"});
 }
 
 TEST_CASE("bad: unknown key in a joint") {
@@ -464,9 +466,10 @@ workpiece: {body: bed}
 }
 
 TEST_CASE("bad: format version") {
-  expect_error("weilgen: 2\nname: bad\nbodies: {bed: {}}\ntool: {body: bed}\n"
-               "workpiece: {body: bed}\n",
-               "bad.yaml:1:10", {"weilgen", "unsupported format version '2'"});
+  expect_error(
+      "weilgen: 2\nname: bad\nbodies: {bed: {}}\ntool: {body: bed}\n"
+      "workpiece: {body: bed}\n",
+      "bad.yaml:1:10", {"weilgen", "unsupported format version '2'"});
 }
 
 TEST_CASE("bad: names that are not identifiers") {
@@ -475,10 +478,11 @@ TEST_CASE("bad: names that are not identifiers") {
                {"name", "'my machine' is not an identifier"});
   expect_error("weilgen: 1\nname: m\nbodies: {bed: {}, 2x: {parent: bed}}\n" + ends,
                "bad.yaml:3:19", {"bodies", "body name '2x' is not an identifier"});
-  expect_error("weilgen: 1\nname: m\nbodies:\n  bed: {}\n"
-               "  x: {parent: bed, joint: {type: prismatic, axis: x, coordinate: X-1}}\n" +
-                   ends,
-               "bad.yaml:5:66", {"bodies.x.joint.coordinate", "'X-1' is not an identifier"});
+  expect_error(
+      "weilgen: 1\nname: m\nbodies:\n  bed: {}\n"
+      "  x: {parent: bed, joint: {type: prismatic, axis: x, coordinate: X-1}}\n" +
+          ends,
+      "bad.yaml:5:66", {"bodies.x.joint.coordinate", "'X-1' is not an identifier"});
   expect_error("weilgen: 1\nname: m\nparameters: {tool length: 3}\nbodies: {bed: {}}\n" + ends,
                "bad.yaml:3:14", {"parameters", "'tool length' is not an identifier"});
   expect_error("weilgen: 1\nname: m\nbodies:\n  bed:\n    errors:\n      bad-name: {}\n" + ends,
@@ -514,9 +518,9 @@ bodies:
   const std::string ends = "tool: {body: head}\nworkpiece: {body: bed}\n";
   expect_error(head + "      drift: {effect: rotation, direction: z, group: spindle}\n" + ends,
                "bad.yaml:12:7", {"duplicate error name 'drift'", "line 8"});
-  expect_error(head + "      sway: {effect: rotation, direction: z, group: spindle, aliases: [d1]}\n" +
-                   ends,
-               "bad.yaml:12:72", {"duplicate alias 'd1'", "alias of error drift", "line 8"});
+  expect_error(
+      head + "      sway: {effect: rotation, direction: z, group: spindle, aliases: [d1]}\n" + ends,
+      "bad.yaml:12:72", {"duplicate alias 'd1'", "alias of error drift", "line 8"});
   expect_error(head + "      d1: {effect: rotation, direction: z, group: spindle}\n" + ends,
                "bad.yaml:12:7", {"duplicate error name 'd1'", "alias of error drift"});
 }
@@ -531,7 +535,8 @@ bodies:
 tool: {body: x2}
 workpiece: {body: bed}
 )",
-               "bad.yaml:6:65", {"bodies.x2.joint.coordinate", "duplicate coordinate 'X'", "line 5"});
+               "bad.yaml:6:65",
+               {"bodies.x2.joint.coordinate", "duplicate coordinate 'X'", "line 5"});
 }
 
 TEST_CASE("bad: coordinate named like a parameter") {
@@ -596,9 +601,10 @@ tool: {body: a}
 workpiece: {body: bed}
 )",
                "bad.yaml:5:15", {"bodies.a.parent", "cycle", "a -> c -> b -> a"});
-  expect_error("weilgen: 1\nname: bad\nbodies:\n  bed: {}\n  a: {parent: a}\n"
-               "tool: {body: a}\nworkpiece: {body: bed}\n",
-               "bad.yaml:5:15", {"bodies.a.parent", "own parent"});
+  expect_error(
+      "weilgen: 1\nname: bad\nbodies:\n  bed: {}\n  a: {parent: a}\n"
+      "tool: {body: a}\nworkpiece: {body: bed}\n",
+      "bad.yaml:5:15", {"bodies.a.parent", "own parent"});
 }
 
 TEST_CASE("bad: tool or workpiece body unknown") {
@@ -612,17 +618,21 @@ TEST_CASE("bad: tool or workpiece body unknown") {
 TEST_CASE("bad: zero direction vectors") {
   const std::string head = "weilgen: 1\nname: bad\ngroups: [g]\nbodies:\n  bed: {}\n";
   const std::string ends = "tool: {body: bed}\nworkpiece: {body: bed}\n";
-  expect_error(head + "  x: {parent: bed, joint: {type: prismatic, axis: [0, 0, 0], coordinate: X}}\n" +
+  expect_error(
+      head + "  x: {parent: bed, joint: {type: prismatic, axis: [0, 0, 0], coordinate: X}}\n" +
+          ends,
+      "bad.yaml:6:51", {"bodies.x.joint.axis", "direction must not be zero"});
+  expect_error(head +
+                   "  x: {parent: bed, errors: {e: {effect: rotation, direction: [0, 0, 0], "
+                   "group: g, sigma: 1}}}\n" +
                    ends,
-               "bad.yaml:6:51", {"bodies.x.joint.axis", "direction must not be zero"});
-  expect_error(head + "  x: {parent: bed, errors: {e: {effect: rotation, direction: [0, 0, 0], "
-                      "group: g, sigma: 1}}}\n" + ends,
                "bad.yaml:6:62", {"bodies.x.errors.e.direction", "direction must not be zero"});
-  expect_error(head + "  x: {parent: bed, offset: {rotation: [{axis: [0, 0, 0], angle: 90}]}}\n" +
-                   ends,
-               "bad.yaml:6:47", {"bodies.x.offset.rotation[0].axis", "must not be zero"});
-  expect_error(head + "  x: {parent: bed, joint: {type: revolute, axis: w, coordinate: C}}\n" + ends,
-               "bad.yaml:6:50", {"bodies.x.joint.axis", "unknown direction 'w'"});
+  expect_error(
+      head + "  x: {parent: bed, offset: {rotation: [{axis: [0, 0, 0], angle: 90}]}}\n" + ends,
+      "bad.yaml:6:47", {"bodies.x.offset.rotation[0].axis", "must not be zero"});
+  expect_error(
+      head + "  x: {parent: bed, joint: {type: revolute, axis: w, coordinate: C}}\n" + ends,
+      "bad.yaml:6:50", {"bodies.x.joint.axis", "unknown direction 'w'"});
 }
 
 TEST_CASE("bad: range with min > max") {
@@ -679,12 +689,14 @@ algebra:
 
 TEST_CASE("bad: unknown group in an error or in error_defaults") {
   const std::string ends = "tool: {body: bed}\nworkpiece: {body: bed}\n";
-  expect_error("weilgen: 1\nname: bad\nbodies:\n  bed:\n    errors:\n"
-               "      e: {effect: rotation, direction: z, group: wobble, sigma: 1}\n" + ends,
-               "bad.yaml:6:50", {"bodies.bed.errors.e.group", "unknown group 'wobble'", "groups:"});
-  expect_error("weilgen: 1\nname: bad\nerror_defaults:\n  wobble: {sigma: 1}\nbodies: {bed: {}}\n" +
-                   ends,
-               "bad.yaml:4:3", {"error_defaults", "unknown group 'wobble'"});
+  expect_error(
+      "weilgen: 1\nname: bad\nbodies:\n  bed:\n    errors:\n"
+      "      e: {effect: rotation, direction: z, group: wobble, sigma: 1}\n" +
+          ends,
+      "bad.yaml:6:50", {"bodies.bed.errors.e.group", "unknown group 'wobble'", "groups:"});
+  expect_error(
+      "weilgen: 1\nname: bad\nerror_defaults:\n  wobble: {sigma: 1}\nbodies: {bed: {}}\n" + ends,
+      "bad.yaml:4:3", {"error_defaults", "unknown group 'wobble'"});
 }
 
 TEST_CASE("bad: units") {
@@ -696,17 +708,22 @@ bodies:
     parent: bed
 )";
   const std::string ends = "tool: {body: x}\nworkpiece: {body: bed}\n";
-  expect_error(head + "    joint: {type: prismatic, axis: x, coordinate: X}\n"
-                      "    errors: {E_XX: {sigma: 1, unit: furlong}}\n" + ends,
+  expect_error(head +
+                   "    joint: {type: prismatic, axis: x, coordinate: X}\n"
+                   "    errors: {E_XX: {sigma: 1, unit: furlong}}\n" +
+                   ends,
                "bad.yaml:8:37", {"bodies.x.errors.E_XX.unit", "unknown unit 'furlong'", "arcsec"});
   expect_error(head + "    joint: {type: prismatic, axis: x, coordinate: X, unit: deg}\n" + ends,
                "bad.yaml:7:60", {"bodies.x.joint.unit", "unknown unit 'deg'", "mm, um, m"});
-  expect_error(head + "    joint: {type: prismatic, axis: x, coordinate: X}\n"
-                      "    errors: {E_AX: {sigma: 1, unit: um}}\n" + ends,
+  expect_error(head +
+                   "    joint: {type: prismatic, axis: x, coordinate: X}\n"
+                   "    errors: {E_AX: {sigma: 1, unit: um}}\n" +
+                   ends,
                "bad.yaml:8:37", {"unit 'um' is a length", "'E_AX' is a rotation"});
-  expect_error("weilgen: 1\nname: bad\nparameters: {L: {value: 1, unit: inch}}\n"
-               "bodies: {bed: {}}\ntool: {body: bed}\nworkpiece: {body: bed}\n",
-               "bad.yaml:3:34", {"parameters.L.unit", "unknown unit 'inch'"});
+  expect_error(
+      "weilgen: 1\nname: bad\nparameters: {L: {value: 1, unit: inch}}\n"
+      "bodies: {bed: {}}\ntool: {body: bed}\nworkpiece: {body: bed}\n",
+      "bad.yaml:3:34", {"parameters.L.unit", "unknown unit 'inch'"});
 }
 
 TEST_CASE("bad: unknown placement, effect, dependence, joint type") {
@@ -726,9 +743,10 @@ bodies:
                {"bodies.x.errors.E_XX.effect", "unknown value 'twist'", "translation, rotation"});
   expect_error(head + "      E_XX: {sigma: 1, dependence: PXGE}\n" + ends, "bad.yaml:9:36",
                {"bodies.x.errors.E_XX.dependence", "unknown value 'PXGE'", "PDGE, PIGE"});
-  expect_error("weilgen: 1\nname: bad\nbodies:\n  bed: {}\n  x: {parent: bed, joint: {type: "
-               "sliding}}\ntool: {body: x}\nworkpiece: {body: bed}\n",
-               "bad.yaml:5:34", {"bodies.x.joint.type", "unknown value 'sliding'"});
+  expect_error(
+      "weilgen: 1\nname: bad\nbodies:\n  bed: {}\n  x: {parent: bed, joint: {type: "
+      "sliding}}\ntool: {body: x}\nworkpiece: {body: bed}\n",
+      "bad.yaml:5:34", {"bodies.x.joint.type", "unknown value 'sliding'"});
 }
 
 TEST_CASE("bad: custom error without effect, direction or group") {
@@ -844,9 +862,9 @@ bodies:
     errors:
 )";
   const std::string ends = "tool: {body: x}\nworkpiece: {body: bed}\n";
-  expect_error(head + "      E_XY: {}\n" + ends, "bad.yaml:10:7",
-               {"'E_XY' is not an ISO 230-1 error of body 'x'", "coordinate Y",
-                "joint coordinate is X"});
+  expect_error(
+      head + "      E_XY: {}\n" + ends, "bad.yaml:10:7",
+      {"'E_XY' is not an ISO 230-1 error of body 'x'", "coordinate Y", "joint coordinate is X"});
   expect_error(head + "      E_A0X: {}\n" + ends, "bad.yaml:10:7",
                {"'E_A0X'", "own direction has no meaning for a line"});
   expect_error(head + "      E_Y0X: {}\n" + ends, "bad.yaml:10:7",

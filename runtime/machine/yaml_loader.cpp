@@ -436,7 +436,7 @@ class Loader {
       def.distribution = *dist;
       if (const Entry* u = dm.find("unit")) def.unit = unit(u->value, kErrorUnits)->name;
       defaults_[group] = def;
-      default_fields_[group] = dm.self;
+      if (const Entry* u = dm.find("unit")) default_units_.emplace(group, u->value);
     }
   }
 
@@ -876,7 +876,7 @@ class Loader {
     if (!unit_given && !def.unit.empty()) err.unit = def.unit;
     double scale = 1;
     if (!def.unit.empty()) {
-      check_dimension(default_fields_.at(err.group), err, def.unit);
+      check_dimension(default_units_.at(err.group), err, def.unit);
       scale = find_unit(kErrorUnits, def.unit)->to_base / find_unit(kErrorUnits, err.unit)->to_base;
     }
     err.distribution = def.distribution;
@@ -976,9 +976,9 @@ class Loader {
   Description d_;
   std::map<std::string, double> parameter_defaults_;
   std::map<std::string, GroupDefault> defaults_;
-  std::map<std::string, Field> default_fields_;
-  std::map<std::string, Claim> error_names_;  // error names and aliases
-  std::map<std::string, Claim> symbols_;      // parameters, coordinates, error names
+  std::map<std::string, Field> default_units_;  // where each group default's unit is written
+  std::map<std::string, Claim> error_names_;    // error names and aliases
+  std::map<std::string, Claim> symbols_;        // parameters, coordinates, error names
   std::vector<BodyDraft> drafts_;
   std::vector<ErrorDef> errors_;              // in file order; moved into d_ in tree order
   std::vector<std::string> parameter_names_;  // in file order, for messages
@@ -998,6 +998,10 @@ Description load_machine_text(const std::string& yaml, const std::string& filena
 }
 
 Description load_machine_file(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    throw InputError({path, 0, 0}, "is a directory, not a machine file");
+  }
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError({path, 0, 0}, "cannot read the machine file");
   std::ostringstream text;

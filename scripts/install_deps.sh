@@ -1,0 +1,20 @@
+#!/usr/bin/env bash
+# Installs weilgen's build and test dependencies from Debian 12 packages (run as root).
+# Does nothing when everything is already installed.
+set -euo pipefail
+packages=(
+  build-essential cmake pkg-config git
+  libginac-dev libeigen3-dev libboost-program-options-dev libboost-dev
+  libyaml-cpp-dev nlohmann-json3-dev doctest-dev libbenchmark-dev
+  time
+)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  echo "installing: ${missing[*]}"
+  export DEBIAN_FRONTEND=noninteractive
+  apt-get update -qq
+  apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi

@@ -1,0 +1,247 @@
+// Generation end to end: golden files, determinism, topology edits, order-2 code compiled and
+// run, and the CLI's handling of bad input.
+#include <doctest/doctest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "atomic_file.hpp"
+#include "emit_report.hpp"
+#include "generate.hpp"
+#include "machine/yaml_loader.hpp"
+#include "model_eval.hpp"
+#include "numeric_chain.hpp"
+#include "test_support.hpp"
+
+using namespace weilgen;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string text_of(const std::string& path) {
+  std::string s;
+  REQUIRE(read_file(path, s));
+  return s;
+}
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path p = fs::path(WEILGEN_TEST_TMP) / name;
+  fs::remove_all(p);
+  fs::create_directories(p);
+  return p;
+}
+
+struct Run {
+  int status = 0;
+  std::string out;
+};
+
+Run run(const std::string& cmd) {
+  Run r;
+  FILE* pipe = popen((cmd + " 2>&1").c_str(), "r");
+  REQUIRE(pipe != nullptr);
+  char buf[4096];
+  while (std::fgets(buf, sizeof buf, pipe)) r.out += buf;
+  const int status = pclose(pipe);
+  r.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+std::string cli(const std::string& args) { return std::string(WEILGEN_BINARY) + " " + args; }
+
+void replace_once(std::string& s, const std::string& from, const std::string& to) {
+  const auto pos = s.find(from);
+  REQUIRE_MESSAGE(pos != std::string::npos, from);
+  s.replace(pos, from.size(), to);
+}
+
+}  // namespace
+
+TEST_CASE("committed generated files are byte-identical to fresh generation, in any order") {
+  // Two passes in different orders: GiNaC's internal term order depends on symbol creation order,
+  // the output must not.
+  std::vector<std::string> names = test::shipped_machines();
+  for (int pass = 0; pass < 2; ++pass) {
+    for (const auto& name : names) {
+      CAPTURE(name);
+      const Description d = load_machine_file(test::machine_path(name));
+      const auto files =
+          gen::generate_files(d, 0, std::string(WEILGEN_SOURCE_DIR) + "/generated");
+      REQUIRE(files.size() == 2);
+      CHECK(gen::stale_files(files).empty());
+    }
+    std::reverse(names.begin(), names.end());
+  }
+}
+
+TEST_CASE("order-2 generation is deterministic") {
+  const Description d = load_machine_file(test::machine_path("five_axis_ac"));
+  const auto a = gen::generate_files(d, 2, "x");
+  const auto b = gen::generate_files(load_machine_file(test::machine_path("vmc_3axis")), 2, "x");
+  const auto c = gen::generate_files(d, 2, "x");
+  CHECK(a[0].contents == c[0].contents);
+  CHECK(a[1].contents == c[1].contents);
+  CHECK(a[0].path == "x/five_axis_ac_o2.hpp");
+  CHECK(b[0].contents.find("HigherOrder") != std::string::npos);
+}
+
+TEST_CASE("topology edit: X moved from the workpiece branch to the tool branch") {
+  std::string text = text_of(test::machine_path("vmc_3axis"));
+  // Column-moving variant: bed -> X -> Z -> spindle carries the tool; the table rides on Y only.
+  replace_once(text, "  x_axis:\n    parent: y_axis", "  x_axis:\n    parent: bed");
+  replace_once(text, "  workpiece:\n    parent: x_axis", "  workpiece:\n    parent: y_axis");
+  replace_once(text, "  z_axis:\n    parent: bed", "  z_axis:\n    parent: x_axis");
+  const fs::path dir = fresh_dir("topology_edit");
+  const std::string path = (dir / "vmc_column.yaml").string();
+  write_file_atomically(path, text);
+
+  const Description d = load_machine_file(path);
+  const gen::SymbolicModel m = gen::build_model(d, 1);
+  // X now moves the tool: its positioning error enters dx with +1 instead of -1.
+  CHECK(m.coefficient(0, {static_cast<std::uint16_t>(d.error_index("E_XX"))}).is_equal(1));
+  const Description original = load_machine_file(test::machine_path("vmc_3axis"));
+  CHECK(gen::build_model(original, 1)
+            .coefficient(0, {static_cast<std::uint16_t>(original.error_index("E_XX"))})
+            .is_equal(-1));
+
+  // The regenerated model still matches the exact chain to O(s²).
+  const NumericChain chain(d);
+  std::mt19937 rng(3);
+  const auto q = test::random_pose(d, rng);
+  const auto u = test::random_direction(d, rng);
+  const double r1 = test::max_abs_diff(gen::evaluate_model(m, q, test::scaled(u, 0.2)),
+                                       chain.deviation(q, test::scaled(u, 0.2)));
+  const double r2 = test::max_abs_diff(gen::evaluate_model(m, q, test::scaled(u, 0.1)),
+                                       chain.deviation(q, test::scaled(u, 0.1)));
+  CHECK(r1 / r2 == doctest::Approx(4).epsilon(0.15));
+
+  // And through the CLI the header is regenerated with the new closed form.
+  const Run g = run(cli("generate " + path + " --out " + dir.string()));
+  CHECK(g.status == 0);
+  const std::string header = text_of((dir / "vmc_3axis.hpp").string());
+  CHECK(header.find("vmc_column.yaml") != std::string::npos);
+  CHECK(header != text_of(std::string(WEILGEN_SOURCE_DIR) + "/generated/vmc_3axis.hpp"));
+}
+
+TEST_CASE("order-2 header compiles standalone (C++20, no exceptions) and matches the chain") {
+  const fs::path dir = fresh_dir("order2");
+  const Run g = run(cli("generate five_axis_ac --order 2 --out " + dir.string()));
+  REQUIRE_MESSAGE(g.status == 0, g.out);
+  // A driver that evaluates Deviation, and rebuilds it from Coefficients and HigherOrder.
+  const std::string driver = R"(#include "five_axis_ac_o2.hpp"
+#include <cstdio>
+#include <cstdlib>
+namespace m = weilgen_models::five_axis_ac_o2;
+int main(int argc, char** argv) {
+  std::array<double, m::kNumAxes> q{};
+  std::array<double, m::kNumErrors> e{};
+  std::array<double, m::kNumParams> p{};
+  int k = 1;
+  for (auto& v : q) v = std::atof(argv[k++]);
+  for (auto& v : e) v = std::atof(argv[k++]);
+  for (std::size_t i = 0; i < p.size(); ++i) p[i] = m::kParams[i].default_value;
+  if (k != argc) return 2;
+  std::array<double, 3> pos{}, rot{};
+  m::Deviation(q, e, p, &pos, &rot);
+  std::array<double, 3 * m::kNumErrors> cp{}, cr{};
+  m::Coefficients(q, p, &cp, &cr);
+  std::array<double, m::kNumOutputs * m::kNumHigherTerms> h{};
+  m::HigherOrder(q, p, &h);
+  for (std::size_t o = 0; o < 6; ++o) {
+    double v = 0;
+    for (std::size_t i = 0; i < m::kNumErrors; ++i) v += (o < 3 ? cp[o * m::kNumErrors + i] : cr[(o - 3) * m::kNumErrors + i]) * e[i];
+    for (std::size_t t = 0; t < m::kNumHigherTerms; ++t) {
+      double mono = h[o * m::kNumHigherTerms + t];
+      for (int idx : m::kHigherTerms[t]) if (idx >= 0) mono *= e[static_cast<std::size_t>(idx)];
+      v += mono;
+    }
+    std::printf("%.17g %.17g\n", o < 3 ? pos[o] : rot[o - 3], v);
+  }
+  return 0;
+})";
+  write_file_atomically((dir / "driver.cpp").string(), driver);
+  const std::string exe = (dir / "driver").string();
+  const Run c = run(std::string(WEILGEN_CXX) + " -std=c++20 -O1 -Wall -Wextra -Werror -fno-exceptions -fno-rtti -I" +
+                    dir.string() + " " + (dir / "driver.cpp").string() + " -o " + exe);
+  REQUIRE_MESSAGE(c.status == 0, c.out);
+
+  const Description d = load_machine_file(test::machine_path("five_axis_ac"));
+  const NumericChain chain(d);
+  std::mt19937 rng(9);
+  const auto q = test::random_pose(d, rng);
+  const auto u = test::random_direction(d, rng);
+  std::vector<double> residual;
+  for (double s : {0.4, 0.2}) {
+    const auto e = test::scaled(u, s);
+    std::ostringstream args;
+    args.precision(17);
+    for (double v : q) args << " " << v;
+    for (double v : e) args << " " << v;
+    const Run r = run(exe + args.str());
+    REQUIRE_MESSAGE(r.status == 0, r.out);
+    std::istringstream in(r.out);
+    std::array<double, 6> dev{};
+    for (int o = 0; o < 6; ++o) {
+      double rebuilt = 0;
+      in >> dev[o] >> rebuilt;
+      CHECK(rebuilt == doctest::Approx(dev[o]).epsilon(1e-9).scale(1e-9));
+    }
+    residual.push_back(test::max_abs_diff(dev, chain.deviation(q, e)));
+  }
+  // Third-order residual: halving s divides it by about 8.
+  CHECK(residual[0] / residual[1] == doctest::Approx(8).epsilon(0.15));
+}
+
+TEST_CASE("CLI: bad input exits non-zero with file:line:column and writes nothing") {
+  const fs::path dir = fresh_dir("bad_input");
+  const std::string bad = (dir / "bad.yaml").string();
+  std::string text = text_of(test::machine_path("two_axis"));
+  replace_once(text, "axis: y, coordinate: Y", "axis: [0, 0, 0], coordinate: Y");
+  write_file_atomically(bad, text);
+  write_file_atomically((dir / "two_axis.hpp").string(), "old contents\n");
+  const Run r = run(cli("generate " + bad + " --out " + dir.string()));
+  CHECK(r.status == 3);
+  CHECK(r.out.find(bad + ":") != std::string::npos);
+  CHECK(r.out.find("zero") != std::string::npos);
+  CHECK(text_of((dir / "two_axis.hpp").string()) == "old contents\n");
+  CHECK_FALSE(fs::exists(dir / "two_axis.md"));
+
+  // A good and a bad machine together: nothing is written for either.
+  const Run r2 = run(cli("generate two_axis " + bad + " --out " + dir.string()));
+  CHECK(r2.status == 3);
+  CHECK_FALSE(fs::exists(dir / "two_axis.md"));
+
+  CHECK(run(cli("generate no_such_machine")).status == 3);
+  CHECK(run(cli("generate two_axis --order 0")).status == 2);
+  CHECK(run(cli("show two_axis --format pdf")).status == 2);
+  CHECK(run(cli("frobnicate")).status == 2);
+}
+
+TEST_CASE("CLI: --check reports stale files and exits 1") {
+  const fs::path dir = fresh_dir("check");
+  CHECK(run(cli("generate two_axis --out " + dir.string())).status == 0);
+  CHECK(run(cli("generate two_axis --check --out " + dir.string())).status == 0);
+  std::string h = text_of((dir / "two_axis.hpp").string());
+  replace_once(h, "kOrder = 1", "kOrder = 7");
+  write_file_atomically((dir / "two_axis.hpp").string(), h);
+  const Run r = run(cli("generate two_axis --check --out " + dir.string()));
+  CHECK(r.status == 1);
+  CHECK(r.out.find("two_axis.hpp: stale, 1 of") != std::string::npos);
+}
+
+TEST_CASE("CLI: show prints closed forms in text, LaTeX, JSON and the seed's notation") {
+  const Run t = run(cli("show gantry_grinder --output dx"));
+  CHECK(t.status == 0);
+  CHECK(t.out.rfind("dx = -E_XX", 0) == 0);
+  CHECK(t.out.find("dy") == std::string::npos);
+  const Run a = run(cli("show vmc_3axis --notation alias --output dx"));
+  CHECK(a.out.find("- z·Sxz") != std::string::npos);  // S_xz = -E_B0Z, as the seed prints it
+  const Run l = run(cli("show gantry_grinder --format latex"));
+  CHECK(l.out.find("E_{XX}") != std::string::npos);
+  const Run j = run(cli("show gantry_grinder --format json"));
+  CHECK(j.out.find("\"closed_form\"") != std::string::npos);
+  CHECK(run(cli("--help")).status == 0);
+  for (const char* verb : {"generate", "show", "list"}) CHECK(run(cli(std::string(verb) + " --help")).status == 0);
+}

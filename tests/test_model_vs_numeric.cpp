@@ -1,0 +1,115 @@
+// The symbolic model against the exact numeric chain (written independently of the generator).
+#include <doctest/doctest.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "machine/yaml_loader.hpp"
+#include "emit_report.hpp"
+#include "model_builder.hpp"
+#include "model_eval.hpp"
+#include "numeric_chain.hpp"
+#include "test_support.hpp"
+
+using namespace weilgen;
+
+namespace {
+
+// Slope of the model-versus-chain discrepancy over error scales s = 2^0 ... 2^-5.
+// Rotations are scaled by `rot_scale` relative to translations (rad per mm of the test scale).
+double convergence_slope(const Description& d, int order, unsigned seed, double* smallest = nullptr,
+                         double s_max = 1.0, double rot_scale = 1.0) {
+  const gen::SymbolicModel m = gen::build_model(d, order);
+  const NumericChain chain(d);
+  std::mt19937 rng(seed);
+  const auto q = test::random_pose(d, rng);
+  auto u = test::random_direction(d, rng);
+  for (std::size_t i = 0; i < u.size(); ++i)
+    if (d.errors[i].effect == ErrorEffect::Rotation) u[i] *= rot_scale;
+  std::vector<double> s, err;
+  for (int k = 0; k <= 5; ++k) {
+    const double sc = s_max * std::ldexp(1.0, -k);
+    const auto e = test::scaled(u, sc);
+    s.push_back(sc);
+    err.push_back(test::max_abs_diff(gen::evaluate_model(m, q, e), chain.deviation(q, e)));
+  }
+  if (smallest) *smallest = err.back();
+  return test::loglog_slope(s, err);
+}
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+}  // namespace
+
+TEST_CASE("order-r model differs from the exact chain by O(s^(r+1)) on every shipped machine") {
+  for (const auto& name : test::shipped_machines()) {
+    const Description d = load_machine_file(test::machine_path(name));
+    for (int r = 1; r <= 2; ++r) {
+      for (unsigned seed : {1u, 2u}) {
+        CAPTURE(name);
+        CAPTURE(r);
+        double smallest = 0;
+        const double slope = convergence_slope(d, r, seed, &smallest);
+        CHECK(slope == doctest::Approx(r + 1).epsilon(0.1));
+        CHECK(smallest > 0);
+      }
+    }
+  }
+}
+
+TEST_CASE("order-3 model of the five-axis machine converges as s^4") {
+  const Description d = load_machine_file(test::machine_path("five_axis_ac"));
+    // Larger errors so that the s^4 residual stays far above rounding (1e-13 mm).
+  CHECK(convergence_slope(d, 3, 7, nullptr, 2.0, 10.0) == doctest::Approx(4).epsilon(0.1));
+}
+
+TEST_CASE("first-order coefficients equal central differences of the exact chain") {
+  for (const auto& name : test::shipped_machines()) {
+    CAPTURE(name);
+    const Description d = load_machine_file(test::machine_path(name));
+    const gen::SymbolicModel m = gen::build_model(d, 1);
+    const NumericChain chain(d);
+    std::mt19937 rng(11);
+    const auto q = test::random_pose(d, rng);
+    const auto coeff_model = [&](int o, std::size_t i) {
+      // Linear part of the model: evaluate at a unit error (order 1 is exactly linear).
+      std::vector<double> e(d.errors.size(), 0.0);
+      e[i] = 1.0;
+      return gen::evaluate_model(m, q, e)[o];
+    };
+    for (std::size_t i = 0; i < d.errors.size(); ++i) {
+      const double h = 1e-6;
+      std::vector<double> ep(d.errors.size(), 0.0), em(d.errors.size(), 0.0);
+      ep[i] = h;
+      em[i] = -h;
+      const auto fp = chain.deviation(q, ep), fm = chain.deviation(q, em);
+      for (int o = 0; o < 6; ++o) {
+        CAPTURE(d.errors[i].name);
+        CAPTURE(o);
+        const double fd = (fp[o] - fm[o]) / (2 * h);
+        CHECK(coeff_model(o, i) == doctest::Approx(fd).epsilon(1e-6).scale(1.0));
+      }
+    }
+  }
+}
+
+TEST_CASE("deviation in the workpiece frame does not depend on the workpiece point") {
+  std::string text = read_text(test::machine_path("vmc_3axis"));
+  const Description a = load_machine_text(text, "vmc_3axis.yaml");
+  const auto pos = text.find("workpiece: {body: workpiece, point: [0, 0, 0]}");
+  REQUIRE(pos != std::string::npos);
+  text.replace(pos, std::string("workpiece: {body: workpiece, point: [0, 0, 0]}").size(),
+               "workpiece: {body: workpiece, point: [120, -40, 35]}");
+  const Description b = load_machine_text(text, "vmc_3axis_moved.yaml");
+  const gen::SymbolicModel ma = gen::build_model(a, 1), mb = gen::build_model(b, 1);
+  for (int o = 0; o < 6; ++o) {
+    const auto fa = gen::closed_form(ma, o, gen::FormStyle::Text, gen::Notation::Iso);
+    CHECK(fa == gen::closed_form(mb, o, gen::FormStyle::Text, gen::Notation::Iso));
+    CHECK(fa.size() > 10);
+  }
+}

@@ -1,0 +1,72 @@
+// Shared helpers for the test suite.
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "machine/description.hpp"
+
+namespace weilgen::test {
+
+inline const std::vector<std::string>& shipped_machines() {
+  static const std::vector<std::string> m = {"gantry_grinder", "vmc_3axis", "two_axis",
+                                             "five_axis_ac"};
+  return m;
+}
+
+inline std::string machine_path(const std::string& name) {
+  return std::string(WEILGEN_SOURCE_DIR) + "/machines/" + name + ".yaml";
+}
+
+// A pose drawn uniformly within the joints' ranges.
+inline std::vector<double> random_pose(const Description& d, std::mt19937& rng) {
+  std::vector<double> q;
+  for (int b : d.axes()) {
+    const Joint& j = d.bodies[b].joint;
+    q.push_back(std::uniform_real_distribution<double>(j.min, j.max)(rng));
+  }
+  return q;
+}
+
+// Errors of scale s: translations s·u mm, rotations s·u·1e-3 rad, u uniform in [-1, 1].
+inline std::vector<double> random_direction(const Description& d, std::mt19937& rng) {
+  std::vector<double> u;
+  for (const auto& e : d.errors) {
+    const double v = std::uniform_real_distribution<double>(-1, 1)(rng);
+    u.push_back(e.effect == ErrorEffect::Rotation ? v * 1e-3 : v);
+  }
+  return u;
+}
+
+inline std::vector<double> scaled(const std::vector<double>& u, double s) {
+  std::vector<double> v(u);
+  for (auto& x : v) x *= s;
+  return v;
+}
+
+inline double max_abs_diff(const std::array<double, 6>& a, const std::array<double, 6>& b) {
+  double m = 0;
+  for (int i = 0; i < 6; ++i) m = std::max(m, std::abs(a[i] - b[i]) * (i < 3 ? 1.0 : 1000.0));
+  return m;
+}
+
+// Least-squares slope of log(err) against log(s).
+inline double loglog_slope(const std::vector<double>& s, const std::vector<double>& err) {
+  double mx = 0, my = 0;
+  const double n = static_cast<double>(s.size());
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    mx += std::log(s[i]) / n;
+    my += std::log(err[i]) / n;
+  }
+  double sxy = 0, sxx = 0;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    sxy += (std::log(s[i]) - mx) * (std::log(err[i]) - my);
+    sxx += (std::log(s[i]) - mx) * (std::log(s[i]) - mx);
+  }
+  return sxy / sxx;
+}
+
+}  // namespace weilgen::test
