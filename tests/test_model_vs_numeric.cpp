@@ -113,3 +113,47 @@ TEST_CASE("deviation in the workpiece frame does not depend on the workpiece poi
     CHECK(fa.size() > 10);
   }
 }
+
+TEST_CASE("a relation ideal gives exactly the order-r model with the ideal's monomials removed") {
+  // R[e]/I is a quotient ring: truncating inside every product must equal the full order-r model
+  // with the monomials of I dropped afterwards.
+  std::string text = read_text(test::machine_path("five_axis_ac"));
+  const Description plain = load_machine_text(text, "five_axis_ac.yaml");
+  const std::string from = "algebra: {order: 1}";
+  text.replace(text.find(from), from.size(),
+               "algebra: {order: 2, relations: [{squares: all}, {within: [location]}, "
+               "{pair: [E_XX, E_AC]}]}");
+  const Description related = load_machine_text(text, "five_axis_ac_rel.yaml");
+  const gen::SymbolicModel full = gen::build_model(plain, 2), quot = gen::build_model(related);
+  REQUIRE(quot.order == 2);
+  const auto is_location = [&](int i) { return plain.errors[i].group == "location"; };
+  GiNaC::exmap to_full;
+  for (std::size_t i = 0; i < full.axes.size(); ++i) {
+    to_full[quot.axes[i].coordinate] = full.axes[i].coordinate;
+    if (full.axes[i].revolute) {
+      to_full[quot.axes[i].cos] = full.axes[i].cos;
+      to_full[quot.axes[i].sin] = full.axes[i].sin;
+    }
+  }
+  for (std::size_t i = 0; i < full.params.size(); ++i) to_full[quot.params[i]] = full.params[i];
+  std::size_t dropped = 0;
+  for (int o = 0; o < 6; ++o) {
+    std::size_t kept = 0;
+    for (const auto& [mono, c] : full.outputs[o].terms()) {
+      const bool square = mono.size() == 2 && mono[0] == mono[1];
+      const bool loc = mono.size() == 2 && is_location(mono[0]) && is_location(mono[1]);
+      const bool pair = mono == gen::Monomial{static_cast<std::uint16_t>(plain.error_index("E_XX")),
+                                              static_cast<std::uint16_t>(plain.error_index("E_AC"))};
+      if (square || loc || pair) {
+        ++dropped;
+        CHECK(quot.coefficient(o, mono).is_zero());
+        continue;
+      }
+      ++kept;
+      // Coefficients agree (mapping the quotient model's symbols onto the full model's).
+      CHECK((c - quot.coefficient(o, mono).subs(to_full)).expand().is_zero());
+    }
+    CHECK(kept == quot.outputs[o].terms().size());
+  }
+  CHECK(dropped > 10);
+}

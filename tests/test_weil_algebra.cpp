@@ -1,0 +1,84 @@
+// The Weil algebra R[e_1..e_k]/I and matrices over it.
+#include <doctest/doctest.h>
+
+#include "weil.hpp"
+
+using namespace weilgen::gen;
+using GiNaC::ex;
+
+namespace {
+const Algebra& plain(int order) {
+  static std::map<int, Algebra> cache;
+  return cache.try_emplace(order, order, std::vector<Monomial>{}, GiNaC::exmap{}).first->second;
+}
+Poly pow_of(const Poly& p, int n, const Algebra& alg) {
+  Poly r(1);
+  for (int i = 0; i < n; ++i) r = r.mul(p, alg);
+  return r;
+}
+}  // namespace
+
+TEST_CASE("D^r_k: products above the order vanish, the rest is the binomial expansion") {
+  const Poly e1 = Poly::error(0);
+  const Poly x = Poly(1) + e1;
+  // (1 + e)^3 = 1 + 3e + 3e² + e³ truncated at order 2.
+  const Poly c = pow_of(x, 3, plain(2));
+  CHECK(c.terms().size() == 3);
+  CHECK(c.constant().is_equal(1));
+  CHECK(c.terms().at({0}).is_equal(3));
+  CHECK(c.terms().at({0, 0}).is_equal(3));
+  // Dual numbers: (1 + e)^5 = 1 + 5e.
+  const Poly d = pow_of(x, 5, plain(1));
+  CHECK(d.terms().size() == 2);
+  CHECK(d.terms().at({0}).is_equal(5));
+}
+
+TEST_CASE("relations: the seed's algebra (40), squares vanish but cross products are kept") {
+  const Algebra w(2, {{0, 0}, {1, 1}}, {});
+  const Poly s = Poly::error(0) + Poly::error(1);
+  const Poly sq = s.mul(s, w);  // (e1 + e2)² = 2 e1 e2 when e1² = e2² = 0
+  CHECK(sq.terms().size() == 1);
+  CHECK(sq.terms().at({0, 1}).is_equal(2));
+  CHECK(w.vanishes({0, 0}));
+  CHECK_FALSE(w.vanishes({0, 1}));
+  CHECK(w.vanishes({0, 1, 1}));
+  // A relation of degree above the order is redundant and dropped; a multiple is not minimal.
+  const Algebra v(2, {{0, 1}, {0, 1, 2}, {0, 0, 1}}, {});
+  CHECK(v.relations().size() == 1);
+}
+
+TEST_CASE("small rotations: sin/cos series truncated in the algebra; inverse by negation") {
+  const ex u[3] = {0, 0, 1};
+  for (int r = 1; r <= 3; ++r) {
+    CAPTURE(r);
+    const Algebra& alg = plain(r);
+    const Mat4 rp = rotation_small(u, Poly::error(0), alg);
+    const Mat4 rm = rotation_small(u, -Poly::error(0), alg);
+    const Mat4 id = rp.mul(rm, alg);
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j) {
+        const Poly diff = id.m[i][j] - Poly(i == j ? 1 : 0);
+        CHECK(diff.is_zero());
+      }
+    // cos e = 1 - e²/2 at order >= 2, 1 at order 1.
+    const Poly c = rp.m[0][0];
+    CHECK(c.constant().is_equal(1));
+    if (r >= 2) CHECK(c.terms().at({0, 0}).is_equal(GiNaC::numeric(-1, 2)));
+    if (r == 1) CHECK(c.terms().size() == 1);
+  }
+}
+
+TEST_CASE("Neumann inverse of a chain with symbolic nominal rotation is exact in the algebra") {
+  GiNaC::symbol c("c"), s("s"), q("q");
+  GiNaC::exmap trig;
+  trig[GiNaC::pow(c, 2)] = 1 - GiNaC::pow(s, 2);
+  const Algebra alg(2, {}, trig);
+  const ex ux[3] = {1, 0, 0}, uy[3] = {0, 1, 0};
+  Mat4 m = rotation_cs(ux, c, s, alg);
+  m = m.mul(translation_by(Poly(q) + Poly::error(0), uy, alg), alg);
+  m = m.mul(rotation_small(uy, Poly::error(1), alg), alg);
+  m = m.mul(rotation_small(ux, Poly::error(2), alg), alg);
+  const Mat4 p = neumann_inverse(m, alg).mul(m, alg);
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) CHECK((p.m[i][j] - Poly(i == j ? 1 : 0)).is_zero());
+}
