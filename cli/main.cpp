@@ -15,14 +15,16 @@ struct Verb {
 
 const std::map<std::string, Verb>& verbs() {
   static const std::map<std::string, Verb> v = {
-      {"generate", {weilgen::cli::verb_generate,
-                    "generate <machine>... [--order r] [--out DIR] [--check]\n"
-                    "      multiply the error HTMs over the Weil algebra and write the C++ header\n"
-                    "      and the closed-form report (generated/<machine>.hpp, .md)"}},
-      {"show", {weilgen::cli::verb_show,
-                "show <machine> [--output dx] [--format text|latex|json] [--notation iso|alias]\n"
-                "      [--order r]\n"
-                "      print the closed-form error expressions"}},
+      {"generate",
+       {weilgen::cli::verb_generate,
+        "generate <machine>... [--order r] [--out DIR] [--check]\n"
+        "      multiply the error HTMs over the Weil algebra and write the C++ header\n"
+        "      and the closed-form report (generated/<machine>.hpp, .md)"}},
+      {"show",
+       {weilgen::cli::verb_show,
+        "show <machine> [--output dx] [--format text|latex|json] [--notation iso|alias]\n"
+        "      [--order r]\n"
+        "      print the closed-form error expressions"}},
       {"list", {weilgen::cli::verb_list, "list\n      list the shipped machines"}},
   };
   return v;

@@ -28,8 +28,9 @@ int verb_generate(const Args& args) {
       "truncation order r >= 1, overriding the file's algebra.order; the outputs are then\n"
       "named <name>_o<r>")("out", po::value<std::string>(&out)->default_value("generated"),
                            "output directory")(
-      "check", "write nothing; exit 1 and list the stale files when the files in --out differ\n"
-               "from what would be generated");
+      "check",
+      "write nothing; exit 1 and list the stale files when the files in --out differ\n"
+      "from what would be generated");
   po::options_description hidden;
   hidden.add_options()("machine", po::value<std::vector<std::string>>(), "");
   po::options_description all;
@@ -60,8 +61,9 @@ int verb_generate(const Args& args) {
     const auto stale = gen::stale_files(files);
     for (const auto& s : stale) std::cout << s << "\n";
     if (!stale.empty()) {
-      std::cout << stale.size() << " generated file(s) out of date: run `weilgen generate` and "
-                                   "commit the result\n";
+      std::cout << stale.size()
+                << " generated file(s) out of date: run `weilgen generate` and "
+                   "commit the result\n";
       return 1;
     }
     std::cout << files.size() << " generated file(s) up to date\n";

@@ -16,8 +16,8 @@ int verb_show(const Args& args) {
       "(dx dy dz in mm, da db dc in rad), grouped by error.\n\nOptions");
   std::string output, format = "text", notation = "iso";
   int order = 0;
-  opts.add_options()("help,h", "show this help")(
-      "output", po::value<std::string>(&output), "only this output: dx dy dz da db dc")(
+  opts.add_options()("help,h", "show this help")("output", po::value<std::string>(&output),
+                                                 "only this output: dx dy dz da db dc")(
       "format", po::value<std::string>(&format)->default_value("text"), "text | latex | json")(
       "notation", po::value<std::string>(&notation)->default_value("iso"),
       "iso (ISO 230-1 names) | alias (each error's first alias, e.g. the paper's symbols)")(

@@ -72,8 +72,7 @@ InputTable inputs_of(const SymbolicModel& m) {
     const Joint& j = m.desc.bodies[a.body].joint;
     add(a.coordinate.get_name(), j.coordinate, "axes[" + std::to_string(i) + "]");
     if (a.revolute) {
-      const std::string arg =
-          j.coordinate + " * Scalar(" + format_double(j.to_base) + ")";
+      const std::string arg = j.coordinate + " * Scalar(" + format_double(j.to_base) + ")";
       add(a.cos.get_name(), "cos_" + j.coordinate, "cos(" + arg + ")");
       add(a.sin.get_name(), "sin_" + j.coordinate, "sin(" + arg + ")");
     }
@@ -145,7 +144,8 @@ FunctionCode function_body(const InputTable& inputs, const std::vector<OutputGro
   std::ostringstream os;
   std::set<std::string> used_code;
   for (const auto& s : used)
-    if (auto it = inputs.code_name.find(s); it != inputs.code_name.end()) used_code.insert(it->second);
+    if (auto it = inputs.code_name.find(s); it != inputs.code_name.end())
+      used_code.insert(it->second);
   // cos/sin of a coordinate need the coordinate itself.
   for (const auto& code : inputs.order)
     if (used_code.count(code) && (code.rfind("cos_", 0) == 0 || code.rfind("sin_", 0) == 0))
@@ -213,8 +213,7 @@ std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_la
     }
     (o < 3 ? pos : rot).push_back(GiNaC::add(terms));
   }
-  const FunctionCode dev =
-      function_body(inputs, {{"position", pos}, {"orientation", rot}}, &coefs);
+  const FunctionCode dev = function_body(inputs, {{"position", pos}, {"orientation", rot}}, &coefs);
 
   // Coefficients: ∂output/∂error at zero error, row-major [output][error].
   std::vector<ex> cpos, crot;
@@ -245,7 +244,8 @@ std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_la
      << ">";
   if (!m.relations.empty()) os << " + <" << m.relations.size() << " relation monomials>";
   os << " (order " << m.order << (m.order == 1 ? ", dual numbers" : "") << ")\n";
-  os << "// Units: axes as in kAxes (mm, deg), errors in base units (mm, rad), parameters in mm/deg;\n"
+  os << "// Units: axes as in kAxes (mm, deg), errors in base units (mm, rad), parameters in "
+        "mm/deg;\n"
      << "//        position outputs dx, dy, dz in mm, orientation outputs da, db, dc in rad.\n";
   os << "// Operation counts (after common-subexpression elimination):\n";
   os << "//   Deviation:    " << dev.ops.str() << ", " << dev.temps << " temporaries\n";
@@ -262,13 +262,14 @@ std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_la
   os << "inline constexpr std::size_t kNumParams = " << d.parameters.size() << ";\n";
   os << "inline constexpr std::size_t kNumOutputs = 6;\n";
   os << "inline constexpr std::size_t kNumHigherTerms = " << higher.size() << ";\n";
-  os << "inline constexpr std::size_t kMaxHigherDegree = " << (higher.empty() ? 0 : higher.back().size())
-     << ";\n\n";
+  os << "inline constexpr std::size_t kMaxHigherDegree = "
+     << (higher.empty() ? 0 : higher.back().size()) << ";\n\n";
 
   os << "enum class DistributionKind { kNone, kNormal, kUniform, kTruncatedNormal };\n\n";
   os << "struct AxisInfo {\n  const char* name;\n  const char* unit;\n  bool revolute;\n"
         "  double min;\n  double max;\n  double to_base;  // unit -> mm or rad\n};\n\n";
-  os << "struct ErrorInfo {\n  const char* name;\n  const char* iso;      // ISO 230-1 name or \"\"\n"
+  os << "struct ErrorInfo {\n  const char* name;\n  const char* iso;      // ISO 230-1 name or "
+        "\"\"\n"
         "  const char* aliases;  // space-separated; a leading '-' marks a negated alias\n"
         "  const char* group;\n  const char* unit;     // unit of the distribution values\n"
         "  double to_base;       // unit -> mm or rad (the unit of Deviation's errors)\n"
@@ -277,7 +278,8 @@ std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_la
         "  bool rotation;\n  DistributionKind distribution;\n"
         "  double a, b;    // normal: mean, sigma; uniform: lo, hi (in unit)\n"
         "  double lo, hi;  // truncated normal bounds (in unit)\n};\n\n";
-  os << "struct ParamInfo {\n  const char* name;\n  const char* unit;\n  double default_value;\n};\n\n";
+  os << "struct ParamInfo {\n  const char* name;\n  const char* unit;\n  double "
+        "default_value;\n};\n\n";
 
   os << "inline constexpr std::array<AxisInfo, kNumAxes> kAxes = {{\n";
   for (const auto& a : m.axes) {
@@ -290,7 +292,8 @@ std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_la
   os << "inline constexpr std::array<ErrorInfo, kNumErrors> kErrors = {{\n";
   for (const auto& e : d.errors) {
     std::string aliases;
-    for (const auto& al : e.aliases) aliases += (aliases.empty() ? "" : " ") + std::string(al.sign < 0 ? "-" : "") + al.name;
+    for (const auto& al : e.aliases)
+      aliases += (aliases.empty() ? "" : " ") + std::string(al.sign < 0 ? "-" : "") + al.name;
     os << "    {" << quoted(e.name) << ", " << quoted(e.iso) << ", " << quoted(aliases) << ", "
        << quoted(e.group) << ", " << quoted(e.unit) << ", " << format_double(e.to_base) << ", "
        << (e.dependence == Dependence::PDGE ? "true" : "false") << ", "
@@ -307,13 +310,15 @@ std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_la
     os << "    {" << quoted(p.name) << ", " << quoted(p.unit) << ", "
        << format_double(defaults.at(p.name)) << "},\n";
   os << "}};\n\n";
-  os << "inline constexpr std::array<const char*, kNumOutputs> kOutputs = {{\"dx\", \"dy\", \"dz\", "
+  os << "inline constexpr std::array<const char*, kNumOutputs> kOutputs = {{\"dx\", \"dy\", "
+        "\"dz\", "
         "\"da\", \"db\", \"dc\"}};\n";
   os << "inline constexpr std::array<const char*, kNumOutputs> kOutputUnits = {{\"mm\", \"mm\", "
         "\"mm\", \"rad\", \"rad\", \"rad\"}};\n\n";
   os << "// Monomials of degree >= 2 with a non-zero coefficient: error indices, padded with -1.\n";
   const std::size_t width = higher.empty() ? 1 : higher.back().size();
-  os << "inline constexpr std::array<std::array<int, " << width << ">, kNumHigherTerms> kHigherTerms = {{\n";
+  os << "inline constexpr std::array<std::array<int, " << width
+     << ">, kNumHigherTerms> kHigherTerms = {{\n";
   for (const auto& mono : higher) {
     os << "    {{";
     for (std::size_t i = 0; i < width; ++i)
@@ -322,14 +327,15 @@ std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_la
   }
   os << "}};\n\n";
 
-  const std::string in_doc = "//   axes:   " + doc_list(axis_names) + "\n//   errors: " +
-                             doc_list(error_names) + "\n//   params: " + doc_list(param_names) +
-                             "\n";
+  const std::string in_doc = "//   axes:   " + doc_list(axis_names) +
+                             "\n//   errors: " + doc_list(error_names) +
+                             "\n//   params: " + doc_list(param_names) + "\n";
   os << "// Deviation of the tool point relative to the workpiece, in the workpiece frame:\n"
         "// position = (dx, dy, dz) in mm, orientation = (da, db, dc) in rad. Null outputs are\n"
         "// skipped. Exact in the algebra of order kOrder.\n"
      << in_doc;
-  os << "template <typename Scalar>\nvoid Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,\n"
+  os << "template <typename Scalar>\nvoid Deviation([[maybe_unused]] const std::array<Scalar, "
+        "kNumAxes>& axes,\n"
         "               [[maybe_unused]] const std::array<Scalar, kNumErrors>& errors,\n"
         "               [[maybe_unused]] const std::array<Scalar, kNumParams>& params,\n"
         "               std::array<Scalar, 3>* const position,\n"
@@ -337,18 +343,23 @@ std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_la
         "  using std::cos;\n  using std::sin;\n  using std::sqrt;\n"
      << dev.body << "}\n\n";
   os << "// First-order coefficients d(output)/d(error) at zero error, row-major [output][error]:\n"
-        "// position_coeff rows dx, dy, dz (mm per base unit of the error), orientation_coeff rows\n"
+        "// position_coeff rows dx, dy, dz (mm per base unit of the error), orientation_coeff "
+        "rows\n"
         "// da, db, dc (rad per base unit).\n";
-  os << "template <typename Scalar>\nvoid Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,\n"
+  os << "template <typename Scalar>\nvoid Coefficients([[maybe_unused]] const std::array<Scalar, "
+        "kNumAxes>& axes,\n"
         "                  [[maybe_unused]] const std::array<Scalar, kNumParams>& params,\n"
         "                  std::array<Scalar, 3 * kNumErrors>* const position_coeff,\n"
-        "                  std::array<Scalar, 3 * kNumErrors>* const orientation_coeff = nullptr) {\n"
+        "                  std::array<Scalar, 3 * kNumErrors>* const orientation_coeff = nullptr) "
+        "{\n"
         "  using std::cos;\n  using std::sin;\n  using std::sqrt;\n"
      << coef.body << "}\n";
   if (!higher.empty()) {
     os << "\n// Coefficients of the monomials kHigherTerms in each output, row-major\n"
-          "// [output][term]: output = Coefficients·errors + Σ terms[o][k]·Π errors[kHigherTerms[k]].\n";
-    os << "template <typename Scalar>\nvoid HigherOrder([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,\n"
+          "// [output][term]: output = Coefficients·errors + Σ terms[o][k]·Π "
+          "errors[kHigherTerms[k]].\n";
+    os << "template <typename Scalar>\nvoid HigherOrder([[maybe_unused]] const std::array<Scalar, "
+          "kNumAxes>& axes,\n"
           "                 [[maybe_unused]] const std::array<Scalar, kNumParams>& params,\n"
           "                 std::array<Scalar, kNumOutputs * kNumHigherTerms>* const terms) {\n"
           "  using std::cos;\n  using std::sin;\n  using std::sqrt;\n"

@@ -32,12 +32,24 @@ std::pair<std::string, int> display(const SymbolicModel& m, std::size_t i, Notat
   return {style == FormStyle::Latex ? latex_name(e.name) : e.name, 1};
 }
 
-std::string join_term(const std::string& acc, ex coeff, const std::string& name,
-                      ExprPrinter& pr, FormStyle style) {
+std::string join_term(const std::string& acc, ex coeff, const std::string& name, ExprPrinter& pr,
+                      FormStyle style) {
   const std::string times = style == FormStyle::Latex ? "\\," : "·";
   bool negative = false;
   std::string c;
   if (GiNaC::is_a<GiNaC::add>(coeff)) {
+    // -(a + b)·E reads better than (-a - b)·E: factor out the sign of a mostly negative sum.
+    std::size_t negatives = 0;
+    for (std::size_t i = 0; i < coeff.nops(); ++i) {
+      bool neg = false;
+      const std::string t = pr.print(coeff.op(i));
+      neg = !t.empty() && t[0] == '-';
+      negatives += neg ? 1 : 0;
+    }
+    if (2 * negatives > coeff.nops()) {
+      negative = true;
+      coeff = (-coeff).expand();
+    }
     c = (style == FormStyle::Latex ? "\\left(" : "(") + pr.print(coeff) +
         (style == FormStyle::Latex ? "\\right)" : ")");
   } else {
@@ -64,6 +76,9 @@ std::map<std::string, std::string> symbol_names(const SymbolicModel& m, FormStyl
   return names;
 }
 
+// Common factors pulled out for reading: cos(c)·z - cos(c)·L -> cos(c)·(z - L).
+ex readable(const ex& c) { return GiNaC::collect_common_factors(c); }
+
 }  // namespace
 
 std::string closed_form(const SymbolicModel& m, int o, FormStyle style, Notation notation) {
@@ -74,7 +89,7 @@ std::string closed_form(const SymbolicModel& m, int o, FormStyle style, Notation
     const ex c = m.coefficient(o, {static_cast<std::uint16_t>(i)});
     if (c.is_zero()) continue;
     const auto [name, sign] = display(m, i, notation, style);
-    s = join_term(s, (c * sign).expand(), name, pr, style);
+    s = join_term(s, readable((c * sign).expand()), name, pr, style);
   }
   for (const auto& mono : m.higher_monomials()) {
     const ex c = m.coefficient(o, mono);
@@ -86,10 +101,11 @@ std::string closed_form(const SymbolicModel& m, int o, FormStyle style, Notation
       name += (name.empty() ? "" : (style == FormStyle::Latex ? "\\," : "·")) + n;
       sign *= sg;
     }
-    s = join_term(s, (c * sign).expand(), name, pr, style);
+    s = join_term(s, readable((c * sign).expand()), name, pr, style);
   }
-  const std::string lhs = style == FormStyle::Latex ? std::string("\\delta_{") + (kOutputNames[o] + 1) + "}"
-                                                     : kOutputNames[o];
+  const std::string lhs = style == FormStyle::Latex
+                              ? std::string("\\delta_{") + (kOutputNames[o] + 1) + "}"
+                              : kOutputNames[o];
   return lhs + " = " + (s.empty() ? "0" : s);
 }
 
@@ -147,7 +163,8 @@ std::string emit_report_markdown(const SymbolicModel& m, const std::string& sour
     os << "⟩";
   }
   os << " (order " << m.order << (m.order == 1 ? ": dual numbers" : "") << ").\n";
-  os << "- Outputs: tool point relative to the workpiece, in the workpiece frame: dx, dy, dz in mm; "
+  os << "- Outputs: tool point relative to the workpiece, in the workpiece frame: dx, dy, dz in "
+        "mm; "
         "da, db, dc in rad. Errors in base units (mm, rad).\n";
   os << "- Coordinates print in lower case (`X` → `x`); revolute coordinates appear as "
         "`cos(c)`, `sin(c)` of the angle.\n\n";
@@ -190,7 +207,8 @@ std::string emit_report_markdown(const SymbolicModel& m, const std::string& sour
        << " | " << pl << " | " << (e.dependence == Dependence::PDGE ? "PDGE" : "PIGE") << " | "
        << e.unit << " | " << e.distribution.str() << " |\n";
   }
-  os << "\n## Axes\n\n| coordinate | type | axis | unit | range |\n| --- | --- | --- | --- | --- |\n";
+  os << "\n## Axes\n\n| coordinate | type | axis | unit | range |\n| --- | --- | --- | --- | --- "
+        "|\n";
   for (const auto& a : m.axes) {
     const Joint& j = d.bodies[a.body].joint;
     os << "| " << j.coordinate << " | " << (a.revolute ? "revolute" : "prismatic") << " | ["

@@ -248,8 +248,8 @@ SymbolicModel build_model(const Description& desc, int order_override) {
   const Builder b{desc, model, alg};
 
   const Mat4 tool = b.branch(desc.tool.body, desc.tool);
-  const Mat4 work = b.branch(desc.workpiece.body, PointSpec{desc.workpiece.body,
-                                                            desc.workpiece.point, {}});
+  const Mat4 work =
+      b.branch(desc.workpiece.body, PointSpec{desc.workpiece.body, desc.workpiece.point, {}});
   // P: the tool frame (at the tool point) in the workpiece frame.
   const Mat4 p = neumann_inverse(work, alg).mul(tool, alg);
 

@@ -1,8 +1,9 @@
 // Description → symbolic error model over the Weil algebra.
 #pragma once
 
-#include <array>
 #include <ginac/ginac.h>
+
+#include <array>
 #include <string>
 #include <vector>
 
@@ -13,9 +14,9 @@ namespace weilgen::gen {
 
 inline constexpr int kNumOutputs = 6;
 inline const std::array<const char*, kNumOutputs> kOutputNames = {"dx", "dy", "dz",
-                                                                   "da", "db", "dc"};
+                                                                  "da", "db", "dc"};
 inline const std::array<const char*, kNumOutputs> kOutputUnits = {"mm",  "mm",  "mm",
-                                                                   "rad", "rad", "rad"};
+                                                                  "rad", "rad", "rad"};
 
 struct AxisSymbols {
   int body = -1;
@@ -47,6 +48,7 @@ SymbolicModel build_model(const Description& desc, int order_override = 0);
 // Exact rational for a decimal double (0.1 → 1/10): the shortest decimal that round-trips.
 GiNaC::numeric exact_decimal(double v);
 // Expr (machine file scalar) → GiNaC, with parameters mapped to `params` by name.
-GiNaC::ex to_ginac(const Expr& e, const Description& desc, const std::vector<GiNaC::symbol>& params);
+GiNaC::ex to_ginac(const Expr& e, const Description& desc,
+                   const std::vector<GiNaC::symbol>& params);
 
 }  // namespace weilgen::gen

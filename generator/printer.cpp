@@ -60,8 +60,7 @@ std::string ExprPrinter::number(const GiNaC::numeric& n) {
   }
   if (n.is_integer()) return text(n);
   if (n.is_rational() && n.denom() < 1000) {
-    if (style_ == Style::Latex) return "\\frac{" + text(n.numer()) + "}{" +
-                                      text(n.denom()) + "}";
+    if (style_ == Style::Latex) return "\\frac{" + text(n.numer()) + "}{" + text(n.denom()) + "}";
     return text(n.numer()) + "/" + text(n.denom());
   }
   return format_double(n.to_double());
@@ -124,6 +123,16 @@ std::string ExprPrinter::term(const ex& e, bool& negative) {
     } else if (GiNaC::is_a<GiNaC::power>(op) && GiNaC::is_a<GiNaC::numeric>(op.op(1)) &&
                GiNaC::ex_to<GiNaC::numeric>(op.op(1)).is_negative()) {
       den.push_back(factor(GiNaC::pow(op.op(0), -op.op(1))));
+    } else if (GiNaC::is_a<GiNaC::add>(op)) {
+      // GiNaC picks the sign of a sum inside a product by hash order; print the sum whose
+      // canonical text is smaller and carry the sign, so the text is the same on every run.
+      const ex neg = (-op).expand();
+      if (canon_.of(neg) < canon_.of(op)) {
+        coeff = -coeff;
+        num.push_back(factor(neg));
+      } else {
+        num.push_back(factor(op));
+      }
     } else {
       num.push_back(factor(op));
     }
@@ -162,10 +171,10 @@ std::string ExprPrinter::factor(const ex& e) {
     const ex v = e.evalf();
     if (GiNaC::is_a<GiNaC::numeric>(v)) {
       const GiNaC::numeric n = GiNaC::ex_to<GiNaC::numeric>(v);
-      std::string s = style_ == Style::Cpp
-                          ? "Scalar(" + format_double(n.to_double()) + ")"
-                          : (GiNaC::is_a<GiNaC::numeric>(e) ? number(n)
-                                                            : format_double(n.to_double()));
+      std::string s =
+          style_ == Style::Cpp
+              ? "Scalar(" + format_double(n.to_double()) + ")"
+              : (GiNaC::is_a<GiNaC::numeric>(e) ? number(n) : format_double(n.to_double()));
       return n.is_negative() ? "(" + s + ")" : s;
     }
   }
@@ -183,8 +192,9 @@ std::string ExprPrinter::factor(const ex& e) {
     if (GiNaC::is_a<GiNaC::numeric>(expo) && GiNaC::ex_to<GiNaC::numeric>(expo).is_pos_integer()) {
       const long n = GiNaC::ex_to<GiNaC::numeric>(expo).to_long();
       const std::string b = factor(base);
-      if (style_ != Style::Cpp) return b + (style_ == Style::Latex ? "^{" : "^") +
-                                       std::to_string(n) + (style_ == Style::Latex ? "}" : "");
+      if (style_ != Style::Cpp)
+        return b + (style_ == Style::Latex ? "^{" : "^") + std::to_string(n) +
+               (style_ == Style::Latex ? "}" : "");
       std::string s = b;
       for (long i = 1; i < n; ++i) {
         s += " * " + b;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <ginac/ginac.h>
+
 #include <map>
 #include <string>
 

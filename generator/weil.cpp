@@ -21,10 +21,9 @@ Algebra::Algebra(int order, std::vector<Monomial> relations, GiNaC::exmap trig_r
     : order_(order), trig_rules_(std::move(trig_rules)) {
   // Keep only minimal generators: drop those of degree > r (already vanish) and multiples.
   for (auto& r : relations) std::sort(r.begin(), r.end());
-  std::sort(relations.begin(), relations.end(),
-            [](const Monomial& a, const Monomial& b) {
-              return a.size() != b.size() ? a.size() < b.size() : a < b;
-            });
+  std::sort(relations.begin(), relations.end(), [](const Monomial& a, const Monomial& b) {
+    return a.size() != b.size() ? a.size() < b.size() : a < b;
+  });
   for (const auto& r : relations) {
     if (static_cast<int>(r.size()) > order_) continue;
     bool redundant = std::any_of(relations_.begin(), relations_.end(),

@@ -7,8 +7,9 @@
 // the symbols cos/sin of revolute coordinates, kept expanded and reduced by cos² = 1 − sin².
 #pragma once
 
-#include <cstdint>
 #include <ginac/ginac.h>
+
+#include <cstdint>
 #include <map>
 #include <vector>
 
@@ -83,14 +84,16 @@ struct Mat4 {
 // Exact inverse of a rigid transform with degree-0 entries: [Rᵀ, −Rᵀp; 0, 1].
 Mat4 rigid_inverse(const Mat4& nominal, const Algebra& alg);
 // Inverse of M = M0 + N (M0 rigid, N nilpotent) by the Neumann series
-// (I + M0⁻¹N)⁻¹ M0⁻¹ = Σ_{j=0}^{r} (−M0⁻¹N)^j M0⁻¹, finite because (M0⁻¹N)^{r+1} = 0 in the algebra.
+// (I + M0⁻¹N)⁻¹ M0⁻¹ = Σ_{j=0}^{r} (−M0⁻¹N)^j M0⁻¹, finite because (M0⁻¹N)^{r+1} = 0 in the
+// algebra.
 Mat4 neumann_inverse(const Mat4& m, const Algebra& alg);
 
 // Elementary transforms. `u` is a unit vector of exact coefficients.
 Mat4 translation(const GiNaC::ex (&v)[3]);
 Mat4 translation_by(const Poly& amount, const GiNaC::ex (&u)[3], const Algebra& alg);
 // Rotation by the nominal angle with cosine c and sine s: I + s[u]x + (1 − c)[u]x².
-Mat4 rotation_cs(const GiNaC::ex (&u)[3], const GiNaC::ex& c, const GiNaC::ex& s, const Algebra& alg);
+Mat4 rotation_cs(const GiNaC::ex (&u)[3], const GiNaC::ex& c, const GiNaC::ex& s,
+                 const Algebra& alg);
 // Rotation by a nilpotent angle `angle` (an error): sin and 1 − cos by their series, truncated
 // in the algebra (so e.g. e² = 0 relations remove the e²/2 term).
 Mat4 rotation_small(const GiNaC::ex (&u)[3], const Poly& angle, const Algebra& alg);

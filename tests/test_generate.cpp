@@ -67,8 +67,7 @@ TEST_CASE("committed generated files are byte-identical to fresh generation, in 
     for (const auto& name : names) {
       CAPTURE(name);
       const Description d = load_machine_file(test::machine_path(name));
-      const auto files =
-          gen::generate_files(d, 0, std::string(WEILGEN_SOURCE_DIR) + "/generated");
+      const auto files = gen::generate_files(d, 0, std::string(WEILGEN_SOURCE_DIR) + "/generated");
       REQUIRE(files.size() == 2);
       CHECK(gen::stale_files(files).empty());
     }
@@ -163,7 +162,8 @@ int main(int argc, char** argv) {
 })";
   write_file_atomically((dir / "driver.cpp").string(), driver);
   const std::string exe = (dir / "driver").string();
-  const Run c = run(std::string(WEILGEN_CXX) + " -std=c++20 -O1 -Wall -Wextra -Werror -fno-exceptions -fno-rtti -I" +
+  const Run c = run(std::string(WEILGEN_CXX) +
+                    " -std=c++20 -O1 -Wall -Wextra -Werror -fno-exceptions -fno-rtti -I" +
                     dir.string() + " " + (dir / "driver.cpp").string() + " -o " + exe);
   REQUIRE_MESSAGE(c.status == 0, c.out);
 
@@ -243,5 +243,6 @@ TEST_CASE("CLI: show prints closed forms in text, LaTeX, JSON and the seed's not
   const Run j = run(cli("show gantry_grinder --format json"));
   CHECK(j.out.find("\"closed_form\"") != std::string::npos);
   CHECK(run(cli("--help")).status == 0);
-  for (const char* verb : {"generate", "show", "list"}) CHECK(run(cli(std::string(verb) + " --help")).status == 0);
+  for (const char* verb : {"generate", "show", "list"})
+    CHECK(run(cli(std::string(verb) + " --help")).status == 0);
 }

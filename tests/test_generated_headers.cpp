@@ -90,21 +90,21 @@ struct Checker {
 };
 
 // Adapters so that Checker can name each generated namespace.
-#define WEILGEN_MODEL_ADAPTER(ns)                                                 \
-  struct ns##_model {                                                             \
-    static constexpr auto kNumAxes = weilgen_models::ns::kNumAxes;               \
-    static constexpr auto kNumErrors = weilgen_models::ns::kNumErrors;           \
-    static constexpr auto kNumParams = weilgen_models::ns::kNumParams;           \
-    static constexpr const auto& kErrors = weilgen_models::ns::kErrors;          \
-    static constexpr const auto& kParams = weilgen_models::ns::kParams;          \
-    template <typename S, typename... A>                                          \
-    static void Deviation(A&&... a) {                                             \
-      weilgen_models::ns::Deviation<S>(std::forward<A>(a)...);                    \
-    }                                                                             \
-    template <typename S, typename... A>                                          \
-    static void Coefficients(A&&... a) {                                          \
-      weilgen_models::ns::Coefficients<S>(std::forward<A>(a)...);                 \
-    }                                                                             \
+#define WEILGEN_MODEL_ADAPTER(ns)                                       \
+  struct ns##_model {                                                   \
+    static constexpr auto kNumAxes = weilgen_models::ns::kNumAxes;      \
+    static constexpr auto kNumErrors = weilgen_models::ns::kNumErrors;  \
+    static constexpr auto kNumParams = weilgen_models::ns::kNumParams;  \
+    static constexpr const auto& kErrors = weilgen_models::ns::kErrors; \
+    static constexpr const auto& kParams = weilgen_models::ns::kParams; \
+    template <typename S, typename... A>                                \
+    static void Deviation(A&&... a) {                                   \
+      weilgen_models::ns::Deviation<S>(std::forward<A>(a)...);          \
+    }                                                                   \
+    template <typename S, typename... A>                                \
+    static void Coefficients(A&&... a) {                                \
+      weilgen_models::ns::Coefficients<S>(std::forward<A>(a)...);       \
+    }                                                                   \
   };
 
 WEILGEN_MODEL_ADAPTER(gantry_grinder)

@@ -4,8 +4,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "machine/yaml_loader.hpp"
 #include "emit_report.hpp"
+#include "machine/yaml_loader.hpp"
 #include "model_builder.hpp"
 #include "model_eval.hpp"
 #include "numeric_chain.hpp"
@@ -64,7 +64,7 @@ TEST_CASE("order-r model differs from the exact chain by O(s^(r+1)) on every shi
 
 TEST_CASE("order-3 model of the five-axis machine converges as s^4") {
   const Description d = load_machine_file(test::machine_path("five_axis_ac"));
-    // Larger errors so that the s^4 residual stays far above rounding (1e-13 mm).
+  // Larger errors so that the s^4 residual stays far above rounding (1e-13 mm).
   CHECK(convergence_slope(d, 3, 7, nullptr, 2.0, 10.0) == doctest::Approx(4).epsilon(0.1));
 }
 
@@ -142,8 +142,9 @@ TEST_CASE("a relation ideal gives exactly the order-r model with the ideal's mon
     for (const auto& [mono, c] : full.outputs[o].terms()) {
       const bool square = mono.size() == 2 && mono[0] == mono[1];
       const bool loc = mono.size() == 2 && is_location(mono[0]) && is_location(mono[1]);
-      const bool pair = mono == gen::Monomial{static_cast<std::uint16_t>(plain.error_index("E_XX")),
-                                              static_cast<std::uint16_t>(plain.error_index("E_AC"))};
+      const bool pair =
+          mono == gen::Monomial{static_cast<std::uint16_t>(plain.error_index("E_XX")),
+                                static_cast<std::uint16_t>(plain.error_index("E_AC"))};
       if (square || loc || pair) {
         ++dropped;
         CHECK(quot.coefficient(o, mono).is_zero());

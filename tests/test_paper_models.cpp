@@ -25,7 +25,8 @@ GiNaC::ex parse(const gen::SymbolicModel& m, const std::string& text) {
 }
 
 // Checks that output o has exactly the expected linear terms (tool_length = 0 as in the seeds).
-void check_output(const gen::SymbolicModel& m, int o, const Terms& printed, const Terms& corrections,
+void check_output(const gen::SymbolicModel& m, int o, const Terms& printed,
+                  const Terms& corrections,
                   const std::vector<std::string>& printed_but_wrong = {}) {
   Terms expected = printed;
   for (const auto& [k, v] : corrections) expected[k] = v;
@@ -53,19 +54,24 @@ TEST_CASE("gantry grinder: eqs. (16)-(18) of the reliability seed, with the two 
       gen::build_model(load_machine_file(test::machine_path("gantry_grinder")), 1);
   // Seed symbols: δxx=E_XX, εxx=E_AX, εyx=E_BX, εzx=E_CX, Sxy=E_C0X, Sxz=E_B0Z, Syz=E_A0Z, ...
   // dx = -δxx - zεyx + yεzx + δxz + δxy + ySxy (18); eq. (17) adds -yεzz, dropped in (18).
-  check_output(m, 0,
-               {{"E_XX", "-1"}, {"E_BX", "-z"}, {"E_CX", "y"}, {"E_XZ", "1"}, {"E_XY", "1"},
-                {"E_C0X", "y"}},
-               {{"E_CZ", "-y"}});
+  check_output(
+      m, 0,
+      {{"E_XX", "-1"}, {"E_BX", "-z"}, {"E_CX", "y"}, {"E_XZ", "1"}, {"E_XY", "1"}, {"E_C0X", "y"}},
+      {{"E_CZ", "-y"}});
   // dy = -δyx + zεxx + xεzx + δyz + δyy + xSxy
-  check_output(m, 1,
-               {{"E_YX", "-1"}, {"E_AX", "z"}, {"E_CX", "x"}, {"E_YZ", "1"}, {"E_YY", "1"},
-                {"E_C0X", "x"}},
-               {});
+  check_output(
+      m, 1,
+      {{"E_YX", "-1"}, {"E_AX", "z"}, {"E_CX", "x"}, {"E_YZ", "1"}, {"E_YY", "1"}, {"E_C0X", "x"}},
+      {});
   // dz = -δzx - yεxx - xεyx + δzz + yεxz + δzy + ySyz
   check_output(m, 2,
-               {{"E_ZX", "-1"}, {"E_AX", "-y"}, {"E_BX", "-x"}, {"E_ZZ", "1"}, {"E_AZ", "y"},
-                {"E_ZY", "1"}, {"E_A0Z", "y"}},
+               {{"E_ZX", "-1"},
+                {"E_AX", "-y"},
+                {"E_BX", "-x"},
+                {"E_ZZ", "1"},
+                {"E_AZ", "y"},
+                {"E_ZY", "1"},
+                {"E_A0Z", "y"}},
                {});
   check_output(m, 3, {{"E_AX", "-1"}, {"E_AZ", "1"}, {"E_A0Z", "1"}, {"E_AY", "1"}}, {});
   check_output(m, 4, {{"E_BX", "-1"}, {"E_BZ", "1"}, {"E_B0Z", "1"}, {"E_BY", "1"}}, {});
@@ -80,24 +86,36 @@ TEST_CASE("VMC: eq. (3) of the 6D-laser seed, with the d_z(z) correction") {
   // S_xy = E_C0Y, S_yz = E_A0Z, S_xz = -E_B0Z.
   // Δx = -dx(x) - dx(y) + dx(z) - y(εxz + εyz) - z(εxy + εyy) + ySxy - zSxz
   check_output(m, 0,
-               {{"E_XX", "-1"}, {"E_XY", "-1"}, {"E_XZ", "1"}, {"E_CX", "-y"}, {"E_CY", "-y"},
-                {"E_BX", "-z"}, {"E_BY", "-z"}, {"E_C0Y", "y"}, {"E_B0Z", "z"}},
+               {{"E_XX", "-1"},
+                {"E_XY", "-1"},
+                {"E_XZ", "1"},
+                {"E_CX", "-y"},
+                {"E_CY", "-y"},
+                {"E_BX", "-z"},
+                {"E_BY", "-z"},
+                {"E_C0Y", "y"},
+                {"E_B0Z", "z"}},
                {});
   // Δy = -dy(x) - dy(y) + dy(z) + xεxz + z(εxx + εyx) - zSyz
   check_output(m, 1,
-               {{"E_YX", "-1"}, {"E_YY", "-1"}, {"E_YZ", "1"}, {"E_CX", "x"}, {"E_AX", "z"},
-                {"E_AY", "z"}, {"E_A0Z", "-z"}},
+               {{"E_YX", "-1"},
+                {"E_YY", "-1"},
+                {"E_YZ", "1"},
+                {"E_CX", "x"},
+                {"E_AX", "z"},
+                {"E_AY", "z"},
+                {"E_A0Z", "-z"}},
                {});
   // Δz = -dz(x) - dz(y) + d_y(z) [printed; Table 3 gives d_z(z)] - xεxy + y(εxx + εyx)
-  check_output(m, 2,
-               {{"E_ZX", "-1"}, {"E_ZY", "-1"}, {"E_BX", "-x"}, {"E_AX", "y"}, {"E_AY", "y"}},
+  check_output(m, 2, {{"E_ZX", "-1"}, {"E_ZY", "-1"}, {"E_BX", "-x"}, {"E_AX", "y"}, {"E_AY", "y"}},
                {{"E_ZZ", "1"}}, {"E_YZ"});
 }
 
 TEST_CASE("two-axis seed example: eq. (5)-style sums of the rotation errors") {
   // Over the dual numbers the orientation errors of serial joints add (seed eq. (5)), rotated by
   // the nominal A rotation for the errors that sit after it.
-  const gen::SymbolicModel m = gen::build_model(load_machine_file(test::machine_path("two_axis")), 1);
+  const gen::SymbolicModel m =
+      gen::build_model(load_machine_file(test::machine_path("two_axis")), 1);
   GiNaC::symtab table;
   for (const auto& a : m.axes)
     if (a.revolute) {
