@@ -15,6 +15,37 @@ int usage_error(const std::string& verb, const std::string& message) {
   return 2;
 }
 
+template <typename Positional>
+std::optional<int> parse_args(const std::string& verb, const Args& args,
+                              const po::options_description& visible, const char* positional,
+                              int max_positional, po::variables_map& vm) {
+  po::options_description hidden;
+  hidden.add_options()(positional, po::value<Positional>(), "");
+  po::options_description all;
+  all.add(visible).add(hidden);
+  po::positional_options_description pos;
+  pos.add(positional, max_positional);
+  try {
+    po::store(po::command_line_parser(args).options(all).positional(pos).run(), vm);
+    po::notify(vm);
+  } catch (const po::error& e) {
+    return usage_error(verb, e.what());
+  }
+  if (vm.count("help")) {
+    std::cout << visible << "\n";
+    return 0;
+  }
+  return std::nullopt;
+}
+
+template std::optional<int> parse_args<std::string>(const std::string&, const Args&,
+                                                    const po::options_description&, const char*,
+                                                    int, po::variables_map&);
+template std::optional<int> parse_args<std::vector<std::string>>(const std::string&, const Args&,
+                                                                 const po::options_description&,
+                                                                 const char*, int,
+                                                                 po::variables_map&);
+
 int verb_generate(const Args& args) {
   po::options_description opts(
       "weilgen generate <machine>... [options]\n\n"
@@ -31,23 +62,9 @@ int verb_generate(const Args& args) {
       "check",
       "write nothing; exit 1 and list the stale files when the files in --out differ\n"
       "from what would be generated");
-  po::options_description hidden;
-  hidden.add_options()("machine", po::value<std::vector<std::string>>(), "");
-  po::options_description all;
-  all.add(opts).add(hidden);
-  po::positional_options_description pos;
-  pos.add("machine", -1);
   po::variables_map vm;
-  try {
-    po::store(po::command_line_parser(args).options(all).positional(pos).run(), vm);
-    po::notify(vm);
-  } catch (const po::error& e) {
-    return usage_error("generate", e.what());
-  }
-  if (vm.count("help")) {
-    std::cout << opts << "\n";
-    return 0;
-  }
+  if (auto stop = parse_args<std::vector<std::string>>("generate", args, opts, "machine", -1, vm))
+    return *stop;
   if (!vm.count("machine")) return usage_error("generate", "no machine given");
   if (vm.count("order") && order < 1) return usage_error("generate", "--order must be >= 1");
 

@@ -22,23 +22,8 @@ int verb_show(const Args& args) {
       "notation", po::value<std::string>(&notation)->default_value("iso"),
       "iso (ISO 230-1 names) | alias (each error's first alias, e.g. the paper's symbols)")(
       "order", po::value<int>(&order), "truncation order r >= 1 overriding the file's");
-  po::options_description hidden;
-  hidden.add_options()("machine", po::value<std::string>(), "");
-  po::options_description all;
-  all.add(opts).add(hidden);
-  po::positional_options_description pos;
-  pos.add("machine", 1);
   po::variables_map vm;
-  try {
-    po::store(po::command_line_parser(args).options(all).positional(pos).run(), vm);
-    po::notify(vm);
-  } catch (const po::error& e) {
-    return usage_error("show", e.what());
-  }
-  if (vm.count("help")) {
-    std::cout << opts << "\n";
-    return 0;
-  }
+  if (auto stop = parse_args<std::string>("show", args, opts, "machine", 1, vm)) return *stop;
   if (!vm.count("machine")) return usage_error("show", "no machine given");
   if (format != "text" && format != "latex" && format != "json")
     return usage_error("show", "--format must be text, latex or json, not '" + format + "'");
