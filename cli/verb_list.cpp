@@ -9,13 +9,13 @@ namespace weilgen::cli {
 
 int verb_list(const Args& args) {
   if (!args.empty() && (args[0] == "--help" || args[0] == "-h")) {
-    std::cout << "weilgen list\n\nLists the shipped machines (" << WEILGEN_MACHINES_DIR
+    std::cout << "weilgen list\n\nLists the shipped machines (" << shipped_machines_dir()
               << "): name, axes, errors, title.\n";
     return 0;
   }
   if (!args.empty()) return usage_error("list", "takes no arguments");
   std::set<std::string> files;
-  for (const auto& e : std::filesystem::directory_iterator(WEILGEN_MACHINES_DIR))
+  for (const auto& e : std::filesystem::directory_iterator(shipped_machines_dir()))
     if (e.path().extension() == ".yaml") files.insert(e.path().string());
   for (const auto& f : files) {
     const Description d = load_machine_file(f);

@@ -7,6 +7,7 @@
 #include "atomic_file.hpp"
 #include "emit_cpp.hpp"
 #include "emit_report.hpp"
+#include "machine/yaml_loader.hpp"
 
 namespace weilgen::gen {
 
@@ -14,7 +15,7 @@ std::string source_label(const std::string& machine_path) {
   namespace fs = std::filesystem;
   std::error_code ec;
   const fs::path p = fs::weakly_canonical(machine_path, ec);
-  const fs::path shipped = fs::weakly_canonical(WEILGEN_MACHINES_DIR, ec);
+  const fs::path shipped = fs::weakly_canonical(shipped_machines_dir(), ec);
   if (p.parent_path() == shipped) return "machines/" + p.filename().string();
   return fs::path(machine_path).filename().string();
 }

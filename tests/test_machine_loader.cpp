@@ -3,7 +3,9 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -918,4 +920,18 @@ workpiece: {body: bed}
 TEST_CASE("bad: the file is not a mapping") {
   expect_error("- just\n- a list\n", "bad.yaml:1:1", {"mapping"});
   expect_error("", "bad.yaml:1:1", {"mapping"});
+}
+
+TEST_CASE("shipped machines are found through $WEILGEN_MACHINES_DIR when it is set") {
+  const std::string dir = std::string(WEILGEN_TEST_TMP) + "/machines_env";
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream out(dir + "/only_here.yaml");
+    out << "x: 1\n";
+  }
+  ::setenv("WEILGEN_MACHINES_DIR", dir.c_str(), 1);
+  CHECK(weilgen::resolve_machine("only_here") == dir + "/only_here.yaml");
+  CHECK_THROWS_AS(weilgen::resolve_machine("vmc_3axis"), weilgen::InputError);
+  ::unsetenv("WEILGEN_MACHINES_DIR");
+  CHECK(weilgen::resolve_machine("vmc_3axis").find("vmc_3axis.yaml") != std::string::npos);
 }

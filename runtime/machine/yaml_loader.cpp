@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <optional>
@@ -1009,14 +1010,29 @@ Description load_machine_file(const std::string& path) {
   return load_machine_text(text.str(), path);
 }
 
+std::string shipped_machines_dir() {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (const char* env = std::getenv("WEILGEN_MACHINES_DIR"); env && *env) return env;
+  if (fs::is_directory(WEILGEN_MACHINES_DIR, ec)) return WEILGEN_MACHINES_DIR;
+  // An installed weilgen: <prefix>/bin/weilgen and <prefix>/share/weilgen/machines.
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    const fs::path installed = exe.parent_path().parent_path() / "share" / "weilgen" / "machines";
+    if (fs::is_directory(installed, ec)) return installed.string();
+  }
+  return WEILGEN_MACHINES_DIR;
+}
+
 std::string resolve_machine(const std::string& name_or_path) {
   namespace fs = std::filesystem;
   std::error_code ec;
   if (fs::is_regular_file(name_or_path, ec)) return name_or_path;
-  const fs::path shipped = fs::path(WEILGEN_MACHINES_DIR) / (name_or_path + ".yaml");
+  const std::string dir = shipped_machines_dir();
+  const fs::path shipped = fs::path(dir) / (name_or_path + ".yaml");
   if (is_identifier(name_or_path) && fs::is_regular_file(shipped, ec)) return shipped.string();
   std::vector<std::string> names;
-  for (const auto& entry : fs::directory_iterator(WEILGEN_MACHINES_DIR, ec)) {
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
     if (entry.path().extension() == ".yaml") names.push_back(entry.path().stem().string());
   }
   std::sort(names.begin(), names.end());

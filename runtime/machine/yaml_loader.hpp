@@ -18,5 +18,8 @@ Description load_machine_text(const std::string& yaml, const std::string& filena
 // A path to a file, or the name of a shipped machine (WEILGEN_MACHINES_DIR "/<name>.yaml").
 // Throws InputError (loc.file = the argument) when neither exists.
 std::string resolve_machine(const std::string& name_or_path);
+// Where shipped machines live: $WEILGEN_MACHINES_DIR if set, else the source tree's machines/
+// when it exists, else <prefix>/share/weilgen/machines next to an installed executable.
+std::string shipped_machines_dir();
 
 }  // namespace weilgen
