@@ -4,7 +4,7 @@
 // Units: axes as in kAxes (mm, deg), errors in base units (mm, rad), parameters in mm/deg;
 //        position outputs dx, dy, dz in mm, orientation outputs da, db, dc in rad.
 // Operation counts (after common-subexpression elimination):
-//   Deviation:    42 (adds 17, muls 23, divs 0, functions 2), 0 temporaries
+//   Deviation:    34 (adds 15, muls 17, divs 0, functions 2), 1 temporaries
 //   Coefficients: 6 (adds 0, muls 4, divs 0, functions 2), 2 temporaries
 #pragma once
 
@@ -121,18 +121,23 @@ void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
   const Scalar E_CA = errors[11];
   const Scalar tool_length = params[0];
 
-  // Intermediate terms (0)
+  // Intermediate terms (1)
+  const Scalar _tmp0 = E_AA + E_AY;
+
+  // Coefficients of the error monomials (2)
+  const Scalar _coef0 = cos_A * tool_length;
+  const Scalar _coef1 = sin_A * tool_length;
 
   // Outputs
   if (position != nullptr) {
     auto& _position = *position;
-    _position[0] = E_XA + E_XY + E_BA * tool_length + E_BY * cos_A * tool_length + E_CY * sin_A * tool_length;
-    _position[1] = E_YY + E_YA * cos_A - E_AA * cos_A * tool_length - E_AY * cos_A * tool_length - E_ZA * sin_A;
-    _position[2] = E_ZY + E_YA * sin_A + E_ZA * cos_A - E_AA * sin_A * tool_length - E_AY * sin_A * tool_length;
+    _position[0] = E_XA + E_XY + E_BA * tool_length + E_BY * _coef0 + E_CY * _coef1;
+    _position[1] = E_YY + E_YA * cos_A - E_ZA * sin_A - _coef0 * _tmp0;
+    _position[2] = E_ZY + E_YA * sin_A + E_ZA * cos_A - _coef1 * _tmp0;
   }
   if (orientation != nullptr) {
     auto& _orientation = *orientation;
-    _orientation[0] = E_AA + E_AY;
+    _orientation[0] = _tmp0;
     _orientation[1] = E_BY + E_BA * cos_A - E_CA * sin_A;
     _orientation[2] = E_CY + E_BA * sin_A + E_CA * cos_A;
   }

@@ -4,7 +4,7 @@
 // Units: axes as in kAxes (mm, deg), errors in base units (mm, rad), parameters in mm/deg;
 //        position outputs dx, dy, dz in mm, orientation outputs da, db, dc in rad.
 // Operation counts (after common-subexpression elimination):
-//   Deviation:    43 (adds 28, muls 15, divs 0, functions 0), 0 temporaries
+//   Deviation:    41 (adds 28, muls 13, divs 0, functions 0), 0 temporaries
 //   Coefficients: 2 (adds 2, muls 0, divs 0, functions 0), 2 temporaries
 #pragma once
 
@@ -148,8 +148,8 @@ void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
   // Outputs
   if (position != nullptr) {
     auto& _position = *position;
-    _position[0] = E_XZ + E_B0Z * Z + E_C0Y * Y - E_BX * _coef0 - E_BY * _coef0 - E_BZ * tool_length - E_CX * Y - E_CY * Y - E_XX - E_XY;
-    _position[1] = E_YZ + E_AX * _coef0 + E_AY * _coef0 + E_AZ * tool_length + E_CX * X - E_A0Z * Z - E_YX - E_YY;
+    _position[0] = E_XZ + E_B0Z * Z + E_C0Y * Y - E_BZ * tool_length - E_CX * Y - E_CY * Y - E_XX - E_XY - _coef0 * (E_BX + E_BY);
+    _position[1] = E_YZ + E_AZ * tool_length + E_CX * X + _coef0 * (E_AX + E_AY) - E_A0Z * Z - E_YX - E_YY;
     _position[2] = E_ZZ + E_AX * Y + E_AY * Y - E_BX * X - E_ZX - E_ZY;
   }
   if (orientation != nullptr) {
@@ -178,7 +178,7 @@ void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
   const Scalar tool_length = params[0];
 
   // Intermediate terms (2)
-  const Scalar _tmp0 = tool_length - Z;
+  const Scalar _tmp0 = Z - tool_length;
   const Scalar _tmp1 = Z - tool_length;
 
   // Outputs
@@ -188,14 +188,14 @@ void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
     _position_coeff[1] = Scalar(0);
     _position_coeff[2] = Scalar(0);
     _position_coeff[3] = Scalar(0);
-    _position_coeff[4] = _tmp0;
+    _position_coeff[4] = -_tmp0;
     _position_coeff[5] = -Y;
     _position_coeff[6] = Y;
     _position_coeff[7] = -Scalar(1);
     _position_coeff[8] = Scalar(0);
     _position_coeff[9] = Scalar(0);
     _position_coeff[10] = Scalar(0);
-    _position_coeff[11] = _tmp0;
+    _position_coeff[11] = -_tmp0;
     _position_coeff[12] = -Y;
     _position_coeff[13] = Scalar(1);
     _position_coeff[14] = Scalar(0);

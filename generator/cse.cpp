@@ -30,6 +30,29 @@ const std::string& CanonicalText::of(const ex& e) {
     std::ostringstream os;
     os << e;
     s = os.str();
+  } else if (GiNaC::is_a<GiNaC::mul>(e)) {
+    // Sign-canonical: a sum factor is taken with the sign whose text is smaller and the sign is
+    // moved to the numeric coefficient, so that c·(a − b) and (−c)·(b − a) read the same.
+    GiNaC::numeric coeff = 1;
+    std::vector<std::string> parts;
+    for (std::size_t i = 0; i < e.nops(); ++i) {
+      const ex& op = e.op(i);
+      if (GiNaC::is_a<GiNaC::numeric>(op)) {
+        coeff *= GiNaC::ex_to<GiNaC::numeric>(op);
+      } else if (GiNaC::is_a<GiNaC::add>(op)) {
+        const std::string a = of(op), b = of((-op).expand());
+        if (b < a) coeff = -coeff;
+        parts.push_back(std::min(a, b));
+      } else {
+        parts.push_back(of(op));
+      }
+    }
+    std::sort(parts.begin(), parts.end());
+    std::ostringstream os;
+    os << "mul(" << coeff;
+    for (const auto& p : parts) os << "," << p;
+    os << ")";
+    s = os.str();
   } else {
     std::vector<std::string> parts;
     for (std::size_t i = 0; i < e.nops(); ++i) parts.push_back(of(e.op(i)));
@@ -52,12 +75,28 @@ const std::string& CanonicalText::of(const ex& e) {
   return memo_.emplace(e, std::move(s)).first->second;
 }
 
+std::string CanonicalText::unsigned_text(const ex& e) {
+  if (!GiNaC::is_a<GiNaC::mul>(e)) return of(e);
+  const std::string& t = of(e);  // "mul(<coeff>,<factors...>)"
+  const auto comma = t.find(',');
+  return comma == std::string::npos ? t : "mul(" + t.substr(comma + 1);
+}
+
 std::vector<ex> CanonicalText::sorted_ops(const ex& e) {
   std::vector<ex> ops;
   for (std::size_t i = 0; i < e.nops(); ++i) ops.push_back(e.op(i));
-  if (GiNaC::is_a<GiNaC::add>(e) || GiNaC::is_a<GiNaC::mul>(e))
+  if (GiNaC::is_a<GiNaC::mul>(e)) {
     std::stable_sort(ops.begin(), ops.end(),
                      [&](const ex& a, const ex& b) { return of(a) < of(b); });
+  } else if (GiNaC::is_a<GiNaC::add>(e)) {
+    // By the term without its numeric factor: the order must not change when GiNaC flips the
+    // sign of the whole sum.
+    std::vector<std::pair<std::string, ex>> keyed;
+    for (const ex& op : ops) keyed.emplace_back(unsigned_text(op), op);
+    std::stable_sort(keyed.begin(), keyed.end(),
+                     [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (std::size_t i = 0; i < ops.size(); ++i) ops[i] = keyed[i].second;
+  }
   return ops;
 }
 
@@ -107,9 +146,18 @@ struct Eliminator {
     }
     if (count[key] >= 2) {
       GiNaC::symbol t(prefix + std::to_string(result.temps.size()));
-      result.temps.push_back({t, rebuilt});
-      replaced.emplace(key, t);
-      return t;
+      // A sum's sign is GiNaC's (hash-order) choice: store the canonical sign in the temporary.
+      ex value = rebuilt, use = t;
+      if (GiNaC::is_a<GiNaC::add>(rebuilt)) {
+        const ex neg = (-rebuilt).expand();
+        if (canon.of(neg) < canon.of(rebuilt)) {
+          value = neg;
+          use = -t;
+        }
+      }
+      result.temps.push_back({t, value});
+      replaced.emplace(key, use);
+      return use;
     }
     replaced.emplace(key, rebuilt);
     return rebuilt;

@@ -18,6 +18,8 @@ namespace weilgen::gen {
 class CanonicalText {
  public:
   const std::string& of(const GiNaC::ex& e);
+  // of(e) without a product's numeric coefficient: the same for c·x and −c·x.
+  std::string unsigned_text(const GiNaC::ex& e);
   // Operands of e in canonical order.
   std::vector<GiNaC::ex> sorted_ops(const GiNaC::ex& e);
 

@@ -1,5 +1,6 @@
 #include "emit_cpp.hpp"
 
+#include <optional>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -97,27 +98,65 @@ struct OutputGroup {
   std::vector<ex> values;
 };
 
-// Named coefficient polynomials of a Deviation-style function. Products c·monomial with a sum c
-// are built on a placeholder symbol whose sign is chosen canonically: GiNaC would otherwise
-// normalise the sign of a sum inside a product by its hash order, which varies between runs.
+// Named coefficient polynomials of a Deviation-style function: every coefficient that is a sum
+// or a product of several symbols gets a placeholder `_coefN` (shared by all outputs and
+// monomials), and the error monomials with the same placeholder are grouped,
+// _coef3·(E_AA + E_AY − E_A0A), instead of repeating the product per error. Signs and numeric
+// factors are chosen canonically: GiNaC would otherwise pick the sign of a sum inside a product
+// by its hash order, which varies between runs.
 struct Coefficients {
   std::vector<std::pair<GiNaC::symbol, ex>> defs;
   std::map<std::string, GiNaC::symbol> by_text;
   CanonicalText canon;
 
-  ex term(const ex& c, const ex& monomial) {
-    if (!GiNaC::is_a<GiNaC::add>(c)) return c * monomial;
-    const ex neg = (-c).expand();
-    const bool flip = canon.of(neg) < canon.of(c);
-    const ex rep = flip ? neg : c;
-    const std::string& key = canon.of(rep);
+  // c = factor · placeholder, or nullopt when c is a number or a single symbol (used inline).
+  std::optional<std::pair<ex, GiNaC::symbol>> split(const ex& c) {
+    ex factor = 1, rest = c;
+    if (GiNaC::is_a<GiNaC::mul>(c)) {
+      rest = 1;
+      for (std::size_t i = 0; i < c.nops(); ++i) {
+        if (GiNaC::is_a<GiNaC::numeric>(c.op(i)))
+          factor *= c.op(i);
+        else
+          rest *= c.op(i);
+      }
+      if (!GiNaC::is_a<GiNaC::mul>(rest) && !GiNaC::is_a<GiNaC::power>(rest)) return std::nullopt;
+    } else if (!GiNaC::is_a<GiNaC::add>(c)) {
+      return std::nullopt;
+    } else {
+      const ex neg = (-c).expand();
+      if (canon.of(neg) < canon.of(c)) {
+        factor = -1;
+        rest = neg;
+      }
+    }
+    const std::string& key = canon.of(rest);
     auto it = by_text.find(key);
     if (it == by_text.end()) {
       GiNaC::symbol sym("_coef" + std::to_string(defs.size()));
-      defs.emplace_back(sym, rep);
+      defs.emplace_back(sym, rest);
       it = by_text.emplace(key, sym).first;
     }
-    return flip ? -it->second * monomial : it->second * monomial;
+    return std::make_pair(factor, it->second);
+  }
+
+  // Σ c_m · monomial_m of one output, grouped by placeholder.
+  ex output(const Poly& p, const std::vector<GiNaC::symbol>& errors) {
+    GiNaC::exvector direct;
+    std::map<std::string, std::pair<GiNaC::symbol, GiNaC::exvector>> grouped;
+    for (const auto& [mono, c] : p.terms()) {
+      ex monomial = 1;
+      for (auto i : mono) monomial *= errors[i];
+      if (auto s = split(c)) {
+        auto& g = grouped[s->second.get_name()];
+        g.first = s->second;
+        g.second.push_back(s->first * monomial);
+      } else {
+        direct.push_back(c * monomial);
+      }
+    }
+    for (auto& [name, g] : grouped) direct.push_back(g.first * GiNaC::add(g.second));
+    return GiNaC::add(direct);
   }
 };
 
@@ -204,15 +243,7 @@ std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_la
   // Deviation: the full algebra element of each output.
   Coefficients coefs;
   std::vector<ex> pos, rot;
-  for (int o = 0; o < 6; ++o) {
-    GiNaC::exvector terms;
-    for (const auto& [mono, c] : m.outputs[o].terms()) {
-      ex monomial = 1;
-      for (auto i : mono) monomial *= m.errors[i];
-      terms.push_back(coefs.term(c, monomial));
-    }
-    (o < 3 ? pos : rot).push_back(GiNaC::add(terms));
-  }
+  for (int o = 0; o < 6; ++o) (o < 3 ? pos : rot).push_back(coefs.output(m.outputs[o], m.errors));
   const FunctionCode dev = function_body(inputs, {{"position", pos}, {"orientation", rot}}, &coefs);
 
   // Coefficients: ∂output/∂error at zero error, row-major [output][error].
