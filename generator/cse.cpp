@@ -40,9 +40,9 @@ const std::string& CanonicalText::of(const ex& e) {
       if (GiNaC::is_a<GiNaC::numeric>(op)) {
         coeff *= GiNaC::ex_to<GiNaC::numeric>(op);
       } else if (GiNaC::is_a<GiNaC::add>(op)) {
-        const std::string a = of(op), b = of((-op).expand());
-        if (b < a) coeff = -coeff;
-        parts.push_back(std::min(a, b));
+        const Signed r = canonical_sign(op);
+        if (r.negated) coeff = -coeff;
+        parts.push_back(of(r.value));
       } else {
         parts.push_back(of(op));
       }
@@ -73,6 +73,12 @@ const std::string& CanonicalText::of(const ex& e) {
     s += ")";
   }
   return memo_.emplace(e, std::move(s)).first->second;
+}
+
+CanonicalText::Signed CanonicalText::canonical_sign(const ex& sum) {
+  const ex neg = (-sum).expand();
+  if (of(neg) < of(sum)) return {neg, true};
+  return {sum, false};
 }
 
 std::string CanonicalText::unsigned_text(const ex& e) {
@@ -149,11 +155,9 @@ struct Eliminator {
       // A sum's sign is GiNaC's (hash-order) choice: store the canonical sign in the temporary.
       ex value = rebuilt, use = t;
       if (GiNaC::is_a<GiNaC::add>(rebuilt)) {
-        const ex neg = (-rebuilt).expand();
-        if (canon.of(neg) < canon.of(rebuilt)) {
-          value = neg;
-          use = -t;
-        }
+        const CanonicalText::Signed r = canon.canonical_sign(rebuilt);
+        value = r.value;
+        if (r.negated) use = -t;
       }
       result.temps.push_back({t, value});
       replaced.emplace(key, use);

@@ -18,6 +18,14 @@ namespace weilgen::gen {
 class CanonicalText {
  public:
   const std::string& of(const GiNaC::ex& e);
+  // A sum or its negation, whichever has the smaller canonical text. GiNaC picks the sign of a
+  // sum inside a product by hash order, which varies between runs; every emitter that must be
+  // deterministic takes the sign from here.
+  struct Signed {
+    GiNaC::ex value;
+    bool negated;
+  };
+  Signed canonical_sign(const GiNaC::ex& sum);
   // of(e) without a product's numeric coefficient: the same for c·x and −c·x.
   std::string unsigned_text(const GiNaC::ex& e);
   // Operands of e in canonical order.

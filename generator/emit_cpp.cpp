@@ -124,11 +124,9 @@ struct Coefficients {
     } else if (!GiNaC::is_a<GiNaC::add>(c)) {
       return std::nullopt;
     } else {
-      const ex neg = (-c).expand();
-      if (canon.of(neg) < canon.of(c)) {
-        factor = -1;
-        rest = neg;
-      }
+      const CanonicalText::Signed r = canon.canonical_sign(c);
+      rest = r.value;
+      if (r.negated) factor = -1;
     }
     const std::string& key = canon.of(rest);
     auto it = by_text.find(key);
@@ -185,23 +183,21 @@ FunctionCode function_body(const InputTable& inputs, const std::vector<OutputGro
   for (const auto& s : used)
     if (auto it = inputs.code_name.find(s); it != inputs.code_name.end())
       used_code.insert(it->second);
-  // cos/sin of a coordinate need the coordinate itself.
-  for (const auto& code : inputs.order)
-    if (used_code.count(code) && (code.rfind("cos_", 0) == 0 || code.rfind("sin_", 0) == 0))
-      used_code.insert(code.substr(4));
-  os << "  // Inputs\n";
-  for (const auto& code : inputs.order) {
-    if (!used_code.count(code)) continue;
-    os << "  const Scalar " << code << " = " << inputs.definition.at(code) << ";\n";
-  }
-  FunctionCode fc;
+  // cos/sin of a coordinate need the coordinate itself; each costs a call and a multiply.
+  const auto is_trig = [](const std::string& code) {
+    return code.rfind("cos_", 0) == 0 || code.rfind("sin_", 0) == 0;
+  };
   OpCount trig;
   for (const auto& code : inputs.order)
-    if (used_code.count(code) && (code.rfind("cos_", 0) == 0 || code.rfind("sin_", 0) == 0)) {
+    if (used_code.count(code) && is_trig(code)) {
+      used_code.insert(code.substr(4));
       ++trig.functions;
       ++trig.muls;
     }
-  printer.reset_ops();
+  os << "  // Inputs\n";
+  for (const auto& code : inputs.order)
+    if (used_code.count(code))
+      os << "  const Scalar " << code << " = " << inputs.definition.at(code) << ";\n";
   os << "\n  // Intermediate terms (" << cse.temps.size() << ")\n";
   for (const auto& t : cse.temps)
     os << "  const Scalar " << t.symbol.get_name() << " = " << printer.print(t.value) << ";\n";
@@ -219,10 +215,8 @@ FunctionCode function_body(const InputTable& inputs, const std::vector<OutputGro
     }
     os << "  }\n";
   }
-  fc.body = os.str();
-  fc.ops = printer.ops();
+  FunctionCode fc{os.str(), printer.ops(), cse.temps.size()};
   fc.ops += trig;
-  fc.temps = cse.temps.size();
   return fc;
 }
 

@@ -40,12 +40,7 @@ std::string join_term(const std::string& acc, ex coeff, const std::string& name,
   if (GiNaC::is_a<GiNaC::add>(coeff)) {
     // -(a + b)·E reads better than (-a - b)·E: factor out the sign of a mostly negative sum.
     std::size_t negatives = 0;
-    for (std::size_t i = 0; i < coeff.nops(); ++i) {
-      bool neg = false;
-      const std::string t = pr.print(coeff.op(i));
-      neg = !t.empty() && t[0] == '-';
-      negatives += neg ? 1 : 0;
-    }
+    for (std::size_t i = 0; i < coeff.nops(); ++i) negatives += pr.print(coeff.op(i))[0] == '-';
     if (2 * negatives > coeff.nops()) {
       negative = true;
       coeff = (-coeff).expand();

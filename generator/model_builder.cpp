@@ -127,11 +127,12 @@ struct Builder {
     return m.mul(error_transform(body, ErrorPlacement::After), alg);
   }
 
-  Mat4 branch(int leaf, const PointSpec& point) const {
+  // Base -> end.body, then Trans(end.point).
+  Mat4 branch(const PointSpec& end) const {
     Mat4 m = Mat4::identity();
-    for (int b : d.chain_to(leaf)) m = m.mul(body_transform(b), alg);
+    for (int b : d.chain_to(end.body)) m = m.mul(body_transform(b), alg);
     ex t[3];
-    for (int i = 0; i < 3; ++i) t[i] = to_ginac(point.point[i], d, model.params);
+    for (int i = 0; i < 3; ++i) t[i] = to_ginac(end.point[i], d, model.params);
     return m.mul(translation(t), alg);
   }
 };
@@ -247,9 +248,8 @@ SymbolicModel build_model(const Description& desc, int order_override) {
   model.relations = alg.relations();
   const Builder b{desc, model, alg};
 
-  const Mat4 tool = b.branch(desc.tool.body, desc.tool);
-  const Mat4 work =
-      b.branch(desc.workpiece.body, PointSpec{desc.workpiece.body, desc.workpiece.point, {}});
+  const Mat4 tool = b.branch(desc.tool);
+  const Mat4 work = b.branch(desc.workpiece);
   // P: the tool frame (at the tool point) in the workpiece frame.
   const Mat4 p = neumann_inverse(work, alg).mul(tool, alg);
 

@@ -74,28 +74,19 @@ std::string ExprPrinter::symbol(const ex& e) {
 
 std::string ExprPrinter::print(const ex& e) {
   if (GiNaC::is_a<GiNaC::add>(e)) {
-    std::string s;
-    bool first = true;
-    const OpCount counted = ops_;  // the partition's trial printing must not count
     // Canonical order, positive terms first: "(tool_length - z)" rather than "(-z + tool_length)".
-    std::vector<ex> ops = canon_.sorted_ops(e);
-    std::stable_partition(ops.begin(), ops.end(), [this](const ex& op) {
-      bool neg = false;
-      term(op, neg);
-      return !neg;
-    });
-    ops_ = counted;
-    for (const ex& op : ops) {
+    std::vector<std::pair<bool, std::string>> terms;  // (negative, text without the sign)
+    for (const ex& op : canon_.sorted_ops(e)) {
       bool neg = false;
       std::string t = term(op, neg);
-      if (first) {
-        s = neg ? "-" + t : t;
-      } else {
-        s += neg ? " - " : " + ";
-        s += t;
-        ++ops_.adds;
-      }
-      first = false;
+      terms.emplace_back(neg, std::move(t));
+    }
+    std::stable_partition(terms.begin(), terms.end(), [](const auto& t) { return !t.first; });
+    std::string s = terms.front().first ? "-" + terms.front().second : terms.front().second;
+    for (std::size_t i = 1; i < terms.size(); ++i) {
+      s += terms[i].first ? " - " : " + ";
+      s += terms[i].second;
+      ++ops_.adds;
     }
     return s;
   }
@@ -124,15 +115,9 @@ std::string ExprPrinter::term(const ex& e, bool& negative) {
                GiNaC::ex_to<GiNaC::numeric>(op.op(1)).is_negative()) {
       den.push_back(factor(GiNaC::pow(op.op(0), -op.op(1))));
     } else if (GiNaC::is_a<GiNaC::add>(op)) {
-      // GiNaC picks the sign of a sum inside a product by hash order; print the sum whose
-      // canonical text is smaller and carry the sign, so the text is the same on every run.
-      const ex neg = (-op).expand();
-      if (canon_.of(neg) < canon_.of(op)) {
-        coeff = -coeff;
-        num.push_back(factor(neg));
-      } else {
-        num.push_back(factor(op));
-      }
+      const CanonicalText::Signed r = canon_.canonical_sign(op);
+      if (r.negated) coeff = -coeff;
+      num.push_back(factor(r.value));
     } else {
       num.push_back(factor(op));
     }
