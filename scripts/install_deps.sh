@@ -6,7 +6,7 @@ packages=(
   build-essential cmake pkg-config git
   libginac-dev libeigen3-dev libboost-program-options-dev libboost-dev
   libyaml-cpp-dev nlohmann-json3-dev doctest-dev libbenchmark-dev
-  time
+  libnlopt-cxx-dev time gnuplot-nox
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -1,0 +1,61 @@
+// Deterministic parallel loops: work is cut into fixed blocks whose boundaries do not depend
+// on the thread count, so per-block random streams and per-block partial sums (reduced in
+// block order) give bit-identical results for any --threads value.
+#pragma once
+
+#include <algorithm>
+#include <atomic>
+#include <cstddef>
+#include <exception>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+namespace weilgen {
+
+// Number of worker threads for a request: 0 means all hardware threads.
+inline unsigned resolve_threads(unsigned requested) {
+  if (requested > 0) return requested;
+  const unsigned hw = std::thread::hardware_concurrency();
+  return hw > 0 ? hw : 1;
+}
+
+// Calls body(block, begin, end, thread) for blocks [k*block_size, min(n, (k+1)*block_size)).
+// `thread` is in [0, threads) and identifies the caller's per-thread workspace. Exceptions
+// from a body are rethrown on the calling thread (the first one wins).
+template <typename Body>
+void parallel_blocks(std::size_t n, std::size_t block_size, unsigned threads, Body&& body) {
+  if (n == 0) return;
+  block_size = std::max<std::size_t>(1, block_size);
+  const std::size_t blocks = (n + block_size - 1) / block_size;
+  threads = std::max(1u, std::min<unsigned>(resolve_threads(threads),
+                                            static_cast<unsigned>(std::min<std::size_t>(
+                                                blocks, 1u << 16))));
+  std::atomic<std::size_t> next{0};
+  std::exception_ptr error;
+  std::mutex error_mutex;
+  auto worker = [&](unsigned t) {
+    for (;;) {
+      const std::size_t k = next.fetch_add(1);
+      if (k >= blocks) return;
+      try {
+        body(k, k * block_size, std::min(n, (k + 1) * block_size), t);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(error_mutex);
+        if (!error) error = std::current_exception();
+        next = blocks;
+        return;
+      }
+    }
+  };
+  if (threads == 1) {
+    worker(0);
+  } else {
+    std::vector<std::thread> pool;
+    for (unsigned t = 0; t < threads; ++t) pool.emplace_back(worker, t);
+    for (auto& th : pool) th.join();
+  }
+  if (error) std::rethrow_exception(error);
+}
+
+}  // namespace weilgen
