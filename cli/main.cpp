@@ -20,12 +20,14 @@ const std::map<std::string, Verb>& verbs() {
         "generate <machine>... [--order r] [--out DIR] [--check]\n"
         "      multiply the error HTMs over the Weil algebra and write the C++ header\n"
         "      and the closed-form report (generated/<machine>.hpp, .md)"}},
+#ifndef WEILGEN_CODEGEN_ONLY
       {"show",
        {weilgen::cli::verb_show,
         "show <machine> [--output dx] [--format text|latex|json] [--notation iso|alias]\n"
         "      [--order r]\n"
         "      print the closed-form error expressions"}},
       {"list", {weilgen::cli::verb_list, "list\n      list the shipped machines"}},
+#endif
   };
   return v;
 }

@@ -10,9 +10,9 @@ endforeach()
 if(WEILGEN_REGENERATE)
   add_custom_command(
     OUTPUT ${CMAKE_CURRENT_BINARY_DIR}/generated.stamp
-    COMMAND weilgen generate ${WEILGEN_SHIPPED_MACHINES} --out ${CMAKE_CURRENT_SOURCE_DIR}/generated
+    COMMAND weilgen_codegen generate ${WEILGEN_SHIPPED_MACHINES} --out ${CMAKE_CURRENT_SOURCE_DIR}/generated
     COMMAND ${CMAKE_COMMAND} -E touch ${CMAKE_CURRENT_BINARY_DIR}/generated.stamp
-    DEPENDS weilgen ${WEILGEN_SHIPPED_MACHINES}
+    DEPENDS weilgen_codegen ${WEILGEN_SHIPPED_MACHINES}
     COMMENT "Regenerating generated/ from machines/*.yaml"
     VERBATIM)
   add_custom_target(weilgen_generated ALL DEPENDS ${CMAKE_CURRENT_BINARY_DIR}/generated.stamp)

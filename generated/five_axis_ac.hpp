@@ -17,6 +17,8 @@ namespace five_axis_ac {
 
 inline constexpr const char* kMachineName = "five_axis_ac";
 inline constexpr int kOrder = 1;
+// Machine-file text, order and weilgen version: identifies the model (runtime/model_key.hpp).
+inline constexpr const char* kModelKey = "bce0f89719f25d49";
 inline constexpr std::size_t kNumAxes = 5;
 inline constexpr std::size_t kNumErrors = 43;
 inline constexpr std::size_t kNumParams = 2;

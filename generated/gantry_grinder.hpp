@@ -17,6 +17,8 @@ namespace gantry_grinder {
 
 inline constexpr const char* kMachineName = "gantry_grinder";
 inline constexpr int kOrder = 1;
+// Machine-file text, order and weilgen version: identifies the model (runtime/model_key.hpp).
+inline constexpr const char* kModelKey = "fad16e0bf41ce90b";
 inline constexpr std::size_t kNumAxes = 3;
 inline constexpr std::size_t kNumErrors = 21;
 inline constexpr std::size_t kNumParams = 1;

@@ -7,6 +7,7 @@
 
 #include "cse.hpp"
 #include "printer.hpp"
+#include "model_key.hpp"
 #include "version.hpp"
 
 namespace weilgen::gen {
@@ -282,6 +283,9 @@ std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_la
 
   os << "inline constexpr const char* kMachineName = " << quoted(d.name) << ";\n";
   os << "inline constexpr int kOrder = " << m.order << ";\n";
+  os << "// Machine-file text, order and weilgen version: identifies the model (runtime/model_key.hpp).\n";
+  os << "inline constexpr const char* kModelKey = " << quoted(model_key(d.source_hash, m.order))
+     << ";\n";
   os << "inline constexpr std::size_t kNumAxes = " << m.axes.size() << ";\n";
   os << "inline constexpr std::size_t kNumErrors = " << ne << ";\n";
   os << "inline constexpr std::size_t kNumParams = " << d.parameters.size() << ";\n";

@@ -20,12 +20,25 @@ std::string source_label(const std::string& machine_path) {
   return fs::path(machine_path).filename().string();
 }
 
-std::vector<GeneratedFile> generate_files(const Description& desc, int order_override,
-                                          const std::string& out_dir) {
-  const SymbolicModel model = build_model(desc, order_override);
-  SymbolicModel named = model;
+namespace {
+SymbolicModel named_model(const Description& desc, int order_override) {
+  SymbolicModel named = build_model(desc, order_override);
   if (order_override > 0 && order_override != desc.algebra.order)
     named.desc.name += "_o" + std::to_string(order_override);
+  return named;
+}
+}  // namespace
+
+std::string generate_header(const Description& desc, int order_override,
+                            std::string* name_space) {
+  const SymbolicModel named = named_model(desc, order_override);
+  if (name_space) *name_space = named.desc.name;
+  return emit_cpp_header(named, source_label(desc.source_file));
+}
+
+std::vector<GeneratedFile> generate_files(const Description& desc, int order_override,
+                                          const std::string& out_dir) {
+  const SymbolicModel named = named_model(desc, order_override);
   const std::string label = source_label(desc.source_file);
   const std::string base = (std::filesystem::path(out_dir) / named.desc.name).string();
   return {{base + ".hpp", emit_cpp_header(named, label)},

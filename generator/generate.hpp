@@ -22,6 +22,11 @@ std::string source_label(const std::string& machine_path);
 std::vector<GeneratedFile> generate_files(const Description& desc, int order_override,
                                           const std::string& out_dir);
 
+// The header alone (run-time compilation, model_loader.hpp); `name_space` receives the model's
+// namespace under weilgen_models.
+std::string generate_header(const Description& desc, int order_override,
+                            std::string* name_space);
+
 // Compares files with what is on disk; returns one line per stale or missing file
 // ("generated/x.hpp: 12 of 340 lines differ, first at line 57").
 std::vector<std::string> stale_files(const std::vector<GeneratedFile>& files);

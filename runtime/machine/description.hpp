@@ -8,6 +8,8 @@
 // converts from the error's declared unit (um, urad, ...) to base.
 #pragma once
 
+#include <cstdint>
+
 #include <array>
 #include <map>
 #include <optional>
@@ -151,6 +153,7 @@ struct Description {
   std::string name;         // identifier, used for file and namespace names
   std::string title;        // human title
   std::string source_file;  // path the description was read from
+  std::uint64_t source_hash = 0;  // FNV-1a of the machine file's text (model_key.hpp)
   std::string notes;        // free text (corrections to the seed, conventions)
   Algebra algebra;
   std::vector<Parameter> parameters;

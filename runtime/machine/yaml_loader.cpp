@@ -1,5 +1,7 @@
 #include "machine/yaml_loader.hpp"
 
+#include "model_key.hpp"
+
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -176,6 +178,11 @@ class Loader {
     if (const Entry* e = top.find("algebra")) read_algebra(e->value);
     d_.source_file = file_;
     return std::move(d_);
+  }
+
+  // read_distribution_keys(): the distribution keys of any mapping, other keys ignored.
+  Distribution distribution_keys(const YAML::Node& node, const std::string& path) const {
+    return read_distribution(map({node, node, path}, {})).value_or(Distribution{});
   }
 
  private:
@@ -995,7 +1002,9 @@ Description load_machine_text(const std::string& yaml, const std::string& filena
     throw InputError({filename, ex.mark.line + 1, ex.mark.column + 1},
                      "YAML syntax error: " + ex.msg);
   }
-  return Loader(filename).load(root);
+  Description desc = Loader(filename).load(root);
+  desc.source_hash = fnv1a64(yaml);
+  return desc;
 }
 
 Description load_machine_file(const std::string& path) {
@@ -1008,6 +1017,11 @@ Description load_machine_file(const std::string& path) {
   std::ostringstream text;
   text << in.rdbuf();
   return load_machine_text(text.str(), path);
+}
+
+Distribution read_distribution_keys(const YAML::Node& mapping, const std::string& file,
+                                    const std::string& path) {
+  return Loader(file).distribution_keys(mapping, path);
 }
 
 std::string shipped_machines_dir() {

@@ -7,6 +7,10 @@
 
 #include "machine/description.hpp"
 
+namespace YAML {
+class Node;
+}
+
 namespace weilgen {
 
 // Reads and checks the machine file at `path`. Throws InputError.
@@ -21,5 +25,14 @@ std::string resolve_machine(const std::string& name_or_path);
 // Where shipped machines live: $WEILGEN_MACHINES_DIR if set, else the source tree's machines/
 // when it exists, else <prefix>/share/weilgen/machines next to an installed executable.
 std::string shipped_machines_dir();
+
+// The distribution keys of a machine file's error or error_defaults entry, for other files that
+// use the same syntax (tolerance files, runtime/tolerance_file.hpp). `mapping` is a YAML mapping
+// (null reads as empty); of its keys, `sigma`, `normal`, `uniform` and `truncnormal` are read (at
+// most one may be present, values numbers or expressions such as 0.05/6, in the caller's unit) and
+// the others are left to the caller. Returns Kind::None when none is present. Throws InputError
+// "file:line:column: <path>.<key>: message", exactly as load_machine_file reports them.
+Distribution read_distribution_keys(const YAML::Node& mapping, const std::string& file,
+                                    const std::string& path);
 
 }  // namespace weilgen

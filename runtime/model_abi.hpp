@@ -1,0 +1,69 @@
+// The plain-C interface of a compiled model: what a built-in model and a model compiled at run
+// time (a shared object loaded with dlopen) both expose. Self-contained on purpose: the run-time
+// compiler is handed this file's text together with the generated header, nothing else.
+//
+// WEILGEN_DEFINE_MODEL_ABI(ns, var) defines `var`, a WeilgenModelAbi for the generated model in
+// namespace `ns` (e.g. weilgen_models::gantry_grinder). Pointer arguments are copied into the
+// generated functions' std::array arguments: a few dozen doubles, cheap against the model.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cstddef>
+
+extern "C" {
+struct WeilgenModelAbi {
+  int abi_version;  // kWeilgenModelAbiVersion
+  int order;
+  const char* name;
+  const char* key;  // kModelKey of the generated header
+  std::size_t num_axes, num_errors, num_params;
+  // axes in their units (mm, deg), errors in base units (mm, rad), params (mm, deg);
+  // position (dx, dy, dz) in mm and orientation (da, db, dc) in rad; either may be null.
+  void (*deviation)(const double* axes, const double* errors, const double* params,
+                    double* position, double* orientation);
+  // Row-major [output][error] first-order coefficients; either output may be null.
+  void (*coefficients)(const double* axes, const double* params, double* position_coeff,
+                       double* orientation_coeff);
+};
+}
+
+inline constexpr int kWeilgenModelAbiVersion = 1;
+
+#define WEILGEN_DEFINE_MODEL_ABI(ns, var)                                                   \
+  namespace var##_impl {                                                                    \
+  inline void deviation(const double* axes, const double* errors, const double* params,     \
+                        double* position, double* orientation) {                            \
+    std::array<double, ns::kNumAxes> a{};                                                   \
+    std::array<double, ns::kNumErrors> e{};                                                 \
+    std::array<double, ns::kNumParams> p{};                                                 \
+    std::copy_n(axes, ns::kNumAxes, a.begin());                                             \
+    std::copy_n(errors, ns::kNumErrors, e.begin());                                         \
+    std::copy_n(params, ns::kNumParams, p.begin());                                         \
+    std::array<double, 3> pos{}, ori{};                                                     \
+    ns::Deviation<double>(a, e, p, position ? &pos : nullptr, orientation ? &ori : nullptr); \
+    if (position) std::copy_n(pos.begin(), 3, position);                                    \
+    if (orientation) std::copy_n(ori.begin(), 3, orientation);                              \
+  }                                                                                         \
+  inline void coefficients(const double* axes, const double* params, double* position_coeff, \
+                           double* orientation_coeff) {                                     \
+    std::array<double, ns::kNumAxes> a{};                                                   \
+    std::array<double, ns::kNumParams> p{};                                                 \
+    std::copy_n(axes, ns::kNumAxes, a.begin());                                             \
+    std::copy_n(params, ns::kNumParams, p.begin());                                         \
+    std::array<double, 3 * ns::kNumErrors> pc{}, oc{};                                      \
+    ns::Coefficients<double>(a, p, position_coeff ? &pc : nullptr,                          \
+                             orientation_coeff ? &oc : nullptr);                            \
+    if (position_coeff) std::copy_n(pc.begin(), pc.size(), position_coeff);                 \
+    if (orientation_coeff) std::copy_n(oc.begin(), oc.size(), orientation_coeff);           \
+  }                                                                                         \
+  }                                                                                         \
+  const WeilgenModelAbi var = {kWeilgenModelAbiVersion,                                     \
+                               ns::kOrder,                                                  \
+                               ns::kMachineName,                                            \
+                               ns::kModelKey,                                               \
+                               ns::kNumAxes,                                                \
+                               ns::kNumErrors,                                              \
+                               ns::kNumParams,                                              \
+                               &var##_impl::deviation,                                      \
+                               &var##_impl::coefficients};

@@ -1,0 +1,183 @@
+// Model loading: built-in models by content key, run-time compilation into a cache, the
+// numeric-chain fallback without a compiler; all engines agree.
+#include <doctest/doctest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include "builtin_models.hpp"
+#include "generator/generate.hpp"
+#include "machine/yaml_loader.hpp"
+#include "model_key.hpp"
+#include "model_loader.hpp"
+#include "numeric_chain.hpp"
+#include "test_support.hpp"
+
+using namespace weilgen;
+namespace fs = std::filesystem;
+
+namespace {
+
+LoadOptions options_in(const std::string& cache, std::vector<std::string>* log = nullptr) {
+  LoadOptions o;
+  o.cache_dir = cache;
+  o.compiler = WEILGEN_CXX;
+  o.builtins = builtin_models();
+  o.generate = [](const Description& d, int order) {
+    GeneratedHeader h;
+    h.text = gen::generate_header(d, order, &h.name_space);
+    return h;
+  };
+  if (log) o.log = [log](const std::string& m) { log->push_back(m); };
+  return o;
+}
+
+std::string fresh_dir(const std::string& name) {
+  const fs::path p = fs::path(WEILGEN_TEST_TMP) / name;
+  fs::remove_all(p);
+  fs::create_directories(p);
+  return p.string();
+}
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// Largest difference between two models' deviation and coefficients over random poses/errors.
+double max_disagreement(const Model& a, const Model& b, double error_scale) {
+  std::mt19937 rng(7);
+  ModelData da(a), db(b);
+  double worst = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    const auto q = test::random_pose(a.description(), rng);
+    const auto e = test::scaled(test::random_direction(a.description(), rng), error_scale);
+    a.deviation(da, q.data(), e.data(), da.out.data());
+    b.deviation(db, q.data(), e.data(), db.out.data());
+    for (int o = 0; o < 6; ++o)
+      worst = std::max(worst, std::abs(da.out[o] - db.out[o]) * (o < 3 ? 1.0 : 1000.0));
+    a.coefficients(da, q.data(), da.coeff.data());
+    b.coefficients(db, q.data(), db.coeff.data());
+    for (std::size_t k = 0; k < da.coeff.size(); ++k)
+      worst = std::max(worst, std::abs(da.coeff[k] - db.coeff[k]) /
+                                  std::max(1.0, std::abs(da.coeff[k])));
+  }
+  return worst;
+}
+
+}  // namespace
+
+TEST_CASE("model loader: shipped machines are built in and match the exact chain") {
+  for (const auto& name : test::shipped_machines()) {
+    CAPTURE(name);
+    const Description d = load_machine_file(test::machine_path(name));
+    const auto model = load_model(d, options_in(fresh_dir("loader_builtin")));
+    CHECK(model->engine() == ModelEngine::BuiltIn);
+    CHECK(model->order() == d.algebra.order);
+    const auto chain = load_model(d, [] {
+      LoadOptions o;
+      o.engine = EngineChoice::Numeric;
+      return o;
+    }());
+    CHECK(chain->engine() == ModelEngine::NumericChain);
+    // Order 1 against the exact chain: errors of 1e-6 (mm, 1e-9 rad) agree to O(s^2).
+    CHECK(max_disagreement(*model, *chain, 1e-6) < 1e-8);
+  }
+}
+
+TEST_CASE("model loader: an edited machine is compiled once, then loaded from the cache") {
+  const std::string dir = fresh_dir("loader_edit");
+  const std::string cache = dir + "/cache";
+  std::string text = read_text(test::machine_path("vmc_3axis"));
+  // A different tool length: a new machine that no built-in model serves.
+  text += "\n# edited by test_model_loader\n";
+  const Description d = load_machine_text(text, dir + "/vmc_edit.yaml");
+  std::vector<std::string> log;
+  const auto compiled = load_model(d, options_in(cache, &log));
+  CHECK(compiled->engine() == ModelEngine::Compiled);
+  CHECK(compiled->origin().find("compiled (") == 0);
+  REQUIRE(log.size() >= 2);
+  CHECK(log.front().find("compiling model vmc_3axis") == 0);
+  CHECK(fs::is_regular_file(cache + "/vmc_3axis-" + model_key(d.source_hash, 1) + ".so"));
+  // No build directories left behind.
+  int entries = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator(cache)) ++entries;
+  CHECK(entries == 1);
+
+  std::vector<std::string> log2;
+  const auto cached = load_model(d, options_in(cache, &log2));
+  CHECK(cached->engine() == ModelEngine::Compiled);
+  CHECK(cached->origin().find("cached (") == 0);
+  CHECK(log2.empty());
+  CHECK(max_disagreement(*compiled, *cached, 1e-3) == 0.0);
+
+  // The same machine through the built-in model: identical functions.
+  const auto builtin =
+      load_model(load_machine_file(test::machine_path("vmc_3axis")), options_in(cache));
+  CHECK(builtin->engine() == ModelEngine::BuiltIn);
+  CHECK(max_disagreement(*compiled, *builtin, 1e-3) == 0.0);
+}
+
+TEST_CASE("model loader: order override compiles an order-2 model that converges as s^3") {
+  const std::string cache = fresh_dir("loader_order2");
+  const Description d = load_machine_file(test::machine_path("two_axis"));
+  LoadOptions o = options_in(cache);
+  o.order = 2;
+  const auto m2 = load_model(d, o);
+  CHECK(m2->engine() == ModelEngine::Compiled);
+  CHECK(m2->order() == 2);
+  LoadOptions n;
+  n.engine = EngineChoice::Numeric;
+  const auto chain = load_model(d, n);
+  std::mt19937 rng(3);
+  const auto q = test::random_pose(d, rng);
+  const auto u = test::random_direction(d, rng);
+  std::vector<double> s{1e-2, 5e-3, 2.5e-3}, err;
+  ModelData a(*m2), b(*chain);
+  for (double si : s) {
+    const auto e = test::scaled(u, si);
+    m2->deviation(a, q.data(), e.data(), a.out.data());
+    chain->deviation(b, q.data(), e.data(), b.out.data());
+    double m = 0;
+    for (int k = 0; k < 6; ++k) m = std::max(m, std::abs(a.out[k] - b.out[k]));
+    err.push_back(m);
+  }
+  CHECK(test::loglog_slope(s, err) == doctest::Approx(3.0).epsilon(0.1));
+}
+
+TEST_CASE("model loader: without a compiler, the numeric chain with a warning") {
+  const std::string cache = fresh_dir("loader_nocxx");
+  std::string text = read_text(test::machine_path("two_axis")) + "\n# edited\n";
+  const Description d = load_machine_text(text, cache + "/two_axis_edit.yaml");
+  std::vector<std::string> log;
+  LoadOptions o = options_in(cache, &log);
+  o.compiler = "/nonexistent/c++";
+  const auto m = load_model(d, o);
+  CHECK(m->engine() == ModelEngine::NumericChain);
+  REQUIRE(log.size() == 1);
+  CHECK(log[0].find("warning: no C++ compiler found (tried /nonexistent/c++)") == 0);
+  o.engine = EngineChoice::Compiled;
+  CHECK_THROWS_WITH_AS(load_model(d, o),
+                       doctest::Contains("cannot compile the model of two_axis"),
+                       std::runtime_error);
+  o.compiler = "none";
+  o.engine = EngineChoice::Auto;
+  log.clear();
+  CHECK(load_model(d, o)->engine() == ModelEngine::NumericChain);
+  CHECK(log[0].find("compilation disabled") != std::string::npos);
+}
+
+TEST_CASE("model loader: a compile failure reports the compiler's message") {
+  const std::string cache = fresh_dir("loader_fail");
+  std::string text = read_text(test::machine_path("two_axis")) + "\n# edited again\n";
+  const Description d = load_machine_text(text, cache + "/two_axis_fail.yaml");
+  LoadOptions o = options_in(cache);
+  o.generate = [](const Description&, int) {
+    return GeneratedHeader{"#error broken header\n", "two_axis"};
+  };
+  CHECK_THROWS_WITH_AS(load_model(d, o), doctest::Contains("broken header"), std::runtime_error);
+  CHECK_FALSE(fs::exists(cache + "/two_axis-" + model_key(d.source_hash, 1) + ".so"));
+}
