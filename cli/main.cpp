@@ -27,6 +27,20 @@ const std::map<std::string, Verb>& verbs() {
         "      [--order r]\n"
         "      print the closed-form error expressions"}},
       {"list", {weilgen::cli::verb_list, "list\n      list the shipped machines"}},
+      {"sensitivity",
+       {weilgen::cli::verb_sensitivity,
+        "sensitivity <machine> (--at ...|--grid ...) [--method local|sobol|exact|all]\n"
+        "      [--samples N]\n"
+        "      coefficients, exact and quasi-Monte Carlo Sobol' indices per pose and output"}},
+      {"reliability",
+       {weilgen::cli::verb_reliability,
+        "reliability <machine> --grid ... --tolerance dx=0.03mm [--limit two-sided|one-sided|\n"
+        "      radial] [--method auto|exact|form|is|mc]\n"
+        "      P(deviation within tolerance) per pose and output, with sensitivities"}},
+      {"allocate",
+       {weilgen::cli::verb_allocate,
+        "allocate <machine> --grid ... --tolerance ... --min 0.95 --mean 0.97\n"
+        "      tighten the most sensitive errors until the reliability targets hold"}},
 #endif
   };
   return v;
@@ -64,6 +78,9 @@ int main(int argc, char** argv) {
   weilgen::cli::Args args(argv + 2, argv + argc);
   try {
     return it->second.run(args);
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "weilgen " << argv[1] << ": " << e.what() << "\n";
+    return 2;
   } catch (const weilgen::InputError& e) {
     std::cerr << e.what() << "\n";
     return 3;

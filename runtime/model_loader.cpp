@@ -40,7 +40,7 @@ std::string shell_quote(const std::string& s) {
   return q + "'";
 }
 
-std::shared_ptr<const Model> open_shared_object(const Description& desc, const std::string& path,
+std::shared_ptr<Model> open_shared_object(const Description& desc, const std::string& path,
                                                 const std::string& key, const std::string& how) {
   void* handle = ::dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (!handle) throw std::runtime_error("cannot load " + path + ": " + ::dlerror());
@@ -143,7 +143,7 @@ std::string find_compiler(const std::string& requested) {
   return "";
 }
 
-std::shared_ptr<const Model> load_model(const Description& desc, const LoadOptions& options) {
+std::shared_ptr<Model> load_model(const Description& desc, const LoadOptions& options) {
   const int order = options.order > 0 ? options.order : desc.algebra.order;
   const std::string key = model_key(desc.source_hash, order);
   const auto numeric = [&](const std::string& why) {

@@ -37,7 +37,7 @@ struct LoadOptions {
   std::function<void(const std::string&)> log;  // progress and warnings (e.g. to stderr)
 };
 
-std::shared_ptr<const Model> load_model(const Description& desc, const LoadOptions& options);
+std::shared_ptr<Model> load_model(const Description& desc, const LoadOptions& options);
 
 // The resolved defaults (for messages and docs).
 std::string default_cache_dir();

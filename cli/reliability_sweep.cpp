@@ -1,0 +1,91 @@
+#include "reliability_sweep.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace weilgen::cli {
+
+LimitChoice parse_limit(const std::string& text) {
+  if (text == "two-sided") return LimitChoice::TwoSided;
+  if (text == "one-sided") return LimitChoice::OneSided;
+  if (text == "radial") return LimitChoice::Radial;
+  throw std::invalid_argument("--limit must be two-sided, one-sided or radial, not '" + text + "'");
+}
+
+const char* limit_name(LimitChoice limit, OutputId output) {
+  if (output == OutputId::Dp) return "radial";
+  return limit == LimitChoice::OneSided ? "one-sided" : "two-sided";
+}
+
+std::vector<SweepCase> reliability_sweep(const Study& st,
+                                         const std::vector<InputDistribution>& inputs,
+                                         LimitChoice limit, const ReliabilityOptions& options,
+                                         bool quiet) {
+  const Model& model = *st.model;
+  const std::size_t ne = model.num_errors(), np = st.poses.poses.size();
+  if (limit == LimitChoice::Radial)
+    for (const auto& t : st.tolerances)
+      if (t.output != OutputId::Dp)
+        throw std::invalid_argument(
+            "--limit radial bounds |(dx,dy,dz)|: give its tolerance as dp=..., not " +
+            std::string(output_name(t.output)));
+  std::vector<ModelData> work;
+  for (unsigned t = 0; t < std::max(1u, st.threads); ++t) work.emplace_back(model);
+  ModelData data(model);
+  std::vector<double> zero(ne, 0.0), base(6);
+  std::vector<SweepCase> cases;
+  Progress progress("reliability", st.tolerances.size() * np, quiet);
+  for (std::size_t k = 0; k < st.tolerances.size(); ++k) {
+    const OutputId out = st.tolerances[k].output;
+    for (std::size_t p = 0; p < np; ++p) {
+      const double* pose = st.poses.poses[p].data();
+      ReliabilityProblem prob;
+      prob.inputs = inputs;
+      prob.tolerance = st.tolerances[k].value;
+      prob.limit = (out == OutputId::Dp || limit == LimitChoice::OneSided) ? LimitKind::Upper
+                                                                            : LimitKind::TwoSided;
+      if (out == OutputId::Dp) {
+        prob.response = [&, pose](unsigned t, const double* x) {
+          ModelData& w = work[t];
+          model.deviation(w, pose, x, w.out.data());
+          return std::sqrt(w.out[0] * w.out[0] + w.out[1] * w.out[1] + w.out[2] * w.out[2]);
+        };
+      } else {
+        const std::size_t row = static_cast<std::size_t>(out);
+        if (model.order() == 1 && model.engine() != ModelEngine::NumericChain) {
+          // Order 1: the output is exactly linear in the errors.
+          model.coefficients(data, pose, data.coeff.data());
+          model.deviation(data, pose, zero.data(), base.data());
+          prob.linear = LinearForm{base[row], std::vector<double>(data.coeff.begin() + row * ne,
+                                                                  data.coeff.begin() + (row + 1) * ne)};
+        } else {
+          prob.response = [&, pose, row](unsigned t, const double* x) {
+            ModelData& w = work[t];
+            model.deviation(w, pose, x, w.out.data());
+            return w.out[row];
+          };
+        }
+      }
+      cases.push_back({p, k, compute_reliability(prob, options)});
+      progress.update(cases.size());
+    }
+  }
+  return cases;
+}
+
+std::vector<SweepSummary> summarize(const Study& st, const std::vector<SweepCase>& cases) {
+  std::vector<SweepSummary> s(st.tolerances.size());
+  std::vector<std::size_t> n(st.tolerances.size(), 0);
+  for (const auto& c : cases) {
+    SweepSummary& x = s[c.tolerance];
+    const double r = c.result.reliability;
+    if (n[c.tolerance] == 0 || r < x.min) x.min = r, x.argmin = c.pose;
+    x.mean += r;
+    ++n[c.tolerance];
+  }
+  for (std::size_t k = 0; k < s.size(); ++k)
+    if (n[k]) s[k].mean /= static_cast<double>(n[k]);
+  return s;
+}
+
+}  // namespace weilgen::cli

@@ -1,0 +1,37 @@
+// Reliability of every (pose, toleranced output) of a study: the sweep behind
+// `weilgen reliability` and `weilgen allocate`. Order-1 components are passed to the engine as
+// exact linear forms (so `auto` is exact for Gaussian errors); dp and higher orders go through
+// the model itself.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "reliability.hpp"
+#include "study.hpp"
+
+namespace weilgen::cli {
+
+enum class LimitChoice { TwoSided, OneSided, Radial };
+LimitChoice parse_limit(const std::string& text);  // two-sided | one-sided | radial
+const char* limit_name(LimitChoice limit, OutputId output);
+
+struct SweepCase {
+  std::size_t pose = 0, tolerance = 0;  // indices into Study::poses.poses and Study::tolerances
+  ReliabilityResult result;
+};
+
+// Cases ordered tolerance-major: all poses of tolerances[0], then tolerances[1], ...
+std::vector<SweepCase> reliability_sweep(const Study& study,
+                                         const std::vector<InputDistribution>& inputs,
+                                         LimitChoice limit, const ReliabilityOptions& options,
+                                         bool quiet);
+
+// Per tolerance (output): min and mean reliability over the poses and the pose of the minimum.
+struct SweepSummary {
+  double min = 1, mean = 0;
+  std::size_t argmin = 0;
+};
+std::vector<SweepSummary> summarize(const Study& study, const std::vector<SweepCase>& cases);
+
+}  // namespace weilgen::cli
