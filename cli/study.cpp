@@ -81,7 +81,8 @@ std::vector<double> parse_params(const Description& d, const std::vector<std::st
       throw std::invalid_argument("--param: unknown parameter \"" + name + "\" (machine " +
                                   d.name + " has " + (known.empty() ? "none" : known) + ")");
     }
-    values[k] = parse_quantity_unit(flag.substr(eq + 1), "", "--param " + name).number;
+    const std::string unit = d.parameters[k].unit;
+    values[k] = parse_quantity_unit(flag.substr(eq + 1), unit, "--param " + name).in(parse_unit(unit));
   }
   return values;
 }

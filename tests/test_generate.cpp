@@ -16,6 +16,10 @@
 #include "test_support.hpp"
 
 using namespace weilgen;
+using test::cli;
+using test::fresh_dir;
+using test::run;
+using test::Run;
 namespace fs = std::filesystem;
 
 namespace {
@@ -26,30 +30,7 @@ std::string text_of(const std::string& path) {
   return s;
 }
 
-fs::path fresh_dir(const std::string& name) {
-  const fs::path p = fs::path(WEILGEN_TEST_TMP) / name;
-  fs::remove_all(p);
-  fs::create_directories(p);
-  return p;
-}
 
-struct Run {
-  int status = 0;
-  std::string out;
-};
-
-Run run(const std::string& cmd) {
-  Run r;
-  FILE* pipe = popen((cmd + " 2>&1").c_str(), "r");
-  REQUIRE(pipe != nullptr);
-  char buf[4096];
-  while (std::fgets(buf, sizeof buf, pipe)) r.out += buf;
-  const int status = pclose(pipe);
-  r.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
-
-std::string cli(const std::string& args) { return std::string(WEILGEN_BINARY) + " " + args; }
 
 void replace_once(std::string& s, const std::string& from, const std::string& to) {
   const auto pos = s.find(from);

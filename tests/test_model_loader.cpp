@@ -33,12 +33,7 @@ LoadOptions options_in(const std::string& cache, std::vector<std::string>* log =
   return o;
 }
 
-std::string fresh_dir(const std::string& name) {
-  const fs::path p = fs::path(WEILGEN_TEST_TMP) / name;
-  fs::remove_all(p);
-  fs::create_directories(p);
-  return p.string();
-}
+std::string fresh_dir(const std::string& name) { return test::fresh_dir(name).string(); }
 
 std::string read_text(const std::string& path) {
   std::ifstream in(path);

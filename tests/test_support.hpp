@@ -1,8 +1,12 @@
 // Shared helpers for the test suite.
 #pragma once
 
+#include <sys/wait.h>
+
 #include <array>
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <random>
 #include <string>
 #include <vector>
@@ -10,6 +14,34 @@
 #include "machine/description.hpp"
 
 namespace weilgen::test {
+
+// A fresh, empty directory under the test build's tmp/.
+inline std::filesystem::path fresh_dir(const std::string& name) {
+  const std::filesystem::path p = std::filesystem::path(WEILGEN_TEST_TMP) / name;
+  std::filesystem::remove_all(p);
+  std::filesystem::create_directories(p);
+  return p;
+}
+
+// A shell command's exit status and combined stdout + stderr.
+struct Run {
+  int status = -1;
+  std::string out;
+};
+
+inline Run run(const std::string& cmd) {
+  Run r;
+  FILE* pipe = popen((cmd + " 2>&1").c_str(), "r");
+  if (!pipe) return r;
+  char buf[4096];
+  while (std::fgets(buf, sizeof buf, pipe)) r.out += buf;
+  const int status = pclose(pipe);
+  r.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+// The weilgen command line with `args`.
+inline std::string cli(const std::string& args) { return std::string(WEILGEN_BINARY) + " " + args; }
 
 inline const std::vector<std::string>& shipped_machines() {
   static const std::vector<std::string> m = {"gantry_grinder", "vmc_3axis", "two_axis",
