@@ -79,6 +79,7 @@ int verb_reliability(const Args& args) {
   if (!(confidence > 0 && confidence < 1))
     return usage_error("reliability", "--confidence must be in (0, 1)");
 
+  if (!f.plot.empty()) check_plot_target(f.plot);  // before a long run, not after
   const Study st = open_study(f, true);
   ro.threads = st.threads;
   const Model& model = *st.model;

@@ -98,6 +98,7 @@ int verb_sensitivity(const Args& args) {
                                           std::to_string(samples));
   const std::vector<OutputId> outputs = parse_outputs(outputs_text);
 
+  if (!f.plot.empty()) check_plot_target(f.plot);  // before a long run, not after
   const Study st = open_study(f, false);
   const Model& model = *st.model;
   const auto& errors = model.description().errors;

@@ -68,12 +68,12 @@ inline constexpr std::array<AxisInfo, kNumAxes> kAxes = {{
 }};
 
 inline constexpr std::array<ErrorInfo, kNumErrors> kErrors = {{
-    {"E_XX", "E_XX", "", "positioning", "um", 1.0, true, "x_axis", "after", false, DistributionKind::kNormal, 0.0, 3.0, 0.0, 0.0},
-    {"E_YX", "E_YX", "", "straightness", "um", 1.0, true, "x_axis", "after", false, DistributionKind::kNormal, 0.0, 2.0, 0.0, 0.0},
-    {"E_ZX", "E_ZX", "", "straightness", "um", 1.0, true, "x_axis", "after", false, DistributionKind::kNormal, 0.0, 2.0, 0.0, 0.0},
-    {"E_AX", "E_AX", "", "angular", "urad", 1.0, true, "x_axis", "after", true, DistributionKind::kNormal, 0.0, 4.0, 0.0, 0.0},
-    {"E_BX", "E_BX", "", "angular", "urad", 1.0, true, "x_axis", "after", true, DistributionKind::kNormal, 0.0, 4.0, 0.0, 0.0},
-    {"E_CX", "E_CX", "", "angular", "urad", 1.0, true, "x_axis", "after", true, DistributionKind::kNormal, 0.0, 4.0, 0.0, 0.0},
+    {"E_XX", "E_XX", "", "positioning", "um", 0.001, true, "x_axis", "after", false, DistributionKind::kNormal, 0.0, 3.0, 0.0, 0.0},
+    {"E_YX", "E_YX", "", "straightness", "um", 0.001, true, "x_axis", "after", false, DistributionKind::kNormal, 0.0, 2.0, 0.0, 0.0},
+    {"E_ZX", "E_ZX", "", "straightness", "um", 0.001, true, "x_axis", "after", false, DistributionKind::kNormal, 0.0, 2.0, 0.0, 0.0},
+    {"E_AX", "E_AX", "", "angular", "urad", 1e-06, true, "x_axis", "after", true, DistributionKind::kNormal, 0.0, 4.0, 0.0, 0.0},
+    {"E_BX", "E_BX", "", "angular", "urad", 1e-06, true, "x_axis", "after", true, DistributionKind::kNormal, 0.0, 4.0, 0.0, 0.0},
+    {"E_CX", "E_CX", "", "angular", "urad", 1e-06, true, "x_axis", "after", true, DistributionKind::kNormal, 0.0, 4.0, 0.0, 0.0},
     {"E_XZ", "E_XZ", "", "straightness", "um", 0.001, true, "z_axis", "after", false, DistributionKind::kNormal, 0.0, 2.0, 0.0, 0.0},
     {"E_YZ", "E_YZ", "", "straightness", "um", 0.001, true, "z_axis", "after", false, DistributionKind::kNormal, 0.0, 2.0, 0.0, 0.0},
     {"E_ZZ", "E_ZZ", "", "positioning", "um", 0.001, true, "z_axis", "after", false, DistributionKind::kNormal, 0.0, 3.0, 0.0, 0.0},

@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -13,6 +14,7 @@
 #include "machine/expr.hpp"
 #include "machine/iso_names.hpp"
 #include "machine/yaml_loader.hpp"
+#include "test_support.hpp"
 
 using namespace weilgen;
 
@@ -934,4 +936,19 @@ TEST_CASE("shipped machines are found through $WEILGEN_MACHINES_DIR when it is s
   CHECK_THROWS_AS(weilgen::resolve_machine("vmc_3axis"), weilgen::InputError);
   ::unsetenv("WEILGEN_MACHINES_DIR");
   CHECK(weilgen::resolve_machine("vmc_3axis").find("vmc_3axis.yaml") != std::string::npos);
+}
+
+TEST_CASE("machine loader: every error's to_base matches its unit (explicit, iso and defaults)") {
+  const std::map<std::string, double> factor = {{"mm", 1.0},    {"um", 1e-3},  {"nm", 1e-6},
+                                                {"rad", 1.0},   {"mrad", 1e-3}, {"urad", 1e-6},
+                                                {"arcsec", M_PI / 648000}, {"deg", M_PI / 180}};
+  for (const auto& name : weilgen::test::shipped_machines()) {
+    const auto d = weilgen::load_machine_file(weilgen::test::machine_path(name));
+    for (const auto& e : d.errors) {
+      CAPTURE(name);
+      CAPTURE(e.name);
+      REQUIRE(factor.count(e.unit) == 1);
+      CHECK(e.to_base == doctest::Approx(factor.at(e.unit)).epsilon(1e-15));
+    }
+  }
 }

@@ -731,6 +731,7 @@ class Loader {
       err.loc = loc(at.where);
       claim_error_names(err, at, {});
       apply_group_default(err, false, at, implicit ? " (implicit errors: iso)" : " (errors: iso)");
+      err.to_base = find_unit(kErrorUnits, err.unit)->to_base;
       add_error(b, std::move(err));
     }
   }

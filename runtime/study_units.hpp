@@ -1,0 +1,53 @@
+// Units and quantities of the study inputs (command-line flags and tolerance files,
+// docs/study-inputs.md): "0.03mm", "30 um", "5 µrad", "0.05/6" (an expression, no unit).
+// Base units are mm for lengths and rad for angles, as everywhere in the runtime.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace weilgen {
+
+// A unit's factor to base units (mm or rad) and whether it measures an angle.
+struct UnitFactor {
+  double to_base = 1.0;
+  bool angle = false;
+};
+
+// Lengths: mm, um, µm, nm, m; angles: rad, mrad, urad, µrad, deg, arcsec; slopes (angles):
+// mm/m, um/m, µm/m (= 1e-3 rad, 1e-6 rad). µ may be written as the micro sign (U+00B5) or the
+// Greek mu (U+03BC). Throws std::invalid_argument naming the unit and the known ones.
+UnitFactor parse_unit(const std::string& unit);
+
+// Every unit parse_unit knows, for messages: "lengths: mm, ...; angles: ...; slopes: ...".
+std::string known_units();
+
+// A number as written with its unit: value in base units = number * unit.to_base.
+struct Quantity {
+  double number = 0;      // the number or expression as written, evaluated
+  UnitFactor unit;        // the written unit, else the default
+  std::string unit_name;  // as written, else the default unit's name
+  bool unit_given = false;
+  double value() const { return number * unit.to_base; }
+  // The number in another unit; exact when `target` is the written unit.
+  double in(const UnitFactor& target) const { return number * (unit.to_base / target.to_base); }
+};
+
+// "0.03mm", "30 um", "0.05/6 mm", "-2*pi rad", "0.05/6" (no unit: `default_unit`). The number may
+// be an expression (+ - * / ^, parentheses, pi). An empty `default_unit` makes the unit required.
+// Throws std::invalid_argument "<what>: <why>" (empty text, unknown unit, NaN, inf, not a number).
+Quantity parse_quantity_unit(const std::string& text, const std::string& default_unit,
+                             const std::string& what);
+
+// The value of parse_quantity_unit in base units (mm or rad).
+double parse_quantity(const std::string& text, const std::string& default_unit,
+                      const std::string& what);
+
+// Helpers shared by the study-input parsers.
+std::string trim(const std::string& s);
+// Splits at every `sep` (empty items kept).
+std::vector<std::string> split(const std::string& s, char sep);
+// "%g"-like text that reads back as the same double (shortest of 15, 16, 17 digits).
+std::string format_number(double v);
+
+}  // namespace weilgen
