@@ -134,7 +134,7 @@ int verb_reliability(const Args& args) {
                   << 100 * ranked[i].second;
     std::cout << std::defaultfloat << "\n";
     for (const SweepCase* c : mine)
-      if (!c->result.note.empty()) {
+      if (!c->result.note.empty() && c->result.method != ReliabilityMethod::Exact) {
         std::cout << "  note at " << pose_label(g, c->pose) << ": " << c->result.note << "\n";
         break;
       }
