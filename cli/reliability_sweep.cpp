@@ -17,10 +17,17 @@ const char* limit_name(LimitChoice limit, OutputId output) {
   return limit == LimitChoice::OneSided ? "one-sided" : "two-sided";
 }
 
+SensitivityChoice parse_sensitivities(const std::string& text) {
+  if (text == "auto") return SensitivityChoice::Auto;
+  if (text == "form") return SensitivityChoice::Form;
+  if (text == "sampling") return SensitivityChoice::Sampling;
+  throw std::invalid_argument("--sensitivities must be auto, form or sampling, not '" + text + "'");
+}
+
 std::vector<SweepCase> reliability_sweep(const Study& st,
                                          const std::vector<InputDistribution>& inputs,
                                          LimitChoice limit, const ReliabilityOptions& options,
-                                         bool quiet) {
+                                         SensitivityChoice sensitivities, bool quiet) {
   const Model& model = *st.model;
   const std::size_t ne = model.num_errors(), np = st.poses.poses.size();
   if (limit == LimitChoice::Radial)
@@ -43,7 +50,7 @@ std::vector<SweepCase> reliability_sweep(const Study& st,
       prob.inputs = inputs;
       prob.tolerance = st.tolerances[k].value;
       prob.limit = (out == OutputId::Dp || limit == LimitChoice::OneSided) ? LimitKind::Upper
-                                                                            : LimitKind::TwoSided;
+                                                                           : LimitKind::TwoSided;
       if (out == OutputId::Dp) {
         prob.response = [&, pose](unsigned t, const double* x) {
           ModelData& w = work[t];
@@ -56,8 +63,9 @@ std::vector<SweepCase> reliability_sweep(const Study& st,
           // Order 1: the output is exactly linear in the errors.
           model.coefficients(data, pose, data.coeff.data());
           model.deviation(data, pose, zero.data(), base.data());
-          prob.linear = LinearForm{base[row], std::vector<double>(data.coeff.begin() + row * ne,
-                                                                  data.coeff.begin() + (row + 1) * ne)};
+          prob.linear =
+              LinearForm{base[row], std::vector<double>(data.coeff.begin() + row * ne,
+                                                        data.coeff.begin() + (row + 1) * ne)};
         } else {
           prob.response = [&, pose, row](unsigned t, const double* x) {
             ModelData& w = work[t];
@@ -66,7 +74,12 @@ std::vector<SweepCase> reliability_sweep(const Study& st,
           };
         }
       }
-      cases.push_back({p, k, compute_reliability(prob, options)});
+      ReliabilityOptions o = options;
+      o.sensitivities = sensitivities == SensitivityChoice::Sampling ||
+                                (sensitivities == SensitivityChoice::Auto && out == OutputId::Dp)
+                            ? SensitivityMethod::Sampling
+                            : SensitivityMethod::Form;
+      cases.push_back({p, k, compute_reliability(prob, o)});
       progress.update(cases.size());
     }
   }

@@ -21,11 +21,17 @@ struct SweepCase {
   ReliabilityResult result;
 };
 
+// --sensitivities auto | form | sampling. auto: sampling-based (importance sampling
+// differentiating its own estimate) for the radial limit, where FORM's single-point linearisation
+// of a sphere is off by a factor 2-3; FORM-based elsewhere.
+enum class SensitivityChoice { Auto, Form, Sampling };
+SensitivityChoice parse_sensitivities(const std::string& text);
+
 // Cases ordered tolerance-major: all poses of tolerances[0], then tolerances[1], ...
 std::vector<SweepCase> reliability_sweep(const Study& study,
                                          const std::vector<InputDistribution>& inputs,
                                          LimitChoice limit, const ReliabilityOptions& options,
-                                         bool quiet);
+                                         SensitivityChoice sensitivities, bool quiet);
 
 // Per tolerance (output): min and mean reliability over the poses and the pose of the minimum.
 struct SweepSummary {

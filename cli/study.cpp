@@ -29,9 +29,9 @@ void add_study_options(po::options_description& opts, StudyFlags& f, bool with_t
       "numeric (the exact Eigen chain)")(
       "compiler", po::value<std::string>(&f.compiler),
       "C++ compiler for machines that are not built in (default $CXX, c++, g++, clang++;\n"
-      "'none' disables compilation)")(
-      "param", po::value<std::vector<std::string>>(&f.params)->composing(),
-      "NAME=VALUE machine parameter (mm or deg), repeatable");
+      "'none' disables compilation)")("param",
+                                      po::value<std::vector<std::string>>(&f.params)->composing(),
+                                      "NAME=VALUE machine parameter (mm or deg), repeatable");
   po::options_description where("Poses and distributions (docs/study-inputs.md)");
   where.add_options()("at", po::value<std::vector<std::string>>(&f.at)->composing(),
                       "one pose, e.g. X=0,Y=1500,Z=600 (axis units mm/deg); repeatable")(
@@ -53,8 +53,9 @@ void add_study_options(po::options_description& opts, StudyFlags& f, bool with_t
       "plot", po::value<std::string>(&f.plot), "draw the result to FILE (.png or .svg, gnuplot)")(
       "seed", po::value<std::uint64_t>(&f.seed)->default_value(1),
       "seed of every sampled result (same seed, same numbers, any --threads)")(
-      "threads", po::value<unsigned>(&f.threads)->default_value(0), "worker threads (0 = all cores)")(
-      "quiet,q", po::bool_switch(&f.quiet), "no progress or model messages on stderr");
+      "threads", po::value<unsigned>(&f.threads)->default_value(0),
+      "worker threads (0 = all cores)")("quiet,q", po::bool_switch(&f.quiet),
+                                        "no progress or model messages on stderr");
   opts.add(model).add(where).add(out);
 }
 
@@ -78,11 +79,12 @@ std::vector<double> parse_params(const Description& d, const std::vector<std::st
     if (k == d.parameters.size()) {
       std::string known;
       for (const auto& p : d.parameters) known += (known.empty() ? "" : ", ") + p.name;
-      throw std::invalid_argument("--param: unknown parameter \"" + name + "\" (machine " +
-                                  d.name + " has " + (known.empty() ? "none" : known) + ")");
+      throw std::invalid_argument("--param: unknown parameter \"" + name + "\" (machine " + d.name +
+                                  " has " + (known.empty() ? "none" : known) + ")");
     }
     const std::string unit = d.parameters[k].unit;
-    values[k] = parse_quantity_unit(flag.substr(eq + 1), unit, "--param " + name).in(parse_unit(unit));
+    values[k] =
+        parse_quantity_unit(flag.substr(eq + 1), unit, "--param " + name).in(parse_unit(unit));
   }
   return values;
 }
@@ -94,10 +96,15 @@ Study open_study(const StudyFlags& f, bool need_tolerances) {
   if (f.order < 0) throw std::invalid_argument("--order must be >= 1");
   LoadOptions lo;
   lo.order = f.order;
-  if (f.engine == "auto") lo.engine = EngineChoice::Auto;
-  else if (f.engine == "compiled") lo.engine = EngineChoice::Compiled;
-  else if (f.engine == "numeric") lo.engine = EngineChoice::Numeric;
-  else throw std::invalid_argument("--engine must be auto, compiled or numeric, not '" + f.engine + "'");
+  if (f.engine == "auto")
+    lo.engine = EngineChoice::Auto;
+  else if (f.engine == "compiled")
+    lo.engine = EngineChoice::Compiled;
+  else if (f.engine == "numeric")
+    lo.engine = EngineChoice::Numeric;
+  else
+    throw std::invalid_argument("--engine must be auto, compiled or numeric, not '" + f.engine +
+                                "'");
   lo.compiler = f.compiler;
   lo.builtins = builtin_models();
   lo.generate = generate_for_loader;
@@ -135,8 +142,8 @@ nlohmann::json pose_json(const PoseSet& poses, std::size_t i) {
 nlohmann::json model_json(const Model& m) {
   const Description& d = m.description();
   nlohmann::json axes = nlohmann::json::array();
-  for (int b : d.axes()) axes.push_back({{"name", d.bodies[b].joint.coordinate},
-                                         {"unit", d.bodies[b].joint.unit}});
+  for (int b : d.axes())
+    axes.push_back({{"name", d.bodies[b].joint.coordinate}, {"unit", d.bodies[b].joint.unit}});
   return {{"machine", d.name},
           {"source", d.source_file},
           {"order", m.order()},

@@ -45,7 +45,8 @@ std::vector<double> parse_steps(const Description& d, const std::vector<std::str
     const std::string t = trim(flag);
     if (!t.empty() && t.back() == '%') {
       const double pct = parse_quantity_unit(t.substr(0, t.size() - 1), "mm", "--step").number;
-      if (!(pct > 0 && pct < 100)) throw std::invalid_argument("--step: percentage must be in (0, 100)");
+      if (!(pct > 0 && pct < 100))
+        throw std::invalid_argument("--step: percentage must be in (0, 100)");
       for (std::size_t i = 0; i < ne; ++i) step[i] = pct / 100 * inputs[i].stddev();
       any_kind = true;
       continue;
@@ -83,7 +84,8 @@ int verb_allocate(const Args& args) {
       "min R >= --min and mean R >= --mean over the poses for every output. With --cost-aware,\n"
       "also the spreads minimising sum w_i/sigma_i under the same targets.\n\nOptions");
   StudyFlags f;
-  std::string limit_text = "two-sided", method_text = "auto", errors_text, save;
+  std::string sens_text = "auto", limit_text = "two-sided", method_text = "auto", errors_text, save,
+              rank = "scaled";
   std::vector<std::string> step_flags, weight_flags;
   double min_target = 0.95, mean_target = 0.97, loosen = 4.0;
   std::size_t choose = 4, max_steps = 100, samples = 1u << 13;
@@ -97,10 +99,15 @@ int verb_allocate(const Args& args) {
       "errors), 0.005/6000rad (all angular errors) or E_C0X=0.005/3000rad; repeatable")(
       "choose", po::value<std::size_t>(&choose)->default_value(choose),
       "errors chosen per output that misses its targets")(
+      "rank", po::value<std::string>(&rank)->default_value("scaled"),
+      "how --choose ranks the errors: scaled (mean |dR/dsigma_i| sigma_i, unit-free) | raw\n"
+      "(mean |dR/dsigma_i| per base unit, mm or rad: the seed's ranking, which favours the\n"
+      "angular errors because a rad is 1000 mm/m)")(
       "errors", po::value<std::string>(&errors_text),
       "explicit comma-separated choice of the errors to tighten (overrides --choose)")(
       "max-steps", po::value<std::size_t>(&max_steps)->default_value(max_steps), "step limit")(
-      "per-output", "tighten at each step only the errors chosen by outputs still missing a target")(
+      "per-output",
+      "tighten at each step only the errors chosen by outputs still missing a target")(
       "cost-aware", "also minimise sum w_i/sigma_i subject to the targets")(
       "weight", po::value<std::vector<std::string>>(&weight_flags)->composing(),
       "NAME=w cost weight of an error, in the unit of its spread (default: its starting\n"
@@ -109,6 +116,9 @@ int verb_allocate(const Args& args) {
       "cost-aware bound: no spread above this factor times its starting value")(
       "save-tolerances", po::value<std::string>(&save),
       "write the step procedure's final spreads as a tolerance file")(
+      "sensitivities", po::value<std::string>(&sens_text)->default_value("auto"),
+      "dR/dmu, dR/dsigma by: auto (sampling for radial, else FORM; analytic when exact) |\n"
+      "form | sampling (importance sampling differentiating its own estimate)")(
       "limit", po::value<std::string>(&limit_text)->default_value(limit_text),
       "two-sided | one-sided | radial")(
       "method", po::value<std::string>(&method_text)->default_value(method_text),
@@ -123,6 +133,7 @@ int verb_allocate(const Args& args) {
     return usage_error("allocate", "--min and --mean must be in (0, 1)");
   if (!(loosen >= 1)) return usage_error("allocate", "--max-loosen must be >= 1");
   const LimitChoice limit = parse_limit(limit_text);
+  const SensitivityChoice sens = parse_sensitivities(sens_text);
   ReliabilityOptions ro;
   ro.method = parse_reliability_method(method_text);
   ro.samples = samples;
@@ -140,7 +151,7 @@ int verb_allocate(const Args& args) {
   std::size_t evaluations = 0;
   prob.evaluate = [&](const std::vector<InputDistribution>& inputs) {
     std::vector<AllocationCase> out;
-    for (auto& c : reliability_sweep(st, inputs, limit, ro, true)) {
+    for (auto& c : reliability_sweep(st, inputs, limit, ro, sens, true)) {
       evaluations += c.result.evaluations;
       out.push_back({c.tolerance, c.result.reliability, c.result.dR_dsigma});
     }
@@ -159,6 +170,31 @@ int verb_allocate(const Args& args) {
       if (i < 0) throw std::invalid_argument("--errors: unknown error \"" + trim(item) + "\"");
       ao.chosen.push_back(static_cast<std::size_t>(i));
     }
+  if (rank != "scaled" && rank != "raw")
+    return usage_error("allocate", "--rank must be scaled or raw, not '" + rank + "'");
+  if (rank == "raw" && ao.chosen.empty()) {
+    // The seed's choice: per output that misses a target, the `choose` errors with the largest
+    // mean |dR/dsigma| in base units.
+    const auto cases = prob.evaluate(st.inputs);
+    for (std::size_t g = 0; g < prob.groups.size(); ++g) {
+      std::vector<double> score(ne, 0.0);
+      double mean = 0, min = 1;
+      std::size_t n = 0;
+      for (const auto& c : cases)
+        if (c.group == g) {
+          for (std::size_t i = 0; i < ne; ++i) score[i] += std::abs(c.dR_dsigma[i]);
+          mean += c.reliability, min = std::min(min, c.reliability), ++n;
+        }
+      if (n == 0 || (min >= min_target && mean / n >= mean_target)) continue;
+      std::vector<std::size_t> idx(ne);
+      for (std::size_t i = 0; i < ne; ++i) idx[i] = i;
+      std::stable_sort(idx.begin(), idx.end(), [&](auto a, auto b) { return score[a] > score[b]; });
+      for (std::size_t k = 0; k < std::min(choose, ne); ++k)
+        if (score[idx[k]] > 0 && ao.step[idx[k]] > 0 &&
+            std::find(ao.chosen.begin(), ao.chosen.end(), idx[k]) == ao.chosen.end())
+          ao.chosen.push_back(idx[k]);
+    }
+  }
   // Default weights: the starting spreads, so that the cost sum sigma0_i / sigma_i is free of
   // units and every error costs 1 at the start (a raw sum of 1/sigma would let the rad-valued
   // errors, ~1e-5, outweigh the mm-valued ones, ~1e-2, by three orders of magnitude).
@@ -166,9 +202,12 @@ int verb_allocate(const Args& args) {
   for (const auto& w : weight_flags) {
     const auto eq = w.find('=');
     const int i = eq == std::string::npos ? -1 : d.error_index(trim(w.substr(0, eq)));
-    if (i < 0) throw std::invalid_argument("--weight: expected NAME=w with a known error, not \"" + w + "\"");
+    if (i < 0)
+      throw std::invalid_argument("--weight: expected NAME=w with a known error, not \"" + w +
+                                  "\"");
     const auto& e = d.errors[i];
-    ao.cost_weights[i] = parse_quantity(w.substr(eq + 1), e.effect == ErrorEffect::Rotation ? "rad" : "mm", "--weight");
+    ao.cost_weights[i] = parse_quantity(
+        w.substr(eq + 1), e.effect == ErrorEffect::Rotation ? "rad" : "mm", "--weight");
     if (!(ao.cost_weights[i] >= 0)) throw std::invalid_argument("--weight: must be >= 0");
   }
   for (std::size_t i = 0; i < ne; ++i) {
@@ -181,8 +220,9 @@ int verb_allocate(const Args& args) {
 
   // ---- stdout: the seed's Tables 5-7 ----
   std::cout << "weilgen allocate: " << st.model->name() << " (order " << st.model->order() << ", "
-            << st.model->origin() << "), " << st.poses.poses.size() << " poses, targets min >= "
-            << 100 * min_target << " %, mean >= " << 100 * mean_target << " %\n";
+            << st.model->origin() << "), " << st.poses.poses.size()
+            << " poses, targets min >= " << 100 * min_target << " %, mean >= " << 100 * mean_target
+            << " %\n";
   std::cout << "chosen errors:";
   for (std::size_t i : res.chosen) std::cout << " " << d.errors[i].name;
   std::cout << "\n\n";
@@ -190,7 +230,8 @@ int verb_allocate(const Args& args) {
   h << std::setw(5) << "step";
   for (std::size_t i : res.chosen)
     h << std::setw(14) << (d.errors[i].name + " (" + d.errors[i].unit + ")");
-  for (const auto& g : prob.groups) h << std::setw(11) << ("mean " + g) << std::setw(10) << ("min " + g);
+  for (const auto& g : prob.groups)
+    h << std::setw(11) << ("mean " + g) << std::setw(10) << ("min " + g);
   std::cout << h.str() << "\n";
   for (const auto& s : res.steps) {
     std::ostringstream line;
@@ -205,15 +246,17 @@ int verb_allocate(const Args& args) {
             << (res.steps.empty() ? 0 : res.steps.back().step) << " steps\n";
   if (!res.note.empty()) std::cout << "note: " << res.note << "\n";
   if (vm.count("cost-aware")) {
-    std::cout << "\ncost-aware (min sum w/sigma): " << (res.cost_aware_met ? "targets met" : "targets NOT met")
-              << ", cost " << std::setprecision(6) << res.cost_aware << " vs step procedure "
-              << res.cost_step << " (" << std::setprecision(3) << std::fixed
+    std::cout << "\ncost-aware (min sum w/sigma): "
+              << (res.cost_aware_met ? "targets met" : "targets NOT met") << ", cost "
+              << std::setprecision(6) << res.cost_aware << " vs step procedure " << res.cost_step
+              << " (" << std::setprecision(3) << std::fixed
               << 100 * (1 - res.cost_aware / res.cost_step) << " % cheaper)\n";
     // Looseness over the errors that move a toleranced output (the others simply go to the
     // --max-loosen bound).
     std::vector<bool> matters(ne, false);
     for (const auto& scores : res.group_scores)
-      for (std::size_t i = 0; i < ne && i < scores.size(); ++i) matters[i] = matters[i] || scores[i] > 0;
+      for (std::size_t i = 0; i < ne && i < scores.size(); ++i)
+        matters[i] = matters[i] || scores[i] > 0;
     double log_ratio = 0;
     std::size_t n_matter = 0;
     for (std::size_t i = 0; i < ne; ++i)
@@ -237,11 +280,11 @@ int verb_allocate(const Args& args) {
     for (std::size_t i = 0; i < ne; ++i) {
       const double s0 = st.inputs[i].stddev(), s1 = res.cost_aware_stddev[i];
       const double sstep = res.steps.back().stddev[i];
-      std::cout << "  " << std::left << std::setw(8) << d.errors[i].name << std::right
-                << " sigma " << std::setw(12) << sigma_text(d.errors[i], s1) << " "
-                << d.errors[i].unit << "  (start " << sigma_text(d.errors[i], s0) << ", steps "
-                << sigma_text(d.errors[i], sstep) << ", x" << std::setprecision(3)
-                << s1 / sstep << " the step result)" << (matters[i] ? "" : ", no effect") << "\n";
+      std::cout << "  " << std::left << std::setw(8) << d.errors[i].name << std::right << " sigma "
+                << std::setw(12) << sigma_text(d.errors[i], s1) << " " << d.errors[i].unit
+                << "  (start " << sigma_text(d.errors[i], s0) << ", steps "
+                << sigma_text(d.errors[i], sstep) << ", x" << std::setprecision(3) << s1 / sstep
+                << " the step result)" << (matters[i] ? "" : ", no effect") << "\n";
     }
     for (std::size_t g = 0; g < prob.groups.size(); ++g)
       std::cout << "  " << prob.groups[g] << ": mean " << 100 * res.cost_aware_group_mean[g]
@@ -251,7 +294,8 @@ int verb_allocate(const Args& args) {
   std::vector<InputDistribution> final_inputs = st.inputs;
   if (!res.steps.empty())
     for (std::size_t i = 0; i < ne; ++i)
-      final_inputs[i] = st.inputs[i].with_mean_stddev(st.inputs[i].mean(), res.steps.back().stddev[i]);
+      final_inputs[i] =
+          st.inputs[i].with_mean_stddev(st.inputs[i].mean(), res.steps.back().stddev[i]);
   if (!save.empty())
     write_tolerance_file(save, d, final_inputs,
                          "weilgen allocate " + d.name + ": spreads after " +
@@ -265,11 +309,13 @@ int verb_allocate(const Args& args) {
       for (std::size_t i = 0; i < ne; ++i) sig[d.errors[i].name] = s.stddev[i];
       for (std::size_t i : s.tightened) tight.push_back(d.errors[i].name);
       for (std::size_t g = 0; g < prob.groups.size(); ++g)
-        groups.push_back({{"output", prob.groups[g]},
-                          {"min", s.group_min[g]},
-                          {"mean", s.group_mean[g]},
-                          {"argmin", pose_json(st.poses, s.group_argmin[g] % st.poses.poses.size())}});
-      steps.push_back({{"step", s.step}, {"stddev", sig}, {"tightened", tight}, {"outputs", groups}});
+        groups.push_back(
+            {{"output", prob.groups[g]},
+             {"min", s.group_min[g]},
+             {"mean", s.group_mean[g]},
+             {"argmin", pose_json(st.poses, s.group_argmin[g] % st.poses.poses.size())}});
+      steps.push_back(
+          {{"step", s.step}, {"stddev", sig}, {"tightened", tight}, {"outputs", groups}});
     }
     nlohmann::json chosen = nlohmann::json::array();
     for (std::size_t i : res.chosen) chosen.push_back(d.errors[i].name);
@@ -277,8 +323,11 @@ int verb_allocate(const Args& args) {
                         {"verb", "allocate"},
                         {"model", model_json(*st.model)},
                         {"settings",
-                         {{"min", min_target}, {"mean", mean_target}, {"limit", limit_text},
-                          {"method", method_text}, {"seed", f.seed}}},
+                         {{"min", min_target},
+                          {"mean", mean_target},
+                          {"limit", limit_text},
+                          {"method", method_text},
+                          {"seed", f.seed}}},
                         {"inputs", inputs_json(*st.model, st.inputs)},
                         {"stddev_unit", "base units: mm for translations, rad for rotations"},
                         {"chosen", chosen},
@@ -288,7 +337,9 @@ int verb_allocate(const Args& args) {
     if (vm.count("cost-aware")) {
       nlohmann::json sig = nlohmann::json::object();
       for (std::size_t i = 0; i < ne; ++i) sig[d.errors[i].name] = res.cost_aware_stddev[i];
-      j["cost_aware"] = {{"met", res.cost_aware_met}, {"stddev", sig}, {"cost", res.cost_aware},
+      j["cost_aware"] = {{"met", res.cost_aware_met},
+                         {"stddev", sig},
+                         {"cost", res.cost_aware},
                          {"cost_step", res.cost_step}};
     }
     write_output(f.json, j.dump(1) + "\n");

@@ -51,10 +51,13 @@ int verb_reliability(const Args& args) {
       "errors), form (HL-RF), is (axis-orthogonal importance sampling at the design points),\n"
       "mc (crude Monte Carlo); auto = exact where it is exact, else is.\n\nOptions");
   StudyFlags f;
-  std::string limit_text = "two-sided", method_text = "auto";
+  std::string sens_text = "auto", limit_text = "two-sided", method_text = "auto";
   std::size_t samples = 1u << 14, top = 5;
   double confidence = 0.95;
   opts.add_options()("help,h", "show this help")(
+      "sensitivities", po::value<std::string>(&sens_text)->default_value("auto"),
+      "dR/dmu, dR/dsigma by: auto (sampling for radial, else FORM; analytic when exact) |\n"
+      "form | sampling (importance sampling differentiating its own estimate)")(
       "limit", po::value<std::string>(&limit_text)->default_value(limit_text),
       "two-sided | one-sided | radial")(
       "method", po::value<std::string>(&method_text)->default_value(method_text),
@@ -62,14 +65,15 @@ int verb_reliability(const Args& args) {
       "samples", po::value<std::size_t>(&samples)->default_value(samples),
       "importance-sampling lines or Monte Carlo samples per pose and output")(
       "confidence", po::value<double>(&confidence)->default_value(confidence),
-      "confidence level of the intervals")(
-      "top", po::value<std::size_t>(&top)->default_value(top),
-      "sensitive errors listed per output");
+      "confidence level of the intervals")("top", po::value<std::size_t>(&top)->default_value(top),
+                                           "sensitive errors listed per output");
   add_study_options(opts, f, true);
   po::variables_map vm;
-  if (auto stop = parse_args<std::string>("reliability", args, opts, "machine", 1, vm)) return *stop;
+  if (auto stop = parse_args<std::string>("reliability", args, opts, "machine", 1, vm))
+    return *stop;
   if (vm.count("machine")) f.machine = vm["machine"].as<std::string>();
   const LimitChoice limit = parse_limit(limit_text);
+  const SensitivityChoice sens = parse_sensitivities(sens_text);
   ReliabilityOptions ro;
   ro.method = parse_reliability_method(method_text);
   ro.samples = samples;
@@ -84,7 +88,7 @@ int verb_reliability(const Args& args) {
   ro.threads = st.threads;
   const Model& model = *st.model;
   const auto& errors = model.description().errors;
-  const auto cases = reliability_sweep(st, st.inputs, limit, ro, f.quiet);
+  const auto cases = reliability_sweep(st, st.inputs, limit, ro, sens, f.quiet);
   const auto sums = summarize(st, cases);
   const std::size_t np = st.poses.poses.size();
 
@@ -96,9 +100,9 @@ int verb_reliability(const Args& args) {
     for (const auto& c : cases)
       if (c.tolerance == k) mine.push_back(&c);
     const ReliabilityResult& first = mine.front()->result;
-    std::cout << "\n" << output_name(tol.output) << ": " << limit_name(limit, tol.output)
-              << ", tolerance " << tol.text << ", method " << to_string(first.method)
-              << " (R in %)\n";
+    std::cout << "\n"
+              << output_name(tol.output) << ": " << limit_name(limit, tol.output) << ", tolerance "
+              << tol.text << ", method " << to_string(first.method) << " (R in %)\n";
     const auto& g = st.poses;
     if (g.grid_axes.size() == 2 && g.grid_size() == np) {
       // A table like the seed's Tables 2-4: rows = first grid axis, columns = second.
@@ -169,8 +173,8 @@ int verb_reliability(const Args& args) {
     }
     for (std::size_t k = 0; k < st.tolerances.size(); ++k) {
       const auto ranked = ranked_sensitivity(cases, k, st.inputs);
-      nlohmann::json sens = nlohmann::json::array();
-      for (const auto& [i, v] : ranked) sens.push_back({{"error", errors[i].name}, {"value", v}});
+      nlohmann::json ranking = nlohmann::json::array();
+      for (const auto& [i, v] : ranked) ranking.push_back({{"error", errors[i].name}, {"value", v}});
       summary.push_back({{"output", output_name(st.tolerances[k].output)},
                          {"limit", limit_name(limit, st.tolerances[k].output)},
                          {"tolerance", st.tolerances[k].value},
@@ -178,7 +182,7 @@ int verb_reliability(const Args& args) {
                          {"min", sums[k].min},
                          {"mean", sums[k].mean},
                          {"argmin", pose_json(st.poses, sums[k].argmin)},
-                         {"sensitivity", sens}});
+                         {"sensitivity", ranking}});
     }
     nlohmann::json j = {{"weilgen", kVersion},
                         {"verb", "reliability"},

@@ -68,7 +68,8 @@ int verb_sensitivity(const Args& args) {
   std::size_t samples = 1u << 14, bootstrap = 200, top = 10;
   double confidence = 0.95;
   opts.add_options()("help,h", "show this help")(
-      "method", po::value<std::string>(&method)->default_value("all"), "local | sobol | exact | all")(
+      "method", po::value<std::string>(&method)->default_value("all"),
+      "local | sobol | exact | all")(
       "outputs", po::value<std::string>(&outputs_text)->default_value(outputs_text),
       "outputs to analyse, comma-separated")(
       "samples", po::value<std::size_t>(&samples)->default_value(samples),
@@ -78,14 +79,16 @@ int verb_sensitivity(const Args& args) {
       "bootstrap", po::value<std::size_t>(&bootstrap)->default_value(bootstrap),
       "bootstrap resamples for the confidence intervals (0 = none)")(
       "confidence", po::value<double>(&confidence)->default_value(confidence),
-      "confidence level of the intervals")(
-      "top", po::value<std::size_t>(&top)->default_value(top), "rows per table on stdout (0 = all)");
+      "confidence level of the intervals")("top", po::value<std::size_t>(&top)->default_value(top),
+                                           "rows per table on stdout (0 = all)");
   add_study_options(opts, f, false);
   po::variables_map vm;
-  if (auto stop = parse_args<std::string>("sensitivity", args, opts, "machine", 1, vm)) return *stop;
+  if (auto stop = parse_args<std::string>("sensitivity", args, opts, "machine", 1, vm))
+    return *stop;
   if (vm.count("machine")) f.machine = vm["machine"].as<std::string>();
   if (method != "local" && method != "sobol" && method != "exact" && method != "all")
-    return usage_error("sensitivity", "--method must be local, sobol, exact or all, not '" + method + "'");
+    return usage_error("sensitivity",
+                       "--method must be local, sobol, exact or all, not '" + method + "'");
   if (sampling != "qmc" && sampling != "mc")
     return usage_error("sensitivity", "--sampling must be qmc or mc, not '" + sampling + "'");
   if (!(confidence > 0 && confidence < 1))
@@ -216,19 +219,24 @@ int verb_sensitivity(const Args& args) {
       };
       std::stable_sort(order.begin(), order.end(),
                        [&](std::size_t a, std::size_t b) { return key(a) > key(b); });
-      std::cout << "\n" << output_name(out) << " ("
-                << (per_pose ? pose_label(st.poses, g) : "mean over " + std::to_string(np) + " poses")
+      std::cout << "\n"
+                << output_name(out) << " ("
+                << (per_pose ? pose_label(st.poses, g)
+                             : "mean over " + std::to_string(np) + " poses")
                 << "), standard deviation " << std::setprecision(4) << sd_mean * sc << " "
                 << display_unit(out) << "\n";
       std::ostringstream h;
       h << std::left << std::setw(10) << "error" << std::right;
       if (do_local && out != OutputId::Dp)
-        h << std::setw(14) << "coefficient" << std::setw(12) << std::string("|c|s ") + display_unit(out);
+        h << std::setw(14) << "coefficient" << std::setw(12)
+          << std::string("|c|s ") + display_unit(out);
       if (do_exact && out != OutputId::Dp) h << std::setw(9) << "S_exact";
       if (do_sobol) {
         h << std::setw(9) << "S" << (per_pose ? "  CI              " : "") << std::setw(9) << "ST";
-        if (per_pose) h << "  CI";
-        else h << std::setw(9) << "ST max";
+        if (per_pose)
+          h << "  CI";
+        else
+          h << std::setw(9) << "ST max";
       }
       std::cout << h.str() << "\n";
       const std::size_t rows = top == 0 ? ne : std::min(top, ne);
@@ -245,8 +253,10 @@ int verb_sensitivity(const Args& args) {
           if (per_pose)
             line << "  [" << std::setw(7) << slo[i] << "," << std::setw(7) << shi[i] << "]";
           line << std::setw(9) << ST[i];
-          if (per_pose) line << "  [" << std::setw(7) << tlo[i] << "," << std::setw(7) << thi[i] << "]";
-          else line << std::setw(9) << STmax[i];
+          if (per_pose)
+            line << "  [" << std::setw(7) << tlo[i] << "," << std::setw(7) << thi[i] << "]";
+          else
+            line << std::setw(9) << STmax[i];
         }
         std::cout << line.str() << "\n";
       }
@@ -321,7 +331,8 @@ int verb_sensitivity(const Args& args) {
     for (std::size_t o = 0; o < no; ++o) {
       BarChart b;
       b.title = std::string(output_name(outputs[o])) +
-                (np > 1 ? " (mean over " + std::to_string(np) + " poses)" : " (" + pose_label(st.poses, 0) + ")");
+                (np > 1 ? " (mean over " + std::to_string(np) + " poses)"
+                        : " (" + pose_label(st.poses, 0) + ")");
       b.ylabel = "index";
       for (const auto& e : errors) b.categories.push_back(e.name);
       BarSeries s{"S", {}, {}, {}}, t{"ST", {}, {}, {}}, x{"S exact", {}, {}, {}};
