@@ -57,14 +57,17 @@ int main(int argc, char** argv) {
   bool quick = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--quick") quick = true;
-    else weilgen = a;
+    if (a == "--quick")
+      quick = true;
+    else
+      weilgen = a;
   }
   const std::string tmp = "/tmp/weilgen_bench_analysis.json";
   const char* grids[3][2] = {{"dx", "X=0,Y=-1500:1500:5,Z=600:1400:5"},
                              {"dy", "X=0:1000:5,Y=0,Z=600:1400:5"},
-                             {"dz", "X=0:1000:5,Y=-1500:1500:5,Z=0"}};
-  std::cout << "| run | engine | wall s | model evaluations | evaluations/s |\n|---|---|---|---|---|\n";
+                             {"dz", "X=0:1000:5,Y=-1500:1500:5,Z=600"}};
+  std::cout
+      << "| run | engine | wall s | model evaluations | evaluations/s |\n|---|---|---|---|---|\n";
   const std::string sobol = "sensitivity gantry_grinder --at X=500,Y=750,Z=1000 --method sobol ";
   std::cout << row("Sobol N=2^16, 1 pose", "built-in",
                    run(weilgen, sobol + "--samples 65536", tmp, false))

@@ -174,7 +174,8 @@ int verb_reliability(const Args& args) {
     for (std::size_t k = 0; k < st.tolerances.size(); ++k) {
       const auto ranked = ranked_sensitivity(cases, k, st.inputs);
       nlohmann::json ranking = nlohmann::json::array();
-      for (const auto& [i, v] : ranked) ranking.push_back({{"error", errors[i].name}, {"value", v}});
+      for (const auto& [i, v] : ranked)
+        ranking.push_back({{"error", errors[i].name}, {"value", v}});
       summary.push_back({{"output", output_name(st.tolerances[k].output)},
                          {"limit", limit_name(limit, st.tolerances[k].output)},
                          {"tolerance", st.tolerances[k].value},

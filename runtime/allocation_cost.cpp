@@ -167,7 +167,13 @@ AllocationResult allocate_cost_aware(const AllocationProblem& problem,
   double fmin = 0;
   try {
     const nlopt::result r = opt.optimize(y, fmin);
-    append(res.note, "cost-aware: SLSQP ended with code " + std::to_string(static_cast<int>(r)));
+    // NLopt's positive codes are successes: 1 success, 2 stopval, 3 ftol, 4 xtol reached.
+    append(res.note, "cost-aware: SLSQP converged (NLopt result " +
+                         std::to_string(static_cast<int>(r)) +
+                         (r == nlopt::FTOL_REACHED      ? ", ftol reached)"
+                          : r == nlopt::XTOL_REACHED    ? ", xtol reached)"
+                          : r == nlopt::MAXEVAL_REACHED ? ", evaluation limit reached)"
+                                                        : ")"));
   } catch (const nlopt::forced_stop&) {
     if (cp.error) std::rethrow_exception(cp.error);
     append(res.note, "cost-aware: SLSQP was stopped");

@@ -66,8 +66,10 @@ InputDistribution InputDistribution::truncated_normal(double mu, double sigma, d
 
 double InputDistribution::mean() const {
   switch (kind_) {
-    case Kind::Normal: return a_;
-    case Kind::Uniform: return 0.5 * (lo_ + hi_);
+    case Kind::Normal:
+      return a_;
+    case Kind::Uniform:
+      return 0.5 * (lo_ + hi_);
     case Kind::TruncatedNormal:
       if (b_ == 0) return a_;
       return a_ + b_ * (normal_pdf(z_lo_) - normal_pdf(z_hi_)) / mass_;
@@ -77,8 +79,10 @@ double InputDistribution::mean() const {
 
 double InputDistribution::stddev() const {
   switch (kind_) {
-    case Kind::Normal: return b_;
-    case Kind::Uniform: return (hi_ - lo_) / std::sqrt(12.0);
+    case Kind::Normal:
+      return b_;
+    case Kind::Uniform:
+      return (hi_ - lo_) / std::sqrt(12.0);
     case Kind::TruncatedNormal: {
       if (b_ == 0) return 0;
       const double pl = normal_pdf(z_lo_), ph = normal_pdf(z_hi_);
@@ -93,8 +97,10 @@ double InputDistribution::stddev() const {
 
 double InputDistribution::pdf(double x) const {
   switch (kind_) {
-    case Kind::Normal: return b_ > 0 ? normal_pdf((x - a_) / b_) / b_ : 0.0;
-    case Kind::Uniform: return (hi_ > lo_ && x >= lo_ && x <= hi_) ? 1 / (hi_ - lo_) : 0.0;
+    case Kind::Normal:
+      return b_ > 0 ? normal_pdf((x - a_) / b_) / b_ : 0.0;
+    case Kind::Uniform:
+      return (hi_ > lo_ && x >= lo_ && x <= hi_) ? 1 / (hi_ - lo_) : 0.0;
     case Kind::TruncatedNormal:
       if (b_ == 0 || x < lo_ || x > hi_) return 0.0;
       return normal_pdf((x - a_) / b_) / (b_ * mass_);
@@ -104,7 +110,8 @@ double InputDistribution::pdf(double x) const {
 
 double InputDistribution::cdf(double x) const {
   switch (kind_) {
-    case Kind::Normal: return b_ > 0 ? normal_cdf((x - a_) / b_) : (x >= a_ ? 1.0 : 0.0);
+    case Kind::Normal:
+      return b_ > 0 ? normal_cdf((x - a_) / b_) : (x >= a_ ? 1.0 : 0.0);
     case Kind::Uniform:
       if (x >= hi_) return 1.0;
       if (x < lo_) return 0.0;
@@ -121,8 +128,10 @@ double InputDistribution::cdf(double x) const {
 double InputDistribution::quantile(double p) const {
   if (is_constant()) return mean();
   switch (kind_) {
-    case Kind::Normal: return a_ + b_ * normal_quantile(p);
-    case Kind::Uniform: return lo_ + (hi_ - lo_) * std::min(1.0, std::max(0.0, p));
+    case Kind::Normal:
+      return a_ + b_ * normal_quantile(p);
+    case Kind::Uniform:
+      return lo_ + (hi_ - lo_) * std::min(1.0, std::max(0.0, p));
     case Kind::TruncatedNormal: {
       const double q = normal_cdf(z_lo_) + std::min(1.0, std::max(0.0, p)) * mass_;
       return std::min(hi_, std::max(lo_, a_ + b_ * normal_quantile(q)));
@@ -164,7 +173,8 @@ InputDistribution InputDistribution::with_mean_stddev(double mean_new, double sd
   if (sd_new < 0) throw std::invalid_argument("standard deviation must be >= 0");
   const double sd = stddev(), m = mean();
   switch (kind_) {
-    case Kind::Normal: return normal(mean_new, sd_new);
+    case Kind::Normal:
+      return normal(mean_new, sd_new);
     case Kind::Uniform: {
       const double h = sd_new * std::sqrt(3.0);
       return uniform(mean_new - h, mean_new + h);
@@ -188,8 +198,10 @@ InputDistribution InputDistribution::scaled(double f) const {
 
 std::string InputDistribution::str() const {
   switch (kind_) {
-    case Kind::Normal: return "normal(" + number(a_) + ", " + number(b_) + ")";
-    case Kind::Uniform: return "uniform(" + number(lo_) + ", " + number(hi_) + ")";
+    case Kind::Normal:
+      return "normal(" + number(a_) + ", " + number(b_) + ")";
+    case Kind::Uniform:
+      return "uniform(" + number(lo_) + ", " + number(hi_) + ")";
     case Kind::TruncatedNormal:
       return "truncnormal(" + number(a_) + ", " + number(b_) + ", " + number(lo_) + ", " +
              number(hi_) + ")";

@@ -17,9 +17,12 @@ std::vector<double> default_parameters(const Description& desc) {
 
 const char* engine_name(ModelEngine engine) {
   switch (engine) {
-    case ModelEngine::BuiltIn: return "built-in";
-    case ModelEngine::Compiled: return "compiled";
-    case ModelEngine::NumericChain: return "numeric chain";
+    case ModelEngine::BuiltIn:
+      return "built-in";
+    case ModelEngine::Compiled:
+      return "compiled";
+    case ModelEngine::NumericChain:
+      return "numeric chain";
   }
   return "";
 }

@@ -30,40 +30,40 @@ struct WeilgenModelAbi {
 
 inline constexpr int kWeilgenModelAbiVersion = 1;
 
-#define WEILGEN_DEFINE_MODEL_ABI(ns, var)                                                   \
-  namespace var##_impl {                                                                    \
-  inline void deviation(const double* axes, const double* errors, const double* params,     \
-                        double* position, double* orientation) {                            \
-    std::array<double, ns::kNumAxes> a{};                                                   \
-    std::array<double, ns::kNumErrors> e{};                                                 \
-    std::array<double, ns::kNumParams> p{};                                                 \
-    std::copy_n(axes, ns::kNumAxes, a.begin());                                             \
-    std::copy_n(errors, ns::kNumErrors, e.begin());                                         \
-    std::copy_n(params, ns::kNumParams, p.begin());                                         \
-    std::array<double, 3> pos{}, ori{};                                                     \
-    ns::Deviation<double>(a, e, p, position ? &pos : nullptr, orientation ? &ori : nullptr); \
-    if (position) std::copy_n(pos.begin(), 3, position);                                    \
-    if (orientation) std::copy_n(ori.begin(), 3, orientation);                              \
-  }                                                                                         \
-  inline void coefficients(const double* axes, const double* params, double* position_coeff, \
-                           double* orientation_coeff) {                                     \
-    std::array<double, ns::kNumAxes> a{};                                                   \
-    std::array<double, ns::kNumParams> p{};                                                 \
-    std::copy_n(axes, ns::kNumAxes, a.begin());                                             \
-    std::copy_n(params, ns::kNumParams, p.begin());                                         \
-    std::array<double, 3 * ns::kNumErrors> pc{}, oc{};                                      \
-    ns::Coefficients<double>(a, p, position_coeff ? &pc : nullptr,                          \
-                             orientation_coeff ? &oc : nullptr);                            \
-    if (position_coeff) std::copy_n(pc.begin(), pc.size(), position_coeff);                 \
-    if (orientation_coeff) std::copy_n(oc.begin(), oc.size(), orientation_coeff);           \
-  }                                                                                         \
-  }                                                                                         \
-  const WeilgenModelAbi var = {kWeilgenModelAbiVersion,                                     \
-                               ns::kOrder,                                                  \
-                               ns::kMachineName,                                            \
-                               ns::kModelKey,                                               \
-                               ns::kNumAxes,                                                \
-                               ns::kNumErrors,                                              \
-                               ns::kNumParams,                                              \
-                               &var##_impl::deviation,                                      \
+#define WEILGEN_DEFINE_MODEL_ABI(ns, var)                                                      \
+  namespace var##_impl {                                                                       \
+    inline void deviation(const double* axes, const double* errors, const double* params,      \
+                          double* position, double* orientation) {                             \
+      std::array<double, ns::kNumAxes> a{};                                                    \
+      std::array<double, ns::kNumErrors> e{};                                                  \
+      std::array<double, ns::kNumParams> p{};                                                  \
+      std::copy_n(axes, ns::kNumAxes, a.begin());                                              \
+      std::copy_n(errors, ns::kNumErrors, e.begin());                                          \
+      std::copy_n(params, ns::kNumParams, p.begin());                                          \
+      std::array<double, 3> pos{}, ori{};                                                      \
+      ns::Deviation<double>(a, e, p, position ? &pos : nullptr, orientation ? &ori : nullptr); \
+      if (position) std::copy_n(pos.begin(), 3, position);                                     \
+      if (orientation) std::copy_n(ori.begin(), 3, orientation);                               \
+    }                                                                                          \
+    inline void coefficients(const double* axes, const double* params, double* position_coeff, \
+                             double* orientation_coeff) {                                      \
+      std::array<double, ns::kNumAxes> a{};                                                    \
+      std::array<double, ns::kNumParams> p{};                                                  \
+      std::copy_n(axes, ns::kNumAxes, a.begin());                                              \
+      std::copy_n(params, ns::kNumParams, p.begin());                                          \
+      std::array<double, 3 * ns::kNumErrors> pc{}, oc{};                                       \
+      ns::Coefficients<double>(a, p, position_coeff ? &pc : nullptr,                           \
+                               orientation_coeff ? &oc : nullptr);                             \
+      if (position_coeff) std::copy_n(pc.begin(), pc.size(), position_coeff);                  \
+      if (orientation_coeff) std::copy_n(oc.begin(), oc.size(), orientation_coeff);            \
+    }                                                                                          \
+  }                                                                                            \
+  const WeilgenModelAbi var = {kWeilgenModelAbiVersion,                                        \
+                               ns::kOrder,                                                     \
+                               ns::kMachineName,                                               \
+                               ns::kModelKey,                                                  \
+                               ns::kNumAxes,                                                   \
+                               ns::kNumErrors,                                                 \
+                               ns::kNumParams,                                                 \
+                               &var##_impl::deviation,                                         \
                                &var##_impl::coefficients};

@@ -13,8 +13,7 @@
 namespace weilgen {
 
 // 64-bit FNV-1a: a stable, platform-independent hash (not cryptographic; a cache key only).
-inline std::uint64_t fnv1a64(const std::string& bytes,
-                             std::uint64_t seed = 0xcbf29ce484222325ULL) {
+inline std::uint64_t fnv1a64(const std::string& bytes, std::uint64_t seed = 0xcbf29ce484222325ULL) {
   std::uint64_t h = seed;
   for (const unsigned char c : bytes) {
     h ^= c;
@@ -31,8 +30,8 @@ inline std::string hex64(std::uint64_t v) {
 
 // 16 hex digits from the machine file's text hash, the order and the weilgen version.
 inline std::string model_key(std::uint64_t source_hash, int order) {
-  return hex64(fnv1a64(hex64(source_hash) + "|order=" + std::to_string(order) +
-                       "|weilgen=" + kVersion));
+  return hex64(
+      fnv1a64(hex64(source_hash) + "|order=" + std::to_string(order) + "|weilgen=" + kVersion));
 }
 
 }  // namespace weilgen

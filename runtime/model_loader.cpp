@@ -41,7 +41,7 @@ std::string shell_quote(const std::string& s) {
 }
 
 std::shared_ptr<Model> open_shared_object(const Description& desc, const std::string& path,
-                                                const std::string& key, const std::string& how) {
+                                          const std::string& key, const std::string& how) {
   void* handle = ::dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (!handle) throw std::runtime_error("cannot load " + path + ": " + ::dlerror());
   std::shared_ptr<void> keep(handle, [](void* h) { ::dlclose(h); });
@@ -58,15 +58,13 @@ std::shared_ptr<Model> open_shared_object(const Description& desc, const std::st
 std::string compile_model(const Description& desc, int order, const std::string& key,
                           const std::string& compiler, const std::string& cache,
                           const LoadOptions& options) {
-  if (!options.generate)
-    throw std::runtime_error("no generator available to compile " + desc.name);
+  if (!options.generate) throw std::runtime_error("no generator available to compile " + desc.name);
   const auto t0 = std::chrono::steady_clock::now();
   const GeneratedHeader header = options.generate(desc, order);
   std::error_code ec;
   fs::create_directories(cache, ec);
   if (ec) throw std::runtime_error("cannot create the model cache " + cache + ": " + ec.message());
-  const fs::path work =
-      fs::path(cache) / ("build-" + key + "-" + std::to_string(::getpid()));
+  const fs::path work = fs::path(cache) / ("build-" + key + "-" + std::to_string(::getpid()));
   fs::create_directories(work, ec);
   if (ec) throw std::runtime_error("cannot create " + work.string() + ": " + ec.message());
   struct Cleanup {
@@ -93,13 +91,12 @@ std::string compile_model(const Description& desc, int order, const std::string&
             "weilgen_model_abi() {\n  return &weilgen_model_abi_instance;\n}\n");
   const fs::path so_tmp = work / "model.so";
   const fs::path log = work / "compile.log";
-  const std::string cmd = compiler + " -std=c++17 -O2 -fPIC -shared -o " +
-                          shell_quote(so_tmp.string()) + " " +
-                          shell_quote((work / "shim.cpp").string()) + " > " +
-                          shell_quote(log.string()) + " 2>&1";
+  const std::string cmd =
+      compiler + " -std=c++17 -O2 -fPIC -shared -o " + shell_quote(so_tmp.string()) + " " +
+      shell_quote((work / "shim.cpp").string()) + " > " + shell_quote(log.string()) + " 2>&1";
   if (options.log)
-    options.log("compiling model " + desc.name + " (order " + std::to_string(order) +
-                ") with " + compiler + " ...");
+    options.log("compiling model " + desc.name + " (order " + std::to_string(order) + ") with " +
+                compiler + " ...");
   const int status = std::system(cmd.c_str());
   if (status != 0) {
     std::string text;
@@ -112,8 +109,7 @@ std::string compile_model(const Description& desc, int order, const std::string&
   fs::rename(so_tmp, target, ec);  // atomic: concurrent runs never see a partial object
   if (ec) throw std::runtime_error("cannot move the compiled model to " + target.string());
   if (options.log) {
-    const double s =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::ostringstream msg;
     msg.precision(2);
     msg << std::fixed << "compiled " << desc.name << " in " << s << " s -> " << target.string();

@@ -28,9 +28,9 @@ void parallel_blocks(std::size_t n, std::size_t block_size, unsigned threads, Bo
   if (n == 0) return;
   block_size = std::max<std::size_t>(1, block_size);
   const std::size_t blocks = (n + block_size - 1) / block_size;
-  threads = std::max(1u, std::min<unsigned>(resolve_threads(threads),
-                                            static_cast<unsigned>(std::min<std::size_t>(
-                                                blocks, 1u << 16))));
+  threads = std::max(
+      1u, std::min<unsigned>(resolve_threads(threads),
+                             static_cast<unsigned>(std::min<std::size_t>(blocks, 1u << 16))));
   std::atomic<std::size_t> next{0};
   std::exception_ptr error;
   std::mutex error_mutex;

@@ -9,3 +9,9 @@ build/weilgen generate gantry_grinder --out generated
 echo
 echo "Closed-form volumetric error of gantry_grinder (dx dy dz in mm, da db dc in rad):"
 build/weilgen show gantry_grinder
+echo
+echo "Sobol' sensitivity of dx at X=500, Y=750, Z=1000 (mm):"
+build/weilgen sensitivity gantry_grinder --at X=500,Y=750,Z=1000 --outputs dx --top 8
+echo
+echo "Machining-accuracy reliability of dx over the seed's grid, tolerance 0.03 mm:"
+build/weilgen reliability gantry_grinder --grid X=0,Y=-1500:1500:5,Z=600:1400:5 --tolerance dx=0.03mm

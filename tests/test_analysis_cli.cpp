@@ -6,16 +6,17 @@
 #include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <set>
 
 #include "atomic_file.hpp"
 #include "distribution.hpp"
 #include "test_support.hpp"
 
 using namespace weilgen;
+using nlohmann::json;
 using test::cli;
 using test::run;
 using test::Run;
-using nlohmann::json;
 
 namespace {
 
@@ -28,13 +29,12 @@ json read_json(const std::string& path) {
 // Table 1 of the grinder seed (standard deviations; mm and rad).
 double grinder_sigma(const std::string& e) {
   static const std::map<std::string, double> s = {
-      {"E_XX", 0.05 / 6},     {"E_YX", 0.05 / 6},     {"E_ZX", 0.05 / 6},
-      {"E_AX", 0.03 / 6000},  {"E_BX", 0.06 / 6000},  {"E_CX", 0.05 / 6000},
-      {"E_XY", 0.04 / 6},     {"E_YY", 0.05 / 6},     {"E_ZY", 0.04 / 6},
-      {"E_AY", 0.05 / 6000},  {"E_BY", 0.04 / 6000},  {"E_CY", 0.04 / 6000},
-      {"E_XZ", 0.03 / 6},     {"E_YZ", 0.03 / 6},     {"E_ZZ", 0.05 / 6},
-      {"E_AZ", 0.03 / 6000},  {"E_BZ", 0.04 / 6000},  {"E_CZ", 0.03 / 6000},
-      {"E_C0X", 0.03 / 3000}, {"E_B0Z", 0.03 / 3000}, {"E_A0Z", 0.02 / 3000}};
+      {"E_XX", 0.05 / 6},    {"E_YX", 0.05 / 6},    {"E_ZX", 0.05 / 6},     {"E_AX", 0.03 / 6000},
+      {"E_BX", 0.06 / 6000}, {"E_CX", 0.05 / 6000}, {"E_XY", 0.04 / 6},     {"E_YY", 0.05 / 6},
+      {"E_ZY", 0.04 / 6},    {"E_AY", 0.05 / 6000}, {"E_BY", 0.04 / 6000},  {"E_CY", 0.04 / 6000},
+      {"E_XZ", 0.03 / 6},    {"E_YZ", 0.03 / 6},    {"E_ZZ", 0.05 / 6},     {"E_AZ", 0.03 / 6000},
+      {"E_BZ", 0.04 / 6000}, {"E_CZ", 0.03 / 6000}, {"E_C0X", 0.03 / 3000}, {"E_B0Z", 0.03 / 3000},
+      {"E_A0Z", 0.02 / 3000}};
   return s.at(e);
 }
 
@@ -50,8 +50,10 @@ std::map<std::string, double> grinder_dx_coefficients(double y, double z) {
 TEST_CASE("sensitivity CLI: coefficients, exact indices and QMC indices on the grinder") {
   const auto dir = test::fresh_dir("cli_sensitivity");
   const std::string out = (dir / "s.json").string();
-  const Run r = run(cli("sensitivity gantry_grinder --at X=0,Y=750,Z=1000 --at X=500,Y=-1500,Z=600 "
-                        "--outputs dx,dy,dp --samples 4096 --bootstrap 100 --quiet --json " + out));
+  const Run r =
+      run(cli("sensitivity gantry_grinder --at X=0,Y=750,Z=1000 --at X=500,Y=-1500,Z=600 "
+              "--outputs dx,dy,dp --samples 4096 --bootstrap 100 --quiet --json " +
+              out));
   REQUIRE(r.status == 0);
   CHECK(r.out.find("E_BX") != std::string::npos);
   const json j = read_json(out);
@@ -62,8 +64,8 @@ TEST_CASE("sensitivity CLI: coefficients, exact indices and QMC indices on the g
   std::size_t inside = 0, compared = 0;
   double sum_exact = 0;
   for (const auto& rec : j["results"]) {
-    for (const char* key : {"pose", "output", "error", "coefficient", "S", "S_ci", "ST", "ST_ci",
-                            "S_exact"})
+    for (const char* key :
+         {"pose", "output", "error", "coefficient", "S", "S_ci", "ST", "ST_ci", "S_exact"})
       REQUIRE(rec.contains(key));
     const double y = rec["pose"]["Y"], z = rec["pose"]["Z"];
     const std::string e = rec["error"], o = rec["output"];
@@ -119,7 +121,8 @@ TEST_CASE("reliability CLI: exact one-sided reliability of the grinder equals th
   const auto dir = test::fresh_dir("cli_reliability");
   const std::string out = (dir / "r.json").string();
   REQUIRE(run(cli("reliability gantry_grinder --grid X=0,Y=-1500:1500:5,Z=600:1400:5 "
-                  "--tolerance dx=0.03mm --limit one-sided --quiet --json " + out))
+                  "--tolerance dx=0.03mm --limit one-sided --quiet --json " +
+                  out))
               .status == 0);
   const json j = read_json(out);
   REQUIRE(j["results"].size() == 25);
@@ -137,8 +140,7 @@ TEST_CASE("reliability CLI: exact one-sided reliability of the grinder equals th
     // dR/dsigma_BX = phi(t/s) * (-t/s^2) * c^2 sigma / s.
     const double c = -z, sg = grinder_sigma("E_BX");
     CHECK(rec["dR_dsigma"]["E_BX"].get<double>() ==
-          doctest::Approx(normal_pdf(0.03 / s) * (-0.03 / (s * s)) * c * c * sg / s)
-              .epsilon(1e-9));
+          doctest::Approx(normal_pdf(0.03 / s) * (-0.03 / (s * s)) * c * c * sg / s).epsilon(1e-9));
     CHECK(rec["dR_dmu"]["E_BX"].get<double>() ==
           doctest::Approx(-normal_pdf(0.03 / s) * c / s).epsilon(1e-9));
     min = std::min(min, expect);
@@ -157,7 +159,8 @@ TEST_CASE("reliability CLI: every method agrees on a linear two-sided limit") {
   for (const char* m : {"exact", "form", "is", "mc"}) {
     const std::string out = (dir / (std::string(m) + ".json")).string();
     REQUIRE(run(cli(std::string("reliability gantry_grinder --at X=250,Y=750,Z=1200 --tolerance "
-                                "dy=25um --samples 200000 --quiet --method ") + m + " --json " + out))
+                                "dy=25um --samples 200000 --quiet --method ") +
+                    m + " --json " + out))
                 .status == 0);
     res[m] = read_json(out)["results"][0];
   }
@@ -172,9 +175,7 @@ TEST_CASE("reliability CLI: every method agrees on a linear two-sided limit") {
 TEST_CASE("analysis CLI: bad arguments give one clear line, exit 2 and leave outputs untouched") {
   const auto dir = test::fresh_dir("cli_bad_args");
   const std::string out = (dir / "keep.json").string();
-  {
-    std::ofstream(out) << "previous";
-  }
+  { std::ofstream(out) << "previous"; }
   struct Case {
     std::string args, message;
   };
@@ -187,10 +188,8 @@ TEST_CASE("analysis CLI: bad arguments give one clear line, exit 2 and leave out
       {"reliability gantry_grinder --at X=0,Y=0,Z=600 --tolerance dx=0mm", "dx"},
       {"reliability gantry_grinder --at X=0,Y=0,Z=600 --tolerance dx=-1um", "dx"},
       {"reliability gantry_grinder --at X=0,Y=0,Z=600", "--tolerance"},
-      {"reliability gantry_grinder --at X=0,Y=0,Z=600 --tolerance dx=1um --limit radial",
-       "radial"},
-      {"reliability gantry_grinder --at X=0,Y=0,Z=600 --tolerance dx=1um --method magic",
-       "magic"},
+      {"reliability gantry_grinder --at X=0,Y=0,Z=600 --tolerance dx=1um --limit radial", "radial"},
+      {"reliability gantry_grinder --at X=0,Y=0,Z=600 --tolerance dx=1um --method magic", "magic"},
       {"reliability gantry_grinder --at W=3 --tolerance dx=1um", "W"},
   };
   for (const auto& c : cases) {
@@ -210,12 +209,10 @@ TEST_CASE("analysis CLI: a machine that is not built in is compiled at run time 
   std::string text;
   REQUIRE(read_file(test::machine_path("two_axis"), text));
   const std::string machine = (dir / "two_axis_long_tool.yaml").string();
-  {
-    std::ofstream(machine) << text << "\n# a user's copy\n";
-  }
+  { std::ofstream(machine) << text << "\n# a user's copy\n"; }
   const std::string env = "WEILGEN_CACHE_DIR=" + (dir / "cache").string() + " ";
-  const std::string args = "sensitivity " + machine +
-                           " --at Y=100,A=30 --method local --param tool_length=250 --json ";
+  const std::string args =
+      "sensitivity " + machine + " --at Y=100,A=30 --method local --param tool_length=250 --json ";
   const Run first = run(env + cli(args + (dir / "c.json").string()));
   REQUIRE(first.status == 0);
   CHECK(first.out.find("compiling model two_axis") != std::string::npos);
@@ -244,12 +241,52 @@ TEST_CASE("analysis CLI: --plot draws PNG and SVG through gnuplot") {
   const auto dir = test::fresh_dir("cli_plot");
   const std::string png = (dir / "s.png").string(), svg = (dir / "r.svg").string();
   REQUIRE(run(cli("sensitivity gantry_grinder --at X=0,Y=750,Z=1000 --outputs dx,dy --samples "
-                  "1024 --quiet --plot " + png)).status == 0);
+                  "1024 --quiet --plot " +
+                  png))
+              .status == 0);
   REQUIRE(run(cli("reliability gantry_grinder --grid X=0,Y=-1500:1500:5,Z=600:1400:5 "
-                  "--tolerance dx=0.03mm --quiet --plot " + svg)).status == 0);
+                  "--tolerance dx=0.03mm --quiet --plot " +
+                  svg))
+              .status == 0);
   std::string p, s;
   REQUIRE(read_file(png, p));
   REQUIRE(read_file(svg, s));
   CHECK(p.substr(0, 8) == std::string("\x89PNG\r\n\x1a\n", 8));
   CHECK(s.find("<svg") != std::string::npos);
+}
+
+TEST_CASE("allocate CLI: the seed's x-direction procedure, and its saved tolerances read back") {
+  const auto dir = test::fresh_dir("cli_allocate");
+  const std::string json_path = (dir / "a.json").string(), tol = (dir / "tol.yaml").string();
+  const std::string grid =
+      "--grid X=0,Y=-1500:1500:5,Z=600:1400:5 --tolerance dx=0.03mm "
+      "--limit one-sided ";
+  const Run r = run(cli("allocate gantry_grinder " + grid +
+                        "--step 0.005/6mm --step 0.005/6000rad --step E_C0X=0.005/3000rad "
+                        "--rank raw --cost-aware --quiet --json " +
+                        json_path + " --save-tolerances " + tol));
+  REQUIRE(r.status == 0);
+  const json j = read_json(json_path);
+  // The raw (per-unit) ranking picks exactly the seed's errors: eps_yx, eps_zx, eps_zz, S_xy.
+  std::set<std::string> chosen;
+  for (const auto& e : j["chosen"]) chosen.insert(e.get<std::string>());
+  CHECK(chosen == std::set<std::string>{"E_BX", "E_CX", "E_CZ", "E_C0X"});
+  REQUIRE(j["steps"].size() == 5);  // start + 4 steps
+  const json& last = j["steps"][4];
+  CHECK(last["stddev"]["E_BX"].get<double>() == doctest::Approx(0.04 / 6000).epsilon(1e-12));
+  CHECK(last["stddev"]["E_C0X"].get<double>() == doctest::Approx(0.01 / 3000).epsilon(1e-12));
+  CHECK(last["stddev"]["E_XX"].get<double>() == doctest::Approx(0.05 / 6).epsilon(1e-12));
+  CHECK(last["outputs"][0]["min"].get<double>() >= 0.95);
+  CHECK(last["outputs"][0]["mean"].get<double>() >= 0.97);
+  CHECK(j["steps"][3]["outputs"][0]["min"].get<double>() < 0.95);  // 3 steps were not enough
+  CHECK(j["cost_aware"]["met"] == true);
+  CHECK(j["cost_aware"]["cost"].get<double>() < j["cost_aware"]["cost_step"].get<double>());
+  // The saved tolerances reproduce the final step's reliability.
+  const std::string rj = (dir / "r.json").string();
+  REQUIRE(run(cli("reliability gantry_grinder " + grid + "--tolerances " + tol +
+                  " --quiet --json " + rj))
+              .status == 0);
+  const json rel = read_json(rj);
+  CHECK(rel["summary"][0]["min"].get<double>() ==
+        doctest::Approx(last["outputs"][0]["min"].get<double>()).epsilon(1e-9));
 }
