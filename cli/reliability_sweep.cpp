@@ -24,6 +24,36 @@ SensitivityChoice parse_sensitivities(const std::string& text) {
   throw std::invalid_argument("--sensitivities must be auto, form or sampling, not '" + text + "'");
 }
 
+void add_reliability_options(boost::program_options::options_description& opts,
+                             ReliabilityFlags& f) {
+  namespace po = boost::program_options;
+  po::options_description r("Reliability");
+  r.add_options()("limit", po::value<std::string>(&f.limit)->default_value(f.limit),
+                  "two-sided | one-sided | radial")(
+      "method", po::value<std::string>(&f.method)->default_value(f.method),
+      "auto | exact | form | is | mc")(
+      "samples", po::value<std::size_t>(&f.samples)->default_value(f.samples),
+      "importance-sampling lines or Monte Carlo samples per pose and output")(
+      "confidence", po::value<double>(&f.confidence)->default_value(f.confidence),
+      "confidence level of the intervals")(
+      "sensitivities", po::value<std::string>(&f.sensitivities)->default_value(f.sensitivities),
+      "dR/dmu, dR/dsigma by: auto (sampling for radial, else FORM; analytic when exact) |\n"
+      "form | sampling (importance sampling differentiating its own estimate)");
+  opts.add(r);
+}
+
+ReliabilitySettings parse_reliability_flags(const ReliabilityFlags& f, std::uint64_t seed) {
+  if (f.samples == 0) throw std::invalid_argument("--samples must be >= 1");
+  if (!(f.confidence > 0 && f.confidence < 1))
+    throw std::invalid_argument("--confidence must be in (0, 1)");
+  ReliabilitySettings s{parse_limit(f.limit), parse_sensitivities(f.sensitivities), {}};
+  s.options.method = parse_reliability_method(f.method);
+  s.options.samples = f.samples;
+  s.options.seed = seed;
+  s.options.confidence = f.confidence;
+  return s;
+}
+
 std::vector<SweepCase> reliability_sweep(const Study& st,
                                          const std::vector<InputDistribution>& inputs,
                                          LimitChoice limit, const ReliabilityOptions& options,

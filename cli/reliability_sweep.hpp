@@ -27,6 +27,23 @@ struct SweepCase {
 enum class SensitivityChoice { Auto, Form, Sampling };
 SensitivityChoice parse_sensitivities(const std::string& text);
 
+// The reliability flags shared by `reliability` and `allocate`: --limit --method --samples
+// --confidence --sensitivities.
+struct ReliabilityFlags {
+  std::string limit = "two-sided", method = "auto", sensitivities = "auto";
+  std::size_t samples = 1u << 14;
+  double confidence = 0.95;
+};
+void add_reliability_options(boost::program_options::options_description& opts,
+                             ReliabilityFlags& flags);
+// Parsed and checked (std::invalid_argument on bad values); threads are set by the caller.
+struct ReliabilitySettings {
+  LimitChoice limit;
+  SensitivityChoice sensitivities;
+  ReliabilityOptions options;
+};
+ReliabilitySettings parse_reliability_flags(const ReliabilityFlags& flags, std::uint64_t seed);
+
 // Cases ordered tolerance-major: all poses of tolerances[0], then tolerances[1], ...
 std::vector<SweepCase> reliability_sweep(const Study& study,
                                          const std::vector<InputDistribution>& inputs,

@@ -84,11 +84,12 @@ int verb_allocate(const Args& args) {
       "min R >= --min and mean R >= --mean over the poses for every output. With --cost-aware,\n"
       "also the spreads minimising sum w_i/sigma_i under the same targets.\n\nOptions");
   StudyFlags f;
-  std::string sens_text = "auto", limit_text = "two-sided", method_text = "auto", errors_text, save,
-              rank = "scaled";
+  ReliabilityFlags rf;
+  rf.samples = 1u << 13;
+  std::string errors_text, save, rank = "scaled";
   std::vector<std::string> step_flags, weight_flags;
   double min_target = 0.95, mean_target = 0.97, loosen = 4.0;
-  std::size_t choose = 4, max_steps = 100, samples = 1u << 13;
+  std::size_t choose = 4, max_steps = 100;
   opts.add_options()("help,h", "show this help")(
       "min", po::value<double>(&min_target)->default_value(min_target),
       "target for the minimum reliability over the poses (per output)")(
@@ -115,16 +116,8 @@ int verb_allocate(const Args& args) {
       "max-loosen", po::value<double>(&loosen)->default_value(loosen),
       "cost-aware bound: no spread above this factor times its starting value")(
       "save-tolerances", po::value<std::string>(&save),
-      "write the step procedure's final spreads as a tolerance file")(
-      "sensitivities", po::value<std::string>(&sens_text)->default_value("auto"),
-      "dR/dmu, dR/dsigma by: auto (sampling for radial, else FORM; analytic when exact) |\n"
-      "form | sampling (importance sampling differentiating its own estimate)")(
-      "limit", po::value<std::string>(&limit_text)->default_value(limit_text),
-      "two-sided | one-sided | radial")(
-      "method", po::value<std::string>(&method_text)->default_value(method_text),
-      "reliability method: auto | exact | form | is | mc")(
-      "samples", po::value<std::size_t>(&samples)->default_value(samples),
-      "importance-sampling lines or Monte Carlo samples per pose and output");
+      "write the step procedure's final spreads as a tolerance file");
+  add_reliability_options(opts, rf);
   add_study_options(opts, f, true);
   po::variables_map vm;
   if (auto stop = parse_args<std::string>("allocate", args, opts, "machine", 1, vm)) return *stop;
@@ -132,12 +125,7 @@ int verb_allocate(const Args& args) {
   if (!(min_target > 0 && min_target < 1) || !(mean_target > 0 && mean_target < 1))
     return usage_error("allocate", "--min and --mean must be in (0, 1)");
   if (!(loosen >= 1)) return usage_error("allocate", "--max-loosen must be >= 1");
-  const LimitChoice limit = parse_limit(limit_text);
-  const SensitivityChoice sens = parse_sensitivities(sens_text);
-  ReliabilityOptions ro;
-  ro.method = parse_reliability_method(method_text);
-  ro.samples = samples;
-  ro.seed = f.seed;
+  auto [limit, sens, ro] = parse_reliability_flags(rf, f.seed);
 
   const Study st = open_study(f, true);
   ro.threads = st.threads;
@@ -325,8 +313,8 @@ int verb_allocate(const Args& args) {
                         {"settings",
                          {{"min", min_target},
                           {"mean", mean_target},
-                          {"limit", limit_text},
-                          {"method", method_text},
+                          {"limit", rf.limit},
+                          {"method", rf.method},
                           {"seed", f.seed}}},
                         {"inputs", inputs_json(*st.model, st.inputs)},
                         {"stddev_unit", "base units: mm for translations, rad for rotations"},

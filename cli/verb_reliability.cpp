@@ -51,38 +51,18 @@ int verb_reliability(const Args& args) {
       "errors), form (HL-RF), is (axis-orthogonal importance sampling at the design points),\n"
       "mc (crude Monte Carlo); auto = exact where it is exact, else is.\n\nOptions");
   StudyFlags f;
-  std::string sens_text = "auto", limit_text = "two-sided", method_text = "auto";
-  std::size_t samples = 1u << 14, top = 5;
-  double confidence = 0.95;
-  opts.add_options()("help,h", "show this help")(
-      "sensitivities", po::value<std::string>(&sens_text)->default_value("auto"),
-      "dR/dmu, dR/dsigma by: auto (sampling for radial, else FORM; analytic when exact) |\n"
-      "form | sampling (importance sampling differentiating its own estimate)")(
-      "limit", po::value<std::string>(&limit_text)->default_value(limit_text),
-      "two-sided | one-sided | radial")(
-      "method", po::value<std::string>(&method_text)->default_value(method_text),
-      "auto | exact | form | is | mc")(
-      "samples", po::value<std::size_t>(&samples)->default_value(samples),
-      "importance-sampling lines or Monte Carlo samples per pose and output")(
-      "confidence", po::value<double>(&confidence)->default_value(confidence),
-      "confidence level of the intervals")("top", po::value<std::size_t>(&top)->default_value(top),
-                                           "sensitive errors listed per output");
+  ReliabilityFlags rf;
+  std::size_t top = 5;
+  opts.add_options()("help,h", "show this help")("top",
+                                                 po::value<std::size_t>(&top)->default_value(top),
+                                                 "sensitive errors listed per output");
+  add_reliability_options(opts, rf);
   add_study_options(opts, f, true);
   po::variables_map vm;
   if (auto stop = parse_args<std::string>("reliability", args, opts, "machine", 1, vm))
     return *stop;
   if (vm.count("machine")) f.machine = vm["machine"].as<std::string>();
-  const LimitChoice limit = parse_limit(limit_text);
-  const SensitivityChoice sens = parse_sensitivities(sens_text);
-  ReliabilityOptions ro;
-  ro.method = parse_reliability_method(method_text);
-  ro.samples = samples;
-  ro.seed = f.seed;
-  ro.confidence = confidence;
-  if (samples == 0) return usage_error("reliability", "--samples must be >= 1");
-  if (!(confidence > 0 && confidence < 1))
-    return usage_error("reliability", "--confidence must be in (0, 1)");
-
+  auto [limit, sens, ro] = parse_reliability_flags(rf, f.seed);
   if (!f.plot.empty()) check_plot_target(f.plot);  // before a long run, not after
   const Study st = open_study(f, true);
   ro.threads = st.threads;
@@ -189,11 +169,11 @@ int verb_reliability(const Args& args) {
                         {"verb", "reliability"},
                         {"model", model_json(model)},
                         {"settings",
-                         {{"method", method_text},
-                          {"limit", limit_text},
-                          {"samples", samples},
+                         {{"method", rf.method},
+                          {"limit", rf.limit},
+                          {"samples", rf.samples},
                           {"seed", f.seed},
-                          {"confidence", confidence}}},
+                          {"confidence", rf.confidence}}},
                         {"inputs", inputs_json(model, st.inputs)},
                         {"results", results},
                         {"summary", summary}};

@@ -363,13 +363,7 @@ InputDistribution negated(const InputDistribution& d) {
 
 ToleranceOverrides read_tolerance_text(const std::string& yaml, const std::string& filename,
                                        const Description& desc) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml);
-  } catch (const YAML::ParserException& ex) {
-    throw InputError({filename, ex.mark.line + 1, ex.mark.column + 1},
-                     "YAML syntax error: " + ex.msg);
-  }
+  const YAML::Node root = parse_yaml(yaml, filename);
   return Reader(filename, desc).read(root);
 }
 

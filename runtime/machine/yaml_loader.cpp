@@ -1,7 +1,5 @@
 #include "machine/yaml_loader.hpp"
 
-#include "model_key.hpp"
-
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -18,6 +16,7 @@
 #include <utility>
 
 #include "machine/iso_names.hpp"
+#include "model_key.hpp"
 
 #ifndef WEILGEN_MACHINES_DIR
 #define WEILGEN_MACHINES_DIR "machines"
@@ -995,14 +994,17 @@ class Loader {
 
 }  // namespace
 
-Description load_machine_text(const std::string& yaml, const std::string& filename) {
-  YAML::Node root;
+YAML::Node parse_yaml(const std::string& text, const std::string& filename) {
   try {
-    root = YAML::Load(yaml);
+    return YAML::Load(text);
   } catch (const YAML::ParserException& ex) {
     throw InputError({filename, ex.mark.line + 1, ex.mark.column + 1},
                      "YAML syntax error: " + ex.msg);
   }
+}
+
+Description load_machine_text(const std::string& yaml, const std::string& filename) {
+  const YAML::Node root = parse_yaml(yaml, filename);
   Description desc = Loader(filename).load(root);
   desc.source_hash = fnv1a64(yaml);
   return desc;

@@ -35,4 +35,7 @@ std::string shipped_machines_dir();
 Distribution read_distribution_keys(const YAML::Node& mapping, const std::string& file,
                                     const std::string& path);
 
+// Parses YAML text; a syntax error throws InputError "file:line:column: YAML syntax error: ...".
+YAML::Node parse_yaml(const std::string& text, const std::string& filename);
+
 }  // namespace weilgen
