@@ -68,8 +68,21 @@ std::vector<SweepCase> reliability_sweep(const Study& st,
             std::string(output_name(t.output)));
   std::vector<ModelData> work;
   for (unsigned t = 0; t < std::max(1u, st.threads); ++t) work.emplace_back(model);
-  ModelData data(model);
-  std::vector<double> zero(ne, 0.0), base(6);
+  // Order 1: every component is exactly linear in the errors. Its linear form (deviation at zero
+  // error, coefficients) depends on the pose only, so it is computed once per pose and shared
+  // by every toleranced output.
+  const bool linear = model.order() == 1 && model.engine() != ModelEngine::NumericChain;
+  std::vector<std::vector<double>> coeff, base;
+  if (linear) {
+    ModelData data(model);
+    const std::vector<double> zero(ne, 0.0);
+    for (std::size_t p = 0; p < np; ++p) {
+      model.coefficients(data, st.poses.poses[p].data(), data.coeff.data());
+      coeff.push_back(data.coeff);
+      base.emplace_back(6);
+      model.deviation(data, st.poses.poses[p].data(), zero.data(), base.back().data());
+    }
+  }
   std::vector<SweepCase> cases;
   Progress progress("reliability", st.tolerances.size() * np, quiet);
   for (std::size_t k = 0; k < st.tolerances.size(); ++k) {
@@ -89,13 +102,10 @@ std::vector<SweepCase> reliability_sweep(const Study& st,
         };
       } else {
         const std::size_t row = static_cast<std::size_t>(out);
-        if (model.order() == 1 && model.engine() != ModelEngine::NumericChain) {
-          // Order 1: the output is exactly linear in the errors.
-          model.coefficients(data, pose, data.coeff.data());
-          model.deviation(data, pose, zero.data(), base.data());
-          prob.linear =
-              LinearForm{base[row], std::vector<double>(data.coeff.begin() + row * ne,
-                                                        data.coeff.begin() + (row + 1) * ne)};
+        if (linear) {
+          prob.linear = LinearForm{
+              base[p][row],
+              std::vector<double>(coeff[p].begin() + row * ne, coeff[p].begin() + (row + 1) * ne)};
         } else {
           prob.response = [&, pose, row](unsigned t, const double* x) {
             ModelData& w = work[t];

@@ -139,6 +139,10 @@ nlohmann::json pose_json(const PoseSet& poses, std::size_t i) {
   return j;
 }
 
+nlohmann::json json_number(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json();
+}
+
 nlohmann::json model_json(const Model& m) {
   const Description& d = m.description();
   nlohmann::json axes = nlohmann::json::array();

@@ -50,6 +50,9 @@ Study open_study(const StudyFlags& flags, bool need_tolerances);
 std::string pose_label(const PoseSet& poses, std::size_t i);
 nlohmann::json pose_json(const PoseSet& poses, std::size_t i);
 
+// A JSON number, or null for NaN and infinities (values not computed, or unbounded).
+nlohmann::json json_number(double v);
+
 // The model's identity for JSON output.
 nlohmann::json model_json(const Model& model);
 // The inputs with their distributions in each error's declared unit.

@@ -18,8 +18,6 @@ namespace weilgen::cli {
 
 namespace {
 
-nlohmann::json num(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
-
 // Errors ranked by the mean over poses of |dR/dsigma_i| * sigma_i (the change of R when the
 // spread changes by 100 %), for one output.
 std::vector<std::pair<std::size_t, double>> ranked_sensitivity(
@@ -130,11 +128,11 @@ int verb_reliability(const Args& args) {
       const auto& r = c.result;
       nlohmann::json mu = nlohmann::json::object(), sg = nlohmann::json::object();
       for (std::size_t i = 0; i < errors.size(); ++i) {
-        mu[errors[i].name] = num(i < r.dR_dmu.size() ? r.dR_dmu[i] : NAN);
-        sg[errors[i].name] = num(i < r.dR_dsigma.size() ? r.dR_dsigma[i] : NAN);
+        mu[errors[i].name] = json_number(i < r.dR_dmu.size() ? r.dR_dmu[i] : NAN);
+        sg[errors[i].name] = json_number(i < r.dR_dsigma.size() ? r.dR_dsigma[i] : NAN);
       }
       nlohmann::json betas = nlohmann::json::array();
-      for (const auto& d : r.design_points) betas.push_back(num(d.beta));
+      for (const auto& d : r.design_points) betas.push_back(json_number(d.beta));
       const OutputId out = st.tolerances[c.tolerance].output;
       results.push_back({{"pose", pose_json(st.poses, c.pose)},
                          {"output", output_name(out)},

@@ -32,8 +32,6 @@ struct OutputSummary {
   double mean = kNaN, variance = kNaN, variance_linear = kNaN;
 };
 
-nlohmann::json num(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
-
 // Display scale: outputs in µm or µrad.
 double display_scale(OutputId o) { return 1e3 * (output_is_angle(o) ? 1e3 : 1.0); }
 const char* display_unit(OutputId o) { return output_is_angle(o) ? "urad" : "um"; }
@@ -273,24 +271,24 @@ int verb_sensitivity(const Args& args) {
         sums.push_back({{"pose", pose_json(st.poses, p)},
                         {"output", output_name(outputs[o])},
                         {"unit", output_unit(outputs[o])},
-                        {"mean", num(sm.mean)},
-                        {"variance", num(sm.variance)},
-                        {"variance_linear", num(sm.variance_linear)}});
+                        {"mean", json_number(sm.mean)},
+                        {"variance", json_number(sm.variance)},
+                        {"variance_linear", json_number(sm.variance_linear)}});
         for (std::size_t i = 0; i < ne; ++i) {
           const Record& r = at(p, o, i);
           results.push_back(
               {{"pose", pose_json(st.poses, p)},
                {"output", output_name(outputs[o])},
                {"error", errors[i].name},
-               {"coefficient", num(r.coefficient)},
+               {"coefficient", json_number(r.coefficient)},
                {"coefficient_unit", std::string(output_unit(outputs[o])) + "/" +
                                         (errors[i].effect == ErrorEffect::Rotation ? "rad" : "mm")},
-               {"contribution", num(r.contribution)},
-               {"S", num(r.S)},
-               {"S_ci", {num(r.S_lo), num(r.S_hi)}},
-               {"ST", num(r.ST)},
-               {"ST_ci", {num(r.ST_lo), num(r.ST_hi)}},
-               {"S_exact", num(r.S_exact)}});
+               {"contribution", json_number(r.contribution)},
+               {"S", json_number(r.S)},
+               {"S_ci", {json_number(r.S_lo), json_number(r.S_hi)}},
+               {"ST", json_number(r.ST)},
+               {"ST_ci", {json_number(r.ST_lo), json_number(r.ST_hi)}},
+               {"S_exact", json_number(r.S_exact)}});
         }
       }
     nlohmann::json j = {{"weilgen", kVersion},

@@ -12,14 +12,20 @@
 
 namespace weilgen {
 
-void write_file_atomically(const std::string& path, const std::string& contents) {
+std::string temporary_path_for(const std::string& path) {
   namespace fs = std::filesystem;
   const fs::path target(path);
   const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
   std::error_code ec;
   fs::create_directories(dir, ec);
-  const fs::path tmp =
-      dir / ("." + target.filename().string() + ".tmp" + std::to_string(::getpid()));
+  return (dir / ("." + target.filename().string() + ".tmp" + std::to_string(::getpid()))).string();
+}
+
+void write_file_atomically(const std::string& path, const std::string& contents) {
+  namespace fs = std::filesystem;
+  const fs::path target(path);
+  const fs::path tmp = temporary_path_for(path);
+  std::error_code ec;
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
     if (!out) throw std::runtime_error(path + ": cannot write (" + std::strerror(errno) + ")");

@@ -18,6 +18,7 @@
 #include <stdexcept>
 
 #include "atomic_file.hpp"
+#include "machine/text.hpp"
 
 namespace weilgen {
 namespace {
@@ -69,11 +70,6 @@ std::string short_num(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.3g", v);
   return buf;
-}
-
-std::string lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
 }
 
 std::string format_of_path(const std::string& path) {
@@ -488,11 +484,8 @@ void write_plot(const std::string& path, const std::vector<Panel>& panels,
   if (!gnuplot_available()) throw std::runtime_error(kNotFound);
 
   const fs::path target(path);
-  const fs::path target_dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  const fs::path tmp_output = temporary_path_for(path);
   std::error_code ec;
-  fs::create_directories(target_dir, ec);
-  const fs::path tmp_output =
-      target_dir / ("." + target.filename().string() + ".tmp" + std::to_string(::getpid()));
   FileGuard output_guard(tmp_output);
 
   TempDir work;

@@ -6,23 +6,13 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "machine/text.hpp"
 #include "tolerance_file.hpp"
 
 namespace weilgen {
 namespace {
 
-std::string join(const std::vector<std::string>& items) {
-  std::string out;
-  for (const std::string& s : items) out += (out.empty() ? "" : ", ") + s;
-  return out;
-}
-
 std::string quoted(const std::string& s) { return "\"" + s + "\""; }
-
-std::string lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
 
 // "--grid: \"X=0:1000:0\"" : the prefix of every message about one flag value.
 std::string flag_context(const std::string& flag, const std::string& text) {
@@ -385,25 +375,14 @@ void apply_set_flag(const Description& desc, const std::string& flag,
       if (desc.errors[i].group == group) targets.emplace_back(i, 1);
     }
     if (targets.empty()) {
-      std::vector<std::string> used;
-      for (const std::string& g : desc.groups) {
-        for (const ErrorDef& e : desc.errors) {
-          if (e.group == g) {
-            used.push_back(g);
-            break;
-          }
-        }
-      }
       fail(context, "no errors in group " + quoted(group) + " (groups with errors in machine " +
-                        desc.name + ": " + join(used) + ")");
+                        desc.name + ": " + join(used_groups(desc)) + ")");
     }
   } else {
     const int index = desc.error_index(name);
     if (index < 0) {
-      std::vector<std::string> names;
-      for (const ErrorDef& e : desc.errors) names.push_back(e.name);
       fail(context, "unknown error " + quoted(name) + " (machine " + desc.name + " has " +
-                        join(names) + "; or group:<group>)");
+                        join(error_names(desc)) + "; or group:<group>)");
     }
     int sign = 1;
     for (const Alias& a : desc.errors[static_cast<std::size_t>(index)].aliases) {

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "machine/expr.hpp"
+#include "machine/text.hpp"
 
 namespace weilgen {
 namespace {
@@ -40,11 +41,6 @@ std::string ascii_micro(const std::string& unit) {
     if (unit.compare(0, m.size(), m) == 0) return "u" + unit.substr(m.size());
   }
   return unit;
-}
-
-std::string lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
 }
 
 bool unit_char(char c) {

@@ -14,6 +14,7 @@
 
 #include "atomic_file.hpp"
 #include "machine/expr.hpp"
+#include "machine/text.hpp"
 #include "machine/yaml_loader.hpp"
 #include "study_units.hpp"
 
@@ -23,37 +24,6 @@ namespace {
 const std::vector<std::string> kTopKeys = {"weilgen_tolerances", "machine", "groups", "errors"};
 const std::vector<std::string> kEntryKeys = {"sigma",       "normal", "uniform",
                                              "truncnormal", "const",  "unit"};
-
-std::string join(const std::vector<std::string>& items) {
-  std::string out;
-  for (const std::string& s : items) out += (out.empty() ? "" : ", ") + s;
-  return out;
-}
-
-std::string lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
-
-std::vector<std::string> error_names(const Description& desc) {
-  std::vector<std::string> names;
-  for (const ErrorDef& e : desc.errors) names.push_back(e.name);
-  return names;
-}
-
-// Groups that have at least one error, in Description::groups order.
-std::vector<std::string> used_groups(const Description& desc) {
-  std::vector<std::string> groups;
-  for (const std::string& g : desc.groups) {
-    for (const ErrorDef& e : desc.errors) {
-      if (e.group == g) {
-        groups.push_back(g);
-        break;
-      }
-    }
-  }
-  return groups;
-}
 
 // An error an entry applies to, and the sign of the name it was given by (alias sign).
 struct Target {

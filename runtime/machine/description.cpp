@@ -101,4 +101,24 @@ const std::vector<std::string>& builtin_groups() {
   return groups;
 }
 
+std::vector<std::string> error_names(const Description& desc) {
+  std::vector<std::string> names;
+  for (const ErrorDef& e : desc.errors) names.push_back(e.name);
+  return names;
+}
+
+// Groups that have at least one error, in Description::groups order.
+std::vector<std::string> used_groups(const Description& desc) {
+  std::vector<std::string> groups;
+  for (const std::string& g : desc.groups) {
+    for (const ErrorDef& e : desc.errors) {
+      if (e.group == g) {
+        groups.push_back(g);
+        break;
+      }
+    }
+  }
+  return groups;
+}
+
 }  // namespace weilgen

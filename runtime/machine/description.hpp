@@ -8,9 +8,8 @@
 // converts from the error's declared unit (um, urad, ...) to base.
 #pragma once
 
-#include <cstdint>
-
 #include <array>
+#include <cstdint>
 #include <map>
 #include <optional>
 #include <stdexcept>
@@ -23,8 +22,8 @@ namespace weilgen {
 
 struct SourceLoc {
   std::string file;
-  int line = 0;    // 1-based; 0 = unknown
-  int column = 0;  // 1-based; 0 = unknown
+  int line = 0;             // 1-based; 0 = unknown
+  int column = 0;           // 1-based; 0 = unknown
   std::string str() const;  // "file:line:column"
 };
 
@@ -59,10 +58,10 @@ struct Offset {
 
 struct Joint {
   JointType type = JointType::Fixed;
-  Vec3 axis{0, 0, 0};    // unit direction (prismatic) or rotation axis (revolute), parent frame
-  std::string coordinate;  // "X", "C", any identifier
-  std::string unit;        // mm | um | m for prismatic; deg | rad for revolute
-  double to_base = 1.0;    // coordinate value in `unit` * to_base = mm or rad
+  Vec3 axis{0, 0, 0};       // unit direction (prismatic) or rotation axis (revolute), parent frame
+  std::string coordinate;   // "X", "C", any identifier
+  std::string unit;         // mm | um | m for prismatic; deg | rad for revolute
+  double to_base = 1.0;     // coordinate value in `unit` * to_base = mm or rad
   double min = 0, max = 0;  // travel range, in `unit`
   SourceLoc loc;
 };
@@ -150,15 +149,15 @@ struct PointSpec {
 };
 
 struct Description {
-  std::string name;         // identifier, used for file and namespace names
-  std::string title;        // human title
-  std::string source_file;  // path the description was read from
+  std::string name;               // identifier, used for file and namespace names
+  std::string title;              // human title
+  std::string source_file;        // path the description was read from
   std::uint64_t source_hash = 0;  // FNV-1a of the machine file's text (model_key.hpp)
-  std::string notes;        // free text (corrections to the seed, conventions)
+  std::string notes;              // free text (corrections to the seed, conventions)
   Algebra algebra;
   std::vector<Parameter> parameters;
   std::vector<std::string> groups;  // builtin_groups() plus the file's `groups:`
-  std::vector<Body> bodies;  // bodies[0] is the base; parents precede children
+  std::vector<Body> bodies;         // bodies[0] is the base; parents precede children
   std::vector<ErrorDef> errors;
   PointSpec tool;       // tool point (cutting point) on the tool branch
   PointSpec workpiece;  // workpiece coordinate system origin on the workpiece branch
@@ -175,5 +174,10 @@ struct Description {
 
 // Groups an error may belong to; machine files may declare more under `groups:`.
 const std::vector<std::string>& builtin_groups();
+
+// The errors' names, in Description::errors order (for messages).
+std::vector<std::string> error_names(const Description& desc);
+// Groups that have at least one error, in Description::groups order.
+std::vector<std::string> used_groups(const Description& desc);
 
 }  // namespace weilgen

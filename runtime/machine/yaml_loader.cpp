@@ -16,6 +16,7 @@
 #include <utility>
 
 #include "machine/iso_names.hpp"
+#include "machine/text.hpp"
 #include "model_key.hpp"
 
 #ifndef WEILGEN_MACHINES_DIR
@@ -63,12 +64,6 @@ const std::vector<std::string> kPointKeys = {"body", "point"};
 const std::vector<std::string> kAlgebraKeys = {"order", "relations"};
 const std::vector<std::string> kAliasKeys = {"name", "sign"};
 
-std::string join(const std::vector<std::string>& items) {
-  std::string out;
-  for (const std::string& s : items) out += (out.empty() ? "" : ", ") + s;
-  return out;
-}
-
 std::string unit_names(const std::vector<Unit>& units) {
   std::vector<std::string> names;
   for (const Unit& u : units) names.push_back(u.name);
@@ -93,11 +88,6 @@ std::string format(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%g", v);
   return buf;
-}
-
-std::string lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
 }
 
 // A value to read, the node to point at when it is wrong (a null value has no useful position of
