@@ -1,6 +1,7 @@
 #include <filesystem>
 #include <iostream>
 #include <set>
+#include <vector>
 
 #include "machine/yaml_loader.hpp"
 #include "verbs.hpp"
@@ -19,8 +20,17 @@ int verb_list(const Args& args) {
     if (e.path().extension() == ".yaml") files.insert(e.path().string());
   for (const auto& f : files) {
     const Description d = load_machine_file(f);
+    // "XZY" for one-letter coordinates, "X, A12, Y231" otherwise.
+    std::vector<std::string> names;
+    bool letters = true;
+    for (int b : d.axes()) {
+      names.push_back(d.bodies[b].joint.coordinate);
+      letters &= names.back().size() == 1;
+    }
     std::string axes;
-    for (int b : d.axes()) axes += d.bodies[b].joint.coordinate;
+    for (const auto& n : names) axes += (axes.empty() || letters ? "" : ", ") + n;
+    if (!d.linked_axes().empty())
+      axes += " (+" + std::to_string(d.linked_axes().size()) + " linked)";
     std::cout << d.name << "  axes " << axes << ", " << d.errors.size() << " errors, order "
               << d.algebra.order << "  — " << d.title << "\n";
   }

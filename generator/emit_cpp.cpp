@@ -6,8 +6,8 @@
 #include <stdexcept>
 
 #include "cse.hpp"
-#include "printer.hpp"
 #include "model_key.hpp"
+#include "printer.hpp"
 #include "version.hpp"
 
 namespace weilgen::gen {
@@ -56,7 +56,12 @@ struct InputTable {
   std::map<std::string, std::string> code_name;
   std::map<std::string, std::string> definition;  // by code name
   std::vector<std::string> order;                 // code names in declaration order
+  // Inputs computed from others (reciprocals of divisors): code name -> the code names it uses.
+  std::map<std::string, std::set<std::string>> depends;
+  std::map<std::string, OpCount> cost;  // operations of a computed input's definition
 };
+
+void collect_symbols(const ex& e, std::set<std::string>& out);
 
 InputTable inputs_of(const SymbolicModel& m) {
   InputTable t;
@@ -83,6 +88,18 @@ InputTable inputs_of(const SymbolicModel& m) {
     add(m.errors[i].get_name(), m.errors[i].get_name(), "errors[" + std::to_string(i) + "]");
   for (std::size_t i = 0; i < m.params.size(); ++i)
     add(m.params[i].get_name(), m.params[i].get_name(), "params[" + std::to_string(i) + "]");
+  // Reciprocals of derived divisors, once per call (model_builder.hpp, Reciprocal).
+  for (const Reciprocal& r : m.reciprocals) {
+    ExprPrinter pr(ExprPrinter::Style::Cpp, t.code_name);
+    const std::string code = r.symbol.get_name();
+    add(code, code, "Scalar(1) / (" + pr.print(r.divisor) + ")");
+    std::set<std::string> syms;
+    collect_symbols(r.divisor, syms);
+    for (const auto& sym : syms) t.depends[code].insert(t.code_name.at(sym));
+    OpCount c = pr.ops();
+    ++c.divs;
+    t.cost[code] = c;
+  }
   return t;
 }
 
@@ -116,10 +133,17 @@ struct Coefficients {
     if (GiNaC::is_a<GiNaC::mul>(c)) {
       rest = 1;
       for (std::size_t i = 0; i < c.nops(); ++i) {
-        if (GiNaC::is_a<GiNaC::numeric>(c.op(i)))
-          factor *= c.op(i);
-        else
-          rest *= c.op(i);
+        const ex op = c.op(i);
+        if (GiNaC::is_a<GiNaC::numeric>(op)) {
+          factor *= op;
+        } else if (GiNaC::is_a<GiNaC::add>(op)) {
+          // Sums in canonical sign: GiNaC's choice varies between runs.
+          const CanonicalText::Signed r = canon.canonical_sign(op);
+          if (r.negated) factor = -factor;
+          rest *= r.value;
+        } else {
+          rest *= op;
+        }
       }
       if (!GiNaC::is_a<GiNaC::mul>(rest) && !GiNaC::is_a<GiNaC::power>(rest)) return std::nullopt;
     } else if (!GiNaC::is_a<GiNaC::add>(c)) {
@@ -189,6 +213,12 @@ FunctionCode function_body(const InputTable& inputs, const std::vector<OutputGro
     return code.rfind("cos_", 0) == 0 || code.rfind("sin_", 0) == 0;
   };
   OpCount trig;
+  // Computed inputs (reverse declaration order: they may use earlier ones) pull in what they use.
+  for (auto it = inputs.order.rbegin(); it != inputs.order.rend(); ++it) {
+    if (!used_code.count(*it) || !inputs.depends.count(*it)) continue;
+    used_code.insert(inputs.depends.at(*it).begin(), inputs.depends.at(*it).end());
+    trig += inputs.cost.at(*it);
+  }
   for (const auto& code : inputs.order)
     if (used_code.count(code) && is_trig(code)) {
       used_code.insert(code.substr(4));
@@ -283,7 +313,8 @@ std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_la
 
   os << "inline constexpr const char* kMachineName = " << quoted(d.name) << ";\n";
   os << "inline constexpr int kOrder = " << m.order << ";\n";
-  os << "// Machine-file text, order and weilgen version: identifies the model (runtime/model_key.hpp).\n";
+  os << "// Machine-file text, order and weilgen version: identifies the model "
+        "(runtime/model_key.hpp).\n";
   os << "inline constexpr const char* kModelKey = " << quoted(model_key(d.source_hash, m.order))
      << ";\n";
   os << "inline constexpr std::size_t kNumAxes = " << m.axes.size() << ";\n";
@@ -359,8 +390,13 @@ std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_la
   const std::string in_doc = "//   axes:   " + doc_list(axis_names) +
                              "\n//   errors: " + doc_list(error_names) +
                              "\n//   params: " + doc_list(param_names) + "\n";
-  os << "// Deviation of the tool point relative to the workpiece, in the workpiece frame:\n"
-        "// position = (dx, dy, dz) in mm, orientation = (da, db, dc) in rad. Null outputs are\n"
+  os << (d.output ? "// Deviation of the output point (" +
+                        (d.output->description.empty() ? std::string("the output transform")
+                                                       : d.output->description) +
+                        "):\n"
+                  : std::string("// Deviation of the tool point relative to the workpiece, in the "
+                                "workpiece frame:\n"))
+     << "// position = (dx, dy, dz) in mm, orientation = (da, db, dc) in rad. Null outputs are\n"
         "// skipped. Exact in the algebra of order kOrder.\n"
      << in_doc;
   os << "template <typename Scalar>\nvoid Deviation([[maybe_unused]] const std::array<Scalar, "

@@ -81,13 +81,13 @@ std::string closed_form(const SymbolicModel& m, int o, FormStyle style, Notation
                  symbol_names(m, style));
   std::string s;
   for (std::size_t i = 0; i < m.errors.size(); ++i) {
-    const ex c = m.coefficient(o, {static_cast<std::uint16_t>(i)});
+    const ex c = m.with_divisors(m.coefficient(o, {static_cast<std::uint16_t>(i)}));
     if (c.is_zero()) continue;
     const auto [name, sign] = display(m, i, notation, style);
     s = join_term(s, readable((c * sign).expand()), name, pr, style);
   }
   for (const auto& mono : m.higher_monomials()) {
-    const ex c = m.coefficient(o, mono);
+    const ex c = m.with_divisors(m.coefficient(o, mono));
     if (c.is_zero()) continue;
     std::string name;
     int sign = 1;
@@ -117,7 +117,7 @@ nlohmann::json closed_forms_json(const SymbolicModel& m, Notation notation) {
     out["latex"] = closed_form(m, o, FormStyle::Latex, notation);
     nlohmann::json lin = nlohmann::json::object();
     for (std::size_t i = 0; i < m.errors.size(); ++i) {
-      const ex c = m.coefficient(o, {static_cast<std::uint16_t>(i)});
+      const ex c = m.with_divisors(m.coefficient(o, {static_cast<std::uint16_t>(i)}));
       if (c.is_zero()) continue;
       const auto [name, sign] = display(m, i, notation, FormStyle::Text);
       lin[name] = pr.print((c * sign).expand());
@@ -125,7 +125,7 @@ nlohmann::json closed_forms_json(const SymbolicModel& m, Notation notation) {
     out["linear"] = lin;
     nlohmann::json hi = nlohmann::json::array();
     for (const auto& mono : m.higher_monomials()) {
-      const ex c = m.coefficient(o, mono);
+      const ex c = m.with_divisors(m.coefficient(o, mono));
       if (c.is_zero()) continue;
       nlohmann::json names = nlohmann::json::array();
       int sign = 1;
@@ -158,9 +158,15 @@ std::string emit_report_markdown(const SymbolicModel& m, const std::string& sour
     os << "⟩";
   }
   os << " (order " << m.order << (m.order == 1 ? ": dual numbers" : "") << ").\n";
-  os << "- Outputs: tool point relative to the workpiece, in the workpiece frame: dx, dy, dz in "
-        "mm; "
-        "da, db, dc in rad. Errors in base units (mm, rad).\n";
+  if (d.output) {
+    os << "- Outputs: deviation of the output transform's point"
+       << (d.output->description.empty() ? "" : " (" + d.output->description + ")")
+       << ": dx, dy, dz in mm; da, db, dc in rad (see \"Derived quantities\"). Errors in base "
+          "units (mm, rad).\n";
+  } else {
+    os << "- Outputs: tool point relative to the workpiece, in the workpiece frame: dx, dy, dz in "
+          "mm; da, db, dc in rad. Errors in base units (mm, rad).\n";
+  }
   os << "- Coordinates print in lower case (`X` → `x`); revolute coordinates appear as "
         "`cos(c)`, `sin(c)` of the angle.\n\n";
 
@@ -183,7 +189,7 @@ std::string emit_report_markdown(const SymbolicModel& m, const std::string& sour
   for (std::size_t i = 0; i < d.errors.size(); ++i) {
     os << "| " << d.errors[i].name;
     for (int o = 0; o < kNumOutputs; ++o) {
-      const ex c = m.coefficient(o, {static_cast<std::uint16_t>(i)});
+      const ex c = m.with_divisors(m.coefficient(o, {static_cast<std::uint16_t>(i)}));
       os << " | " << (c.is_zero() ? "·" : pr.print(c));
     }
     os << " |\n";
@@ -202,14 +208,59 @@ std::string emit_report_markdown(const SymbolicModel& m, const std::string& sour
        << " | " << pl << " | " << (e.dependence == Dependence::PDGE ? "PDGE" : "PIGE") << " | "
        << e.unit << " | " << e.distribution.str() << " |\n";
   }
-  os << "\n## Axes\n\n| coordinate | type | axis | unit | range |\n| --- | --- | --- | --- | --- "
-        "|\n";
-  for (const auto& a : m.axes) {
-    const Joint& j = d.bodies[a.body].joint;
-    os << "| " << j.coordinate << " | " << (a.revolute ? "revolute" : "prismatic") << " | ["
-       << format_double(j.axis[0]) << ", " << format_double(j.axis[1]) << ", "
-       << format_double(j.axis[2]) << "] | " << j.unit << " | " << format_double(j.min) << " … "
-       << format_double(j.max) << " |\n";
+  os << "\n## Axes\n\n| coordinate | body | type | axis | twist ξ = (ω, v) | unit | range |\n"
+        "| --- | --- | --- | --- | --- | --- | --- |\n";
+  for (std::size_t b = 0; b < d.bodies.size(); ++b) {
+    const Joint& j = d.bodies[b].joint;
+    if (j.type == JointType::Fixed) continue;
+    const bool revolute = j.type == JointType::Revolute;
+    std::string axis = "[" + format_double(j.axis[0]) + ", " + format_double(j.axis[1]) + ", " +
+                       format_double(j.axis[2]) + "]";
+    if (revolute &&
+        !(j.through[0].is_number() && j.through[0].number == 0 && j.through[1].is_number() &&
+          j.through[1].number == 0 && j.through[2].is_number() && j.through[2].number == 0)) {
+      axis += " through [" + j.through[0].str() + ", " + j.through[1].str() + ", " +
+              j.through[2].str() + "]";
+    }
+    os << "| " << j.coordinate << " | " << d.bodies[b].name << " | "
+       << (revolute ? "revolute" : "prismatic") << " | " << axis << " | "
+       << (j.twist.empty() ? "·" : j.twist) << " | " << j.unit << " | "
+       << (j.link ? "linked: " + j.coordinate + " = " + j.link->str()
+                  : format_double(j.min) + " … " + format_double(j.max))
+       << " |\n";
+  }
+  if (!d.points.empty() || !d.derived.empty() || d.output) {
+    os << "\n## Derived quantities\n\n";
+    if (!d.points.empty()) {
+      os << "Chain points (deviation P(e) − P(0) in the base frame, mm; `name.x` …):\n\n"
+            "| point | body | point in the body (mm) |\n| --- | --- | --- |\n";
+      for (const ChainPoint& p : d.points)
+        os << "| " << p.name << " | " << d.bodies[p.at.body].name << " | [" << p.at.point[0].str()
+           << ", " << p.at.point[1].str() << ", " << p.at.point[2].str() << "] |\n";
+      os << "\n";
+    }
+    if (!d.derived.empty()) {
+      os << "Derived quantities, in evaluation order:\n\n```text\n";
+      for (const Derived& q : d.derived)
+        os << q.name << " = " << q.value.str()
+           << (q.description.empty() ? "" : "    # " + q.description) << "\n";
+      os << "```\n\n";
+    }
+    if (d.output) {
+      os << "Output transform P = ";
+      for (const TransformStep& st : d.output->steps) {
+        if (st.kind == TransformStep::Kind::Translate) {
+          os << "Trans(" << st.translation[0].str() << ", " << st.translation[1].str() << ", "
+             << st.translation[2].str() << ") · ";
+        } else {
+          os << "exp(ξ^·" << st.amount.str() << ") [ξ = (" << format_double(st.omega[0]) << ", "
+             << format_double(st.omega[1]) << ", " << format_double(st.omega[2]) << ", "
+             << st.v[0].str() << ", " << st.v[1].str() << ", " << st.v[2].str() << ")] · ";
+        }
+      }
+      os << "Trans(" << d.output->point[0].str() << ", " << d.output->point[1].str() << ", "
+         << d.output->point[2].str() << ")\n";
+    }
   }
   if (!d.parameters.empty()) {
     os << "\n## Parameters\n\n| name | default | unit | description |\n| --- | --- | --- | --- |\n";

@@ -4,6 +4,10 @@
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
+#include <utility>
+
+#include "cse.hpp"
+#include "machine/text.hpp"
 
 namespace weilgen::gen {
 
@@ -62,15 +66,11 @@ ex to_ginac(const Expr& e, const Description& desc, const std::vector<GiNaC::sym
 
 namespace {
 
-std::string lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
-  return s;
-}
-
 struct Builder {
   const Description& d;
   SymbolicModel& model;
   const Algebra& alg;
+  CanonicalText& canon;
 
   void unit_vector(const Vec3& v, ex (&u)[3]) const {
     for (int i = 0; i < 3; ++i) u[i] = exact_decimal(v[i]);
@@ -104,18 +104,187 @@ struct Builder {
     return m;
   }
 
+  // A joint coordinate's nominal value in its unit: the symbol of an independent coordinate, the
+  // expression of a linked one.
+  ex coordinate_value(int body) const {
+    const Joint& j = d.bodies[body].joint;
+    if (j.link) return nominal(*j.link);
+    const auto it = std::find_if(model.axes.begin(), model.axes.end(),
+                                 [&](const AxisSymbols& a) { return a.body == body; });
+    return it->coordinate;
+  }
+
+  // Expr over parameters and coordinates (links, twist axes) → GiNaC.
+  ex nominal(const Expr& e) const {
+    const Poly p = value(e, {});
+    if (p.min_degree() > 0 || p.terms().size() > 1)
+      throw std::logic_error("nominal expression depends on errors: " + e.str());
+    return p.constant();
+  }
+
+  // cos and sin of revolute joint `body`: the trigonometric symbols of an independent coordinate;
+  // for a linked one the symbols of the coordinate it equals (±C), else cos/sin of the expression.
+  std::pair<ex, ex> cos_sin(int body) const {
+    const Joint& j = d.bodies[body].joint;
+    const auto sym = [&](int b) {
+      return std::find_if(model.axes.begin(), model.axes.end(),
+                          [&](const AxisSymbols& a) { return a.body == b; });
+    };
+    if (!j.link) return {sym(body)->cos, sym(body)->sin};
+    const Expr* e = &*j.link;
+    const bool negated = e->kind == Expr::Kind::Neg;
+    if (negated) e = e->a.get();
+    if (e->kind == Expr::Kind::Param) {
+      const int other = d.coordinate_body(e->name);
+      if (other >= 0 && !d.bodies[other].joint.link &&
+          d.bodies[other].joint.type == JointType::Revolute &&
+          d.bodies[other].joint.to_base == j.to_base) {
+        const auto it = sym(other);
+        return {it->cos, negated ? ex(-it->sin) : ex(it->sin)};
+      }
+    }
+    const ex angle = coordinate_value(body) * exact_decimal(j.to_base);
+    return {GiNaC::cos(angle), GiNaC::sin(angle)};
+  }
+
   Mat4 joint(int body) const {
     const Joint& j = d.bodies[body].joint;
     if (j.type == JointType::Fixed) return Mat4::identity();
-    const auto it = std::find_if(model.axes.begin(), model.axes.end(),
-                                 [&](const AxisSymbols& a) { return a.body == body; });
     ex u[3];
     unit_vector(j.axis, u);
     if (j.type == JointType::Prismatic) {
-      const Poly q(it->coordinate * exact_decimal(j.to_base));
+      const Poly q(coordinate_value(body) * exact_decimal(j.to_base));
       return translation_by(q, u, alg);
     }
-    return rotation_cs(u, it->cos, it->sin, alg);
+    const auto [c, s] = cos_sin(body);
+    const Mat4 r = rotation_cs(u, c, s, alg);
+    ex q[3], minus_q[3];
+    bool origin = true;
+    for (int i = 0; i < 3; ++i) {
+      q[i] = to_ginac(j.through[i], d, model.params);
+      minus_q[i] = -q[i];
+      origin &= q[i].is_zero();
+    }
+    if (origin) return r;
+    return translation(q).mul(r, alg).mul(translation(minus_q), alg);
+  }
+
+  // ---- Chain points, derived quantities, the output transform -------------------------------
+
+  // An expression of a derived quantity or output step as an algebra element; `names` holds the
+  // point components and derived quantities evaluated so far.
+  Poly value(const Expr& e, const std::map<std::string, Poly>& names) const {
+    switch (e.kind) {
+      case Expr::Kind::Number:
+        return Poly(exact_decimal(e.number));
+      case Expr::Kind::Param: {
+        if (const auto it = names.find(e.name); it != names.end()) return it->second;
+        if (const int b = d.coordinate_body(e.name); b >= 0) return Poly(coordinate_value(b));
+        return Poly(to_ginac(e, d, model.params));
+      }
+      case Expr::Kind::Neg:
+        return -value(*e.a, names);
+      case Expr::Kind::Add:
+        return value(*e.a, names) + value(*e.b, names);
+      case Expr::Kind::Sub:
+        return value(*e.a, names) - value(*e.b, names);
+      case Expr::Kind::Mul:
+        return value(*e.a, names).mul(value(*e.b, names), alg);
+      case Expr::Kind::Div: {
+        // The loader admits only nominal divisors (machine/derived.hpp).
+        const Poly den = value(*e.b, names);
+        return value(*e.a, names).scaled(reciprocal(den.constant()), alg);
+      }
+      case Expr::Kind::Pow: {
+        const Poly base = value(*e.a, names);
+        const double k = e.b->number;
+        if (base.min_degree() == 0 && base.terms().size() <= 1)
+          return Poly(GiNaC::pow(base.constant(), exact_decimal(k)));
+        Poly p(1);
+        for (int i = 0; i < static_cast<int>(k); ++i) p = p.mul(base, alg);
+        return p;
+      }
+    }
+    return {};
+  }
+
+  // 1/den: a number, or ±_invK for the divisor's canonical sign (one symbol per divisor).
+  ex reciprocal(const ex& den) const {
+    const ex e = den.expand();
+    if (GiNaC::is_a<GiNaC::numeric>(e)) return 1 / e;
+    ex canonical = e;
+    bool negated = false;
+    if (GiNaC::is_a<GiNaC::add>(e)) {
+      const CanonicalText::Signed r = canon.canonical_sign(e);
+      canonical = r.value;
+      negated = r.negated;
+    }
+    const std::string& key = canon.of(canonical);
+    for (const Reciprocal& r : model.reciprocals)
+      if (canon.of(r.divisor) == key) return negated ? ex(-r.symbol) : ex(r.symbol);
+    model.reciprocals.push_back(
+        {GiNaC::symbol("_inv" + std::to_string(model.reciprocals.size())), canonical});
+    const ex sym = model.reciprocals.back().symbol;
+    return negated ? -sym : sym;
+  }
+
+  // A coefficient with reciprocals as one fraction over a single divisor when it has one:
+  // 1 + (L01 + x − L04)·_inv0 with _inv0 = 1/(L04 − L01 − x − LW) becomes −LW·_inv0. Anything else
+  // (several divisors) stays as it is.
+  ex as_fraction(const ex& c) const {
+    if (model.reciprocals.empty()) return c;
+    const ex nd = GiNaC::normal(model.with_divisors(c)).numer_denom();
+    const ex num = nd.op(0).expand(), den = nd.op(1).expand();
+    if (GiNaC::is_a<GiNaC::numeric>(den)) return alg.normalize(num / den);
+    for (const Reciprocal& r : model.reciprocals) {
+      if ((den - r.divisor).expand().is_zero()) return alg.normalize(num * r.symbol);
+      if ((den + r.divisor).expand().is_zero()) return alg.normalize(-num * r.symbol);
+    }
+    return c;
+  }
+
+  // P = Π steps · Trans(point), with the chain points' deviations P(e) − P(0) (base frame) and the
+  // derived quantities in scope.
+  Mat4 output_transform() const {
+    std::map<std::string, Poly> names;
+    for (const ChainPoint& p : d.points) {
+      const Mat4 m = branch(p.at);
+      for (int i = 0; i < 3; ++i)
+        names[p.name + "." + static_cast<char>('x' + i)] = m.m[i][3].without_constant();
+    }
+    for (const Derived& q : d.derived) names[q.name] = value(q.value, names);
+    Mat4 m = Mat4::identity();
+    for (const TransformStep& s : d.output->steps) {
+      if (s.kind == TransformStep::Kind::Translate) {
+        Mat4 t = Mat4::identity();
+        for (int i = 0; i < 3; ++i) t.m[i][3] = value(s.translation[i], names);
+        m = m.mul(t, alg);
+        continue;
+      }
+      const Poly amount = value(s.amount, names);
+      ex v[3], w[3];
+      for (int i = 0; i < 3; ++i) v[i] = nominal(s.v[i]);
+      unit_vector(s.omega, w);
+      if (s.omega == Vec3{0, 0, 0}) {
+        m = m.mul(translation_by(amount, v, alg), alg);
+        continue;
+      }
+      // exp(ξ^ a) = Trans(q) · Rot(ω, a) · Trans(−q) · Trans(ω (ω·v) a), q = ω × v.
+      ex q[3], minus_q[3];
+      q[0] = w[1] * v[2] - w[2] * v[1];
+      q[1] = w[2] * v[0] - w[0] * v[2];
+      q[2] = w[0] * v[1] - w[1] * v[0];
+      for (int i = 0; i < 3; ++i) minus_q[i] = -q[i];
+      const ex a0 = amount.constant();
+      Mat4 r = rotation_small(w, amount - Poly(a0), alg);
+      if (!a0.is_zero()) r = rotation_cs(w, GiNaC::cos(a0), GiNaC::sin(a0), alg).mul(r, alg);
+      const ex pitch = (w[0] * v[0] + w[1] * v[1] + w[2] * v[2]).expand();
+      m = m.mul(translation(q), alg).mul(r, alg).mul(translation(minus_q), alg);
+      if (!pitch.is_zero()) m = m.mul(translation_by(amount.scaled(pitch, alg), w, alg), alg);
+    }
+    ex t[3];  // nominal (checked by the loader)
+    for (int i = 0; i < 3; ++i) t[i] = value(d.output->point[i], names).constant();
+    return m.mul(translation(t), alg);
   }
 
   // T = Offset · E_before · (E_axis · J · E_axis⁻¹) · E_after
@@ -189,6 +358,13 @@ std::vector<Monomial> relation_monomials(const Description& d) {
 
 }  // namespace
 
+ex SymbolicModel::with_divisors(const ex& c) const {
+  if (reciprocals.empty()) return c;
+  GiNaC::exmap m;
+  for (const Reciprocal& r : reciprocals) m[r.symbol] = GiNaC::pow(r.divisor, -1);
+  return c.subs(m);
+}
+
 ex SymbolicModel::coefficient(int o, const Monomial& m) const {
   const auto& t = outputs[o].terms();
   auto it = t.find(m);
@@ -246,12 +422,13 @@ SymbolicModel build_model(const Description& desc, int order_override) {
 
   const Algebra alg(model.order, relation_monomials(desc), trig_rules);
   model.relations = alg.relations();
-  const Builder b{desc, model, alg};
+  CanonicalText canon;
+  const Builder b{desc, model, alg, canon};
 
-  const Mat4 tool = b.branch(desc.tool);
-  const Mat4 work = b.branch(desc.workpiece);
-  // P: the tool frame (at the tool point) in the workpiece frame.
-  const Mat4 p = neumann_inverse(work, alg).mul(tool, alg);
+  // P: the tool frame (at the tool point) in the workpiece frame, or the output transform.
+  const Mat4 p = desc.output
+                     ? b.output_transform()
+                     : neumann_inverse(b.branch(desc.workpiece), alg).mul(b.branch(desc.tool), alg);
 
   for (int i = 0; i < 3; ++i) model.outputs[i] = p.m[i][3].without_constant();
 
@@ -277,6 +454,9 @@ SymbolicModel build_model(const Description& desc, int order_override) {
   model.outputs[3] = (log.m[2][1] - log.m[1][2]).scaled(half, alg);
   model.outputs[4] = (log.m[0][2] - log.m[2][0]).scaled(half, alg);
   model.outputs[5] = (log.m[1][0] - log.m[0][1]).scaled(half, alg);
+  // Ratios with nominal divisors (derived quantities) expand into sums of fractions over the
+  // same divisor; one fraction numerator/denominator reads better and costs fewer operations.
+  for (Poly& out : model.outputs) out = out.mapped([&](const ex& c) { return b.as_fraction(c); });
   return model;
 }
 

@@ -25,6 +25,14 @@ struct AxisSymbols {
   bool revolute = false;
 };
 
+// 1/divisor of a derived ratio, as a symbol: coefficients stay polynomials (GiNaC would
+// otherwise choose the sign of a divisor by hash order, which varies between runs), and generated
+// code computes each reciprocal once. `divisor` has the sign CanonicalText chooses.
+struct Reciprocal {
+  GiNaC::symbol symbol;  // "_inv0", "_inv1", ...
+  GiNaC::ex divisor;     // over coordinates and parameters
+};
+
 struct SymbolicModel {
   Description desc;
   int order = 1;
@@ -33,6 +41,10 @@ struct SymbolicModel {
   std::vector<GiNaC::symbol> errors;
   std::vector<GiNaC::symbol> params;
   std::array<Poly, kNumOutputs> outputs;  // deviation, as algebra elements (no constant term)
+  std::vector<Reciprocal> reciprocals;    // symbols standing for 1/divisor in coefficients
+
+  // c with each reciprocal symbol replaced by 1/divisor: for printing and numeric evaluation.
+  GiNaC::ex with_divisors(const GiNaC::ex& c) const;
 
   // Coefficient of a monomial in output o (0 when absent).
   GiNaC::ex coefficient(int o, const Monomial& m) const;

@@ -24,6 +24,8 @@ std::array<double, 6> evaluate_model(const SymbolicModel& m, const std::vector<d
   const auto defaults = m.desc.parameter_defaults();
   for (std::size_t i = 0; i < m.params.size(); ++i)
     values[m.params[i]] = params.empty() ? defaults.at(m.desc.parameters[i].name) : params.at(i);
+  for (const Reciprocal& r : m.reciprocals)
+    values[r.symbol] = GiNaC::pow(r.divisor.subs(values), -1);
   std::array<double, 6> out{};
   for (int o = 0; o < kNumOutputs; ++o) {
     const GiNaC::ex v = m.outputs[o].to_ex(m.errors).subs(values).evalf();

@@ -105,15 +105,23 @@ std::string ExprPrinter::term(const ex& e, bool& negative) {
     }
     return number(n);
   }
-  if (!GiNaC::is_a<GiNaC::mul>(e)) return factor(e);
+  const bool divisor = GiNaC::is_a<GiNaC::power>(e) && GiNaC::is_a<GiNaC::numeric>(e.op(1)) &&
+                       GiNaC::ex_to<GiNaC::numeric>(e.op(1)).is_negative();
+  if (!GiNaC::is_a<GiNaC::mul>(e) && !divisor) return factor(e);
   GiNaC::numeric coeff = 1;
   std::vector<std::string> num, den;
-  for (const ex& op : canon_.sorted_ops(e)) {
+  for (const ex& op : divisor ? std::vector<ex>{e} : canon_.sorted_ops(e)) {
     if (GiNaC::is_a<GiNaC::numeric>(op)) {
       coeff *= GiNaC::ex_to<GiNaC::numeric>(op);
     } else if (GiNaC::is_a<GiNaC::power>(op) && GiNaC::is_a<GiNaC::numeric>(op.op(1)) &&
                GiNaC::ex_to<GiNaC::numeric>(op.op(1)).is_negative()) {
-      den.push_back(factor(GiNaC::pow(op.op(0), -op.op(1))));
+      ex base = op.op(0);
+      if (GiNaC::is_a<GiNaC::add>(base)) {  // the divisor's sign as CanonicalText chooses it
+        const CanonicalText::Signed r = canon_.canonical_sign(base);
+        if (r.negated && GiNaC::ex_to<GiNaC::numeric>(op.op(1)).is_odd()) coeff = -coeff;
+        base = r.value;
+      }
+      den.push_back(factor(GiNaC::pow(base, -op.op(1))));
     } else if (GiNaC::is_a<GiNaC::add>(op)) {
       const CanonicalText::Signed r = canon_.canonical_sign(op);
       if (r.negated) coeff = -coeff;
@@ -186,6 +194,14 @@ std::string ExprPrinter::factor(const ex& e) {
         ++ops_.muls;
       }
       return "(" + s + ")";
+    }
+    if (GiNaC::is_a<GiNaC::numeric>(expo) && GiNaC::ex_to<GiNaC::numeric>(expo).is_integer() &&
+        GiNaC::ex_to<GiNaC::numeric>(expo).is_negative()) {
+      // A divisor (derived ratios): 1 / b^n.
+      ++ops_.divs;
+      const std::string den = factor(GiNaC::pow(base, -expo));
+      if (style_ == Style::Latex) return "\\frac{1}{" + den + "}";
+      return (style_ == Style::Cpp ? "Scalar(1) / " : "1 / ") + den;
     }
     if (expo.is_equal(GiNaC::numeric(1, 2))) {
       ++ops_.functions;

@@ -52,6 +52,13 @@ class Poly {
   const Terms& terms() const { return terms_; }
   GiNaC::ex constant() const;  // degree-0 coefficient
   Poly without_constant() const;
+  // The same element with every coefficient c replaced by f(c) (zero results dropped).
+  template <typename F>
+  Poly mapped(F f) const {
+    Poly p;
+    for (const auto& [m, c] : terms_) p.add_term(m, f(c));
+    return p;
+  }
   int min_degree() const;  // of stored monomials; 0 for zero
 
   Poly operator+(const Poly& o) const;

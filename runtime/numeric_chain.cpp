@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "machine/derived.hpp"
+
 namespace weilgen {
 
 namespace {
@@ -52,7 +54,7 @@ Eigen::Matrix4d NumericChain::error_transform(int body, ErrorPlacement placement
   return m;
 }
 
-Eigen::Matrix4d NumericChain::body_transform(int body, const std::vector<double>& axes,
+Eigen::Matrix4d NumericChain::body_transform(int body, const std::vector<double>& q_body,
                                              const std::vector<double>& errors) const {
   const Body& b = desc_.bodies[body];
   Eigen::Vector3d t;
@@ -63,23 +65,69 @@ Eigen::Matrix4d NumericChain::body_transform(int body, const std::vector<double>
 
   Eigen::Matrix4d joint = Eigen::Matrix4d::Identity();
   if (b.joint.type != JointType::Fixed) {
-    const auto k = std::find(axis_bodies_.begin(), axis_bodies_.end(), body) - axis_bodies_.begin();
-    const double q = axes.at(static_cast<std::size_t>(k)) * b.joint.to_base;
-    joint = b.joint.type == JointType::Prismatic ? translation(q * vec(b.joint.axis))
-                                                 : rotation(vec(b.joint.axis), q);
+    const double q = q_body[static_cast<std::size_t>(body)] * b.joint.to_base;
+    if (b.joint.type == JointType::Prismatic) {
+      joint = translation(q * vec(b.joint.axis));
+    } else {
+      Eigen::Vector3d through;
+      for (int i = 0; i < 3; ++i) through[i] = b.joint.through[i].eval(params_);
+      joint = translation(through) * rotation(vec(b.joint.axis), q) * translation(-through);
+    }
   }
   const Eigen::Matrix4d axis = error_transform(body, ErrorPlacement::Axis, errors);
   return m * error_transform(body, ErrorPlacement::Before, errors) * axis * joint *
          rigid_inverse(axis) * error_transform(body, ErrorPlacement::After, errors);
 }
 
-Eigen::Matrix4d NumericChain::branch(const PointSpec& end, const std::vector<double>& axes,
+Eigen::Matrix4d NumericChain::branch(const PointSpec& end, const std::vector<double>& q_body,
                                      const std::vector<double>& errors) const {
   Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
-  for (int b : desc_.chain_to(end.body)) m = m * body_transform(b, axes, errors);
+  for (int b : desc_.chain_to(end.body)) m = m * body_transform(b, q_body, errors);
   Eigen::Vector3d p;
   for (int i = 0; i < 3; ++i) p[i] = end.point[i].eval(params_);
   return m * translation(p);
+}
+
+std::map<std::string, double> NumericChain::coordinate_values(
+    const std::vector<double>& axes) const {
+  std::map<std::string, double> values = params_;
+  for (std::size_t k = 0; k < axis_bodies_.size(); ++k)
+    values[desc_.bodies[static_cast<std::size_t>(axis_bodies_[k])].joint.coordinate] = axes[k];
+  resolve_links(desc_, values);
+  return values;
+}
+
+Eigen::Matrix4d NumericChain::output_transform(std::map<std::string, double> values,
+                                               const std::vector<double>& q_body,
+                                               const std::vector<double>& errors) const {
+  const std::vector<double> none(errors.size(), 0.0);
+  for (const ChainPoint& p : desc_.points) {
+    const Eigen::Vector3d d =
+        (branch(p.at, q_body, errors) - branch(p.at, q_body, none)).block<3, 1>(0, 3);
+    for (int i = 0; i < 3; ++i) values[p.name + "." + static_cast<char>('x' + i)] = d[i];
+  }
+  for (const Derived& q : desc_.derived) values[q.name] = q.value.eval(values);
+  auto vec3 = [&](const std::array<Expr, 3>& e) {
+    return Eigen::Vector3d(e[0].eval(values), e[1].eval(values), e[2].eval(values));
+  };
+  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+  for (const TransformStep& s : desc_.output->steps) {
+    if (s.kind == TransformStep::Kind::Translate) {
+      m = m * translation(vec3(s.translation));
+      continue;
+    }
+    // exp(ξ^ a) for ξ = (ω, v): a screw about the line through ω × v with pitch ω·v (|ω| = 1),
+    // or a translation by v·a (ω = 0).
+    const Eigen::Vector3d w = vec(s.omega), v = vec3(s.v);
+    const double a = s.amount.eval(values);
+    if (w.norm() == 0) {
+      m = m * translation(a * v);
+    } else {
+      const Eigen::Vector3d q = w.cross(v);
+      m = m * translation(q) * rotation(w, a) * translation(w.dot(v) * a * w - q);
+    }
+  }
+  return m * translation(vec3(desc_.output->point));
 }
 
 Eigen::Matrix4d NumericChain::tool_in_workpiece(const std::vector<double>& axes,
@@ -89,7 +137,15 @@ Eigen::Matrix4d NumericChain::tool_in_workpiece(const std::vector<double>& axes,
   if (errors.size() != desc_.errors.size())
     throw std::invalid_argument("expected " + std::to_string(desc_.errors.size()) +
                                 " error values");
-  return rigid_inverse(branch(desc_.workpiece, axes, errors)) * branch(desc_.tool, axes, errors);
+  const std::map<std::string, double> values = coordinate_values(axes);
+  std::vector<double> q_body(desc_.bodies.size(), 0.0);
+  for (std::size_t b = 0; b < desc_.bodies.size(); ++b) {
+    const Joint& j = desc_.bodies[b].joint;
+    if (j.type != JointType::Fixed) q_body[b] = values.at(j.coordinate);
+  }
+  if (desc_.output) return output_transform(values, q_body, errors);
+  return rigid_inverse(branch(desc_.workpiece, q_body, errors)) *
+         branch(desc_.tool, q_body, errors);
 }
 
 std::array<double, 6> NumericChain::deviation(const std::vector<double>& axes,

@@ -6,6 +6,8 @@
 
 #include <Eigen/Geometry>
 #include <array>
+#include <map>
+#include <string>
 #include <vector>
 
 #include "machine/description.hpp"
@@ -20,7 +22,8 @@ class NumericChain {
   // Parameter values in the order of Description::parameters (mm / deg).
   void set_parameters(const std::vector<double>& values);
 
-  // Tool frame (at the tool point) in the workpiece frame. `axes` in the joints' units, in
+  // Tool frame (at the tool point) in the workpiece frame; for a machine with an `output`
+  // transform, that transform (times Trans(point)) instead. `axes` in the joints' units, in
   // Description::axes() order; `errors` in base units (mm, rad), in Description::errors order.
   Eigen::Matrix4d tool_in_workpiece(const std::vector<double>& axes,
                                     const std::vector<double>& errors) const;
@@ -35,12 +38,19 @@ class NumericChain {
   std::size_t num_errors() const { return desc_.errors.size(); }
 
  private:
-  Eigen::Matrix4d body_transform(int body, const std::vector<double>& axes,
+  // q_body: each body's joint value in its unit (0 for fixed bodies).
+  Eigen::Matrix4d body_transform(int body, const std::vector<double>& q_body,
                                  const std::vector<double>& errors) const;
   Eigen::Matrix4d error_transform(int body, ErrorPlacement placement,
                                   const std::vector<double>& errors) const;
-  Eigen::Matrix4d branch(const PointSpec& end, const std::vector<double>& axes,
+  Eigen::Matrix4d branch(const PointSpec& end, const std::vector<double>& q_body,
                          const std::vector<double>& errors) const;
+  // Parameters, independent coordinates (from `axes`) and linked coordinates by name.
+  std::map<std::string, double> coordinate_values(const std::vector<double>& axes) const;
+  // Chain points, derived quantities (by name, into `values`) and the output transform.
+  Eigen::Matrix4d output_transform(std::map<std::string, double> values,
+                                   const std::vector<double>& q_body,
+                                   const std::vector<double>& errors) const;
 
   Description desc_;
   std::vector<int> axis_bodies_;

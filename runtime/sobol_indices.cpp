@@ -100,15 +100,6 @@ SobolDesign::SobolDesign(std::vector<InputDistribution> inputs, const SobolOptio
                                 std::to_string(samples_));
   if (samples_ > 0xffffffffu)
     throw std::invalid_argument("Sobol' design: the sample size N must be below 2^32");
-  if (sampling_ == Sampling::Qmc && (samples_ & (samples_ - 1)) != 0) {
-    std::size_t below = 1;
-    while (below * 2 < samples_) below *= 2;
-    throw std::invalid_argument(
-        "Sobol' design: quasi-Monte Carlo sampling needs a power-of-two "
-        "sample size N (the Sobol' net property), got " +
-        std::to_string(samples_) + "; use " + std::to_string(below) + " or " +
-        std::to_string(below * 2));
-  }
   for (std::size_t i = 0; i < inputs_.size(); ++i)
     if (!inputs_[i].is_constant()) varying_.push_back(i);
   const std::size_t k = inputs_.size(), kv = varying_.size();

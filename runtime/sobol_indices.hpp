@@ -16,7 +16,7 @@ namespace weilgen {
 enum class Sampling { Qmc, MonteCarlo };
 
 struct SobolOptions {
-  std::size_t samples = 1u << 14;  // N: base sample size (power of two required for Qmc)
+  std::size_t samples = 1u << 14;  // N: base sample size (a power of two is best for Qmc)
   Sampling sampling = Sampling::Qmc;
   std::uint64_t seed = 1;       // 0 with Qmc: unshifted Sobol' points (see sobol_sequence.hpp)
   std::size_t bootstrap = 200;  // bootstrap resamples for the confidence intervals (0 = none)
@@ -34,8 +34,10 @@ struct SobolOptions {
 // are drawn from std::mt19937_64 streams seeded from (seed, block of 1024 rows).
 // The bootstrap resample multiplicities for (options.seed, options.bootstrap) are drawn here too
 // (2 (R+1) N bytes), so repeated estimate_sobol calls with the same options do not redraw them.
-// Throws std::invalid_argument for samples < 2, a non-power-of-two N with Qmc, 2k' above the
-// Sobol' table's 3667 dimensions, or a confidence outside (0, 1).
+// Any N >= 2: with Qmc a power of two keeps the Sobol' net property (the most uniform design);
+// other N take the sequence's first N points (the pipe-cutter seed uses N = 20000).
+// Throws std::invalid_argument for samples < 2, 2k' above the Sobol' table's 3667 dimensions, or
+// a confidence outside (0, 1).
 class SobolDesign {
  public:
   SobolDesign(std::vector<InputDistribution> inputs, const SobolOptions& options);

@@ -183,7 +183,7 @@ TEST_CASE("analysis CLI: bad arguments give one clear line, exit 2 and leave out
       {"sensitivity gantry_grinder --at X=0,Y=0,Z=600 --set E_QQ=sigma:1um", "unknown error"},
       {"sensitivity gantry_grinder --grid X=0:1000:0,Y=0,Z=600", "count must be >= 1"},
       {"sensitivity gantry_grinder", "pose"},
-      {"sensitivity gantry_grinder --at X=0,Y=0,Z=600 --samples 1000", "power of two"},
+      {"sensitivity gantry_grinder --at X=0,Y=0,Z=600 --samples 1", "--samples must be >= 2"},
       {"sensitivity gantry_grinder --at X=0,Y=0,Z=600 --outputs dq", "dq"},
       {"reliability gantry_grinder --at X=0,Y=0,Z=600 --tolerance dx=0mm", "dx"},
       {"reliability gantry_grinder --at X=0,Y=0,Z=600 --tolerance dx=-1um", "dx"},

@@ -4,6 +4,7 @@
 
 #include "generated/five_axis_ac.hpp"
 #include "generated/gantry_grinder.hpp"
+#include "generated/pipe_cutter.hpp"
 #include "generated/two_axis.hpp"
 #include "generated/vmc_3axis.hpp"
 #include "machine/yaml_loader.hpp"
@@ -111,6 +112,7 @@ WEILGEN_MODEL_ADAPTER(gantry_grinder)
 WEILGEN_MODEL_ADAPTER(vmc_3axis)
 WEILGEN_MODEL_ADAPTER(two_axis)
 WEILGEN_MODEL_ADAPTER(five_axis_ac)
+WEILGEN_MODEL_ADAPTER(pipe_cutter)
 
 }  // namespace
 
@@ -118,5 +120,6 @@ TEST_CASE("generated headers agree with the exact chain and their coefficients a
   Checker<gantry_grinder_model>{"gantry_grinder"}.run();
   Checker<vmc_3axis_model>{"vmc_3axis"}.run();
   Checker<two_axis_model>{"two_axis"}.run();
+  Checker<pipe_cutter_model>{"pipe_cutter"}.run();
   Checker<five_axis_ac_model>{"five_axis_ac"}.run();
 }

@@ -23,12 +23,8 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 
 std::string load_error(const std::string& yaml) {
-  try {
-    load_machine_text(yaml, "bad.yaml");
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(loaded without error)";
+  const std::string m = test::load_error(yaml);
+  return m.empty() ? "(loaded without error)" : m;
 }
 
 // The load fails at `where` ("bad.yaml:line:column") with a message containing every word.
@@ -939,9 +935,14 @@ TEST_CASE("shipped machines are found through $WEILGEN_MACHINES_DIR when it is s
 }
 
 TEST_CASE("machine loader: every error's to_base matches its unit (explicit, iso and defaults)") {
-  const std::map<std::string, double> factor = {{"mm", 1.0},    {"um", 1e-3},  {"nm", 1e-6},
-                                                {"rad", 1.0},   {"mrad", 1e-3}, {"urad", 1e-6},
-                                                {"arcsec", M_PI / 648000}, {"deg", M_PI / 180}};
+  const std::map<std::string, double> factor = {{"mm", 1.0},
+                                                {"um", 1e-3},
+                                                {"nm", 1e-6},
+                                                {"rad", 1.0},
+                                                {"mrad", 1e-3},
+                                                {"urad", 1e-6},
+                                                {"arcsec", M_PI / 648000},
+                                                {"deg", M_PI / 180}};
   for (const auto& name : weilgen::test::shipped_machines()) {
     const auto d = weilgen::load_machine_file(weilgen::test::machine_path(name));
     for (const auto& e : d.errors) {

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "machine/description.hpp"
+#include "machine/yaml_loader.hpp"
 
 namespace weilgen::test {
 
@@ -43,9 +44,19 @@ inline Run run(const std::string& cmd) {
 // The weilgen command line with `args`.
 inline std::string cli(const std::string& args) { return std::string(WEILGEN_BINARY) + " " + args; }
 
+// The message of loading `yaml` as a machine file named `filename` ("" when it loads).
+inline std::string load_error(const std::string& yaml, const std::string& filename = "bad.yaml") {
+  try {
+    load_machine_text(yaml, filename);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
 inline const std::vector<std::string>& shipped_machines() {
   static const std::vector<std::string> m = {"gantry_grinder", "vmc_3axis", "two_axis",
-                                             "five_axis_ac"};
+                                             "five_axis_ac", "pipe_cutter"};
   return m;
 }
 

@@ -72,9 +72,27 @@ int Description::error_index(const std::string& error_name) const {
 std::vector<int> Description::axes() const {
   std::vector<int> out;
   for (size_t i = 0; i < bodies.size(); ++i) {
-    if (bodies[i].joint.type != JointType::Fixed) out.push_back(static_cast<int>(i));
+    if (bodies[i].joint.type != JointType::Fixed && !bodies[i].joint.link)
+      out.push_back(static_cast<int>(i));
   }
   return out;
+}
+
+std::vector<int> Description::linked_axes() const {
+  std::vector<int> out;
+  for (size_t i = 0; i < bodies.size(); ++i) {
+    if (bodies[i].joint.type != JointType::Fixed && bodies[i].joint.link)
+      out.push_back(static_cast<int>(i));
+  }
+  return out;
+}
+
+int Description::coordinate_body(const std::string& coordinate) const {
+  for (size_t i = 0; i < bodies.size(); ++i) {
+    if (bodies[i].joint.type != JointType::Fixed && bodies[i].joint.coordinate == coordinate)
+      return static_cast<int>(i);
+  }
+  return -1;
 }
 
 std::vector<int> Description::chain_to(int b) const {

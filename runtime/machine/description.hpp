@@ -56,9 +56,19 @@ struct Offset {
   bool is_identity() const;
 };
 
+// A moving joint, J(q) in its parent's frame. Given either in axis form (type, axis, optional
+// `through`) or as a twist ξ = (ω, v) with J(q) = exp(ξ^ q) (the seed's POE form): ω = 0 is a
+// prismatic joint along v, |ω| = 1 with ω·v = 0 a revolute joint about ω through ω × v. Both
+// forms fill the same fields; `twist` keeps the text as written for reports.
 struct Joint {
   JointType type = JointType::Fixed;
-  Vec3 axis{0, 0, 0};       // unit direction (prismatic) or rotation axis (revolute), parent frame
+  Vec3 axis{0, 0, 0};  // unit direction (prismatic) or rotation axis (revolute), parent frame
+  // Revolute: a point of the rotation axis line, parent frame, mm (origin unless `through`/twist).
+  std::array<Expr, 3> through{Expr::num(0), Expr::num(0), Expr::num(0)};
+  std::string twist;  // "[0, 0, 0, 1, 0, 0]" when given as a twist, else empty
+  // A linked joint (Y23.2 = -Y23.1): its value, in `unit`, as an expression of other coordinates
+  // and parameters. Linked joints are not inputs of the model (Description::axes() skips them).
+  std::optional<Expr> link;
   std::string coordinate;   // "X", "C", any identifier
   std::string unit;         // mm | um | m for prismatic; deg | rad for revolute
   double to_base = 1.0;     // coordinate value in `unit` * to_base = mm or rad
@@ -148,6 +158,45 @@ struct PointSpec {
   SourceLoc loc;
 };
 
+// A point on a chain whose deviation P(e) − P(0) (mm, base frame) derived quantities use as
+// `name.x`, `name.y`, `name.z` (the seed's E_0N of each jaw tip).
+struct ChainPoint {
+  std::string name;
+  PointSpec at;
+};
+
+// A named scalar of the algebra (mm, rad or dimensionless), in file order; its expression may use
+// parameters, coordinates (independent or linked), point components `P.x` and earlier derived
+// quantities. Divisors must be nominal (no error dependence) and non-zero over the travel range.
+struct Derived {
+  std::string name;
+  Expr value;
+  bool nominal = false;  // depends on no error (may be a divisor)
+  std::string description;
+  SourceLoc loc;
+};
+
+// One factor of the output transform: a translation (mm) or exp(ξ^ · amount) for a twist
+// ξ = (ω, v) (amount in rad when ω ≠ 0, else mm). Components are expressions like Derived.
+struct TransformStep {
+  enum class Kind { Translate, Twist };
+  Kind kind = Kind::Translate;
+  std::array<Expr, 3> translation{Expr::num(0), Expr::num(0), Expr::num(0)};
+  Vec3 omega{0, 0, 0};
+  std::array<Expr, 3> v{Expr::num(0), Expr::num(0), Expr::num(0)};
+  Expr amount = Expr::num(0);
+  SourceLoc loc;
+};
+
+// An output built from derived quantities instead of the tool/workpiece branches:
+// P = Π steps · Trans(point); dx..dc are the deviation of P as for W⁻¹·T.
+struct OutputTransform {
+  std::vector<TransformStep> steps;
+  std::array<Expr, 3> point{Expr::num(0), Expr::num(0), Expr::num(0)};
+  std::string description;  // what the output point is (report, `weilgen show`)
+  SourceLoc loc;
+};
+
 struct Description {
   std::string name;               // identifier, used for file and namespace names
   std::string title;              // human title
@@ -159,14 +208,22 @@ struct Description {
   std::vector<std::string> groups;  // builtin_groups() plus the file's `groups:`
   std::vector<Body> bodies;         // bodies[0] is the base; parents precede children
   std::vector<ErrorDef> errors;
-  PointSpec tool;       // tool point (cutting point) on the tool branch
+  PointSpec tool;       // tool point (cutting point) on the tool branch (unset with `output`)
   PointSpec workpiece;  // workpiece coordinate system origin on the workpiece branch
+  std::vector<ChainPoint> points;         // chain points used by derived quantities
+  std::vector<Derived> derived;           // in evaluation (file) order
+  std::optional<OutputTransform> output;  // replaces W⁻¹·T when present
 
   // Index lookups; -1 when absent.
   int body_index(const std::string& name) const;
   int error_index(const std::string& name) const;  // by name or alias
-  // Moving joints in tree order (bodies with a prismatic or revolute joint).
+  // The model's input axes in tree order: bodies with a prismatic or revolute joint that is not
+  // linked to other coordinates.
   std::vector<int> axes() const;
+  // Bodies with a linked joint, in tree order.
+  std::vector<int> linked_axes() const;
+  // Body whose joint coordinate is `coordinate` (independent or linked); -1 when none.
+  int coordinate_body(const std::string& coordinate) const;
   // Path from the base to body b (base first, b last).
   std::vector<int> chain_to(int b) const;
   std::map<std::string, double> parameter_defaults() const;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <optional>
 #include <set>
 #include <stdexcept>
 #include <utility>
@@ -32,7 +33,7 @@ Expr binary(Expr::Kind kind, Expr a, Expr b) {
 //   product := signed (('*' | '/') signed)*
 //   signed  := ('-' | '+') signed | power
 //   power   := primary ('^' signed)?          (right-associative; -2^2 = -(2^2))
-//   primary := number | identifier | '(' sum ')'
+//   primary := number | identifier ('.' ('x'|'y'|'z'))? | '(' sum ')'
 class Parser {
  public:
   explicit Parser(const std::string& text) : text_(text) {}
@@ -169,6 +170,13 @@ class Parser {
            (std::isalnum(static_cast<unsigned char>(text_[pos_])) || text_[pos_] == '_')) {
       ++pos_;
     }
+    // A component of a chain point: `E031.x` (machines/README.md, "Derived quantities").
+    if (pos_ + 1 < text_.size() && text_[pos_] == '.' &&
+        std::string("xyz").find(text_[pos_ + 1]) != std::string::npos &&
+        (pos_ + 2 == text_.size() ||
+         !(std::isalnum(static_cast<unsigned char>(text_[pos_ + 2])) || text_[pos_ + 2] == '_'))) {
+      pos_ += 2;
+    }
     std::string id = text_.substr(start, pos_ - start);
     skip_space();
     if (id == "pi") return Expr::num(kPi);
@@ -291,5 +299,24 @@ std::string Expr::str() const {
 }
 
 Expr parse_expr(const std::string& text) { return Parser(text).parse(); }
+
+Expr linear_combination(const std::vector<std::pair<double, Expr>>& terms) {
+  std::optional<Expr> sum;
+  for (const auto& [c, e] : terms) {
+    if (c == 0 || (e.is_number() && e.number == 0)) continue;
+    // −(−e) is e: the sign of a negated operand joins the coefficient's.
+    const bool inner_negated = e.kind == Expr::Kind::Neg;
+    const Expr& base = inner_negated ? *e.a : e;
+    const bool negative = (c < 0) != inner_negated;
+    const Expr term =
+        std::abs(c) == 1 ? base : binary(Expr::Kind::Mul, Expr::num(std::abs(c)), base);
+    if (!sum) {
+      sum = negative ? unary(Expr::Kind::Neg, term) : term;
+    } else {
+      sum = binary(negative ? Expr::Kind::Sub : Expr::Kind::Add, *sum, term);
+    }
+  }
+  return sum ? *sum : Expr::num(0);
+}
 
 }  // namespace weilgen

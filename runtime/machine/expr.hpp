@@ -6,6 +6,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace weilgen {
@@ -13,9 +14,9 @@ namespace weilgen {
 struct Expr {
   enum class Kind { Number, Param, Neg, Add, Sub, Mul, Div, Pow };
   Kind kind = Kind::Number;
-  double number = 0.0;                // Kind::Number
-  std::string name;                   // Kind::Param
-  std::shared_ptr<const Expr> a, b;   // operands
+  double number = 0.0;               // Kind::Number
+  std::string name;                  // Kind::Param
+  std::shared_ptr<const Expr> a, b;  // operands
 
   static Expr num(double v);
   static Expr param(std::string n);
@@ -28,6 +29,10 @@ struct Expr {
   bool is_number() const { return kind == Kind::Number; }
   std::string str() const;
 };
+
+// Σ c_i · e_i, without the terms whose coefficient is 0 (1 and −1 print without a factor); 0 for
+// no terms. Used to write derived vectors such as ω × v readably.
+Expr linear_combination(const std::vector<std::pair<double, Expr>>& terms);
 
 // Parses `text`. Identifiers must be parameter names (or `pi`); throws std::invalid_argument with a
 // message naming the offending character position.

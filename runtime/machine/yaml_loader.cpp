@@ -15,6 +15,7 @@
 #include <sstream>
 #include <utility>
 
+#include "machine/derived.hpp"
 #include "machine/iso_names.hpp"
 #include "machine/text.hpp"
 #include "model_key.hpp"
@@ -47,13 +48,17 @@ const std::vector<Unit> kPrismaticUnits = {
 const std::vector<Unit> kRevoluteUnits = {{"deg", kPi / 180, true}, {"rad", 1, true}};
 const std::vector<Unit> kParameterUnits = {{"mm", 1, false}, {"deg", 1, true}};
 
-const std::vector<std::string> kTopKeys = {"weilgen", "name",       "title",    "notes",
-                                           "algebra", "parameters", "groups",   "error_defaults",
-                                           "bodies",  "tool",       "workpiece"};
+const std::vector<std::string> kTopKeys = {
+    "weilgen",        "name",   "title", "notes",     "algebra", "parameters", "groups",
+    "error_defaults", "bodies", "tool",  "workpiece", "points",  "derived",    "output"};
 const std::vector<std::string> kBodyKeys = {"parent", "offset", "joint", "errors"};
 const std::vector<std::string> kOffsetKeys = {"translation", "rotation"};
 const std::vector<std::string> kRotationKeys = {"axis", "angle"};
-const std::vector<std::string> kJointKeys = {"type", "axis", "coordinate", "unit", "range"};
+const std::vector<std::string> kJointKeys = {"type",       "axis", "twist", "through",
+                                             "coordinate", "unit", "range", "linked"};
+const std::vector<std::string> kDerivedKeys = {"value", "description"};
+const std::vector<std::string> kOutputKeys = {"transform", "point", "description"};
+const std::vector<std::string> kStepKeys = {"translate", "twist", "by"};
 const std::vector<std::string> kDistributionKeys = {"sigma", "normal", "uniform", "truncnormal"};
 const std::vector<std::string> kErrorKeys = {"aliases", "group",     "unit",      "dependence",
                                              "effect",  "direction", "placement", "description",
@@ -82,12 +87,6 @@ bool is_identifier(const std::string& s) {
   return std::all_of(s.begin(), s.end(), [](char c) {
     return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
   });
-}
-
-std::string format(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
 }
 
 // A value to read, the node to point at when it is wrong (a null value has no useful position of
@@ -162,10 +161,24 @@ class Loader {
     if (const Entry* e = top.find("groups")) read_groups(e->value);
     if (const Entry* e = top.find("error_defaults")) read_error_defaults(e->value);
     read_bodies(required(top, "bodies"));
-    d_.tool = read_point_spec(required(top, "tool").value);
-    d_.workpiece = read_point_spec(required(top, "workpiece").value);
+    if (const Entry* e = top.find("points")) read_points(e->value);
+    if (const Entry* e = top.find("derived")) read_derived(e->value);
+    if (const Entry* e = top.find("output")) {
+      for (const char* key : {"tool", "workpiece"}) {
+        if (const Entry* t = top.find(key)) {
+          fail_at(t->key_node, "",
+                  std::string("'") + key +
+                      "' does not apply: this machine's output is the 'output' transform");
+        }
+      }
+      d_.output = read_output(e->value);
+    } else {
+      d_.tool = read_point_spec(required(top, "tool").value);
+      d_.workpiece = read_point_spec(required(top, "workpiece").value);
+    }
     if (const Entry* e = top.find("algebra")) read_algebra(e->value);
     d_.source_file = file_;
+    check_derived(d_);
     return std::move(d_);
   }
 
@@ -479,7 +492,8 @@ class Loader {
   }
 
   void check_interval(const Field& f, double lo, double hi) const {
-    if (lo >= hi) fail(f, "lo (" + format(lo) + ") must be less than hi (" + format(hi) + ")");
+    if (lo >= hi)
+      fail(f, "lo (" + format_short(lo) + ") must be less than hi (" + format_short(hi) + ")");
   }
 
   // ---- Bodies ---------------------------------------------------------------------------------
@@ -538,10 +552,16 @@ class Loader {
     const MapView m = map(e.value, kJointKeys);
     Joint j;
     j.loc = loc(e.key_node);
-    j.type = choice<JointType>(required(m, "type").value, {{"fixed", JointType::Fixed},
-                                                           {"prismatic", JointType::Prismatic},
-                                                           {"revolute", JointType::Revolute}});
-    if (j.type == JointType::Fixed) {
+    const Entry* twist = m.find("twist");
+    const Entry* type = m.find("type");
+    if (!type && !twist)
+      fail(m.self, "missing required key 'type' (or give the joint as a 'twist')");
+    if (type) {
+      j.type = choice<JointType>(type->value, {{"fixed", JointType::Fixed},
+                                               {"prismatic", JointType::Prismatic},
+                                               {"revolute", JointType::Revolute}});
+    }
+    if (type && j.type == JointType::Fixed) {
       for (const Entry& other : m.entries) {
         if (other.key != "type") {
           fail_at(other.key_node, m.self.path, "a fixed joint takes no '" + other.key + "'");
@@ -549,7 +569,24 @@ class Loader {
       }
       return j;
     }
-    j.axis = direction(required(m, "axis").value);
+    if (twist) {
+      for (const char* key : {"axis", "through"}) {
+        if (const Entry* other = m.find(key)) {
+          fail_at(other->key_node, m.self.path,
+                  std::string("give either 'twist' or '") + key +
+                      "', not both (a twist's v already places the axis)");
+        }
+      }
+      read_twist(twist->value, type ? std::optional<JointType>(j.type) : std::nullopt, j);
+    } else {
+      j.axis = direction(required(m, "axis").value);
+      if (const Entry* t = m.find("through")) {
+        if (j.type != JointType::Revolute) {
+          fail_at(t->key_node, m.self.path, "'through' places a revolute joint's axis line");
+        }
+        j.through = point(t->value);
+      }
+    }
     const Field& coordinate = required(m, "coordinate").value;
     j.coordinate = identifier(coordinate, "coordinate");
     claim_symbol(j.coordinate, "coordinate", coordinate);
@@ -559,13 +596,141 @@ class Loader {
     if (const Entry* ue = m.find("unit")) u = unit(ue->value, units);
     j.unit = u->name;
     j.to_base = u->to_base;
-    if (const Entry* r = m.find("range")) {
-      const std::vector<Field> v = items(r->value, 2, 2, "[min, max]");
+    const Entry* range = m.find("range");
+    if (const Entry* l = m.find("linked")) {
+      if (range) {
+        fail_at(range->key_node, m.self.path,
+                "a linked coordinate has no range of its own: it follows from 'linked'");
+      }
+      j.link = parsed(l->value);  // names are checked once all coordinates are known
+    }
+    if (range) {
+      const std::vector<Field> v = items(range->value, 2, 2, "[min, max]");
       j.min = number(v[0]);
       j.max = number(v[1]);
-      if (j.min > j.max) fail(r->value, "min " + text(v[0]) + " is greater than max " + text(v[1]));
+      if (j.min > j.max)
+        fail(range->value, "min " + text(v[0]) + " is greater than max " + text(v[1]));
     }
     return j;
+  }
+
+  // ξ = [ωx, ωy, ωz, vx, vy, vz] (the seed's twists): ω numbers, v expressions over parameters.
+  void read_twist(const Field& f, std::optional<JointType> declared, Joint& j) const {
+    const std::vector<Field> xi = items(f, 6, 6, "a twist [wx, wy, wz, vx, vy, vz]");
+    const Vec3 w{number(xi[0]), number(xi[1]), number(xi[2])};
+    std::array<Expr, 3> v{expression(xi[3]), expression(xi[4]), expression(xi[5])};
+    const double wn = std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+    std::string textual;
+    for (const Field& x : xi) textual += (textual.empty() ? "" : ", ") + text(x);
+    j.twist = "[" + textual + "]";
+    if (wn == 0) {
+      j.type = JointType::Prismatic;
+      for (const Expr& c : v) {
+        if (!c.is_number()) {
+          fail(f, "a prismatic twist (w = 0) has a unit direction v of numbers, not '" + c.str() +
+                      "'");
+        }
+      }
+      j.axis = {v[0].number, v[1].number, v[2].number};
+      const double vn =
+          std::sqrt(j.axis[0] * j.axis[0] + j.axis[1] * j.axis[1] + j.axis[2] * j.axis[2]);
+      if (std::abs(vn - 1) > 1e-9) {
+        fail(f, "a prismatic twist (w = 0) needs a unit v, |v| = " + format_short(vn) +
+                    " (scale the coordinate's unit instead)");
+      }
+    } else {
+      if (std::abs(wn - 1) > 1e-9)
+        fail(f, "w must be a unit vector or zero, |w| = " + format_short(wn));
+      j.type = JointType::Revolute;
+      j.axis = w;
+      double pitch = 0;
+      for (int i = 0; i < 3; ++i) pitch += w[i] * v[i].eval(parameter_defaults_);
+      if (std::abs(pitch) > 1e-12) {
+        fail(f, "screw joints are not supported: the pitch w·v = " + format_short(pitch) +
+                    " mm/rad must be 0 (v = -w × q for an axis through q)");
+      }
+      // The axis passes through q = w × v (for w·v = 0, v = -w × q).
+      j.through = {linear_combination({{w[1], v[2]}, {-w[2], v[1]}}),
+                   linear_combination({{w[2], v[0]}, {-w[0], v[2]}}),
+                   linear_combination({{w[0], v[1]}, {-w[1], v[0]}})};
+    }
+    if (declared && *declared != j.type) {
+      fail(f, std::string("the twist describes a ") +
+                  (j.type == JointType::Prismatic ? "prismatic" : "revolute") +
+                  " joint, but 'type' says otherwise");
+    }
+  }
+
+  // ---- Points, derived quantities, output transform ---------------------------------------
+
+  void read_points(const Field& f) {
+    const MapView m = map(f, {}, "point name");
+    for (const Entry& e : m.entries) {
+      ChainPoint p;
+      p.name = key_identifier(e, f.path, "point name");
+      claim_symbol(p.name, "chain point", {e.key_node, e.key_node, f.path});
+      p.at = read_point_spec(e.value);
+      d_.points.push_back(std::move(p));
+    }
+  }
+
+  void read_derived(const Field& f) {
+    const MapView m = map(f, {}, "quantity name");
+    for (const Entry& e : m.entries) {
+      Derived q;
+      q.name = key_identifier(e, f.path, "derived quantity name");
+      claim_symbol(q.name, "derived quantity", {e.key_node, e.key_node, f.path});
+      if (e.value.node.IsMap()) {
+        const MapView qm = map(e.value, kDerivedKeys);
+        q.value = parsed(required(qm, "value").value);
+        q.loc = loc(required(qm, "value").value.where);
+        if (const Entry* t = qm.find("description")) q.description = text(t->value);
+      } else {
+        q.value = parsed(e.value);
+        q.loc = loc(e.value.where);
+      }
+      d_.derived.push_back(std::move(q));
+    }
+  }
+
+  OutputTransform read_output(const Field& f) const {
+    const MapView m = map(f, kOutputKeys);
+    OutputTransform out;
+    out.loc = loc(f.where);
+    for (const Field& item : items(required(m, "transform").value, 1, SIZE_MAX,
+                                   "a list of {translate: [x, y, z]} and {twist: [...], by: q}")) {
+      const MapView sm = map(item, kStepKeys);
+      TransformStep step;
+      step.loc = loc(item.where);
+      if (const Entry* t = sm.find("translate")) {
+        if (sm.entries.size() != 1) fail(item, "a translate step has no other keys");
+        const std::vector<Field> xyz = items(t->value, 3, 3, "[x, y, z]");
+        for (int i = 0; i < 3; ++i) step.translation[static_cast<size_t>(i)] = parsed(xyz[i]);
+      } else if (const Entry* tw = sm.find("twist")) {
+        step.kind = TransformStep::Kind::Twist;
+        const std::vector<Field> xi = items(tw->value, 6, 6, "a twist [wx, wy, wz, vx, vy, vz]");
+        step.omega = {number(xi[0]), number(xi[1]), number(xi[2])};
+        const double wn = std::sqrt(step.omega[0] * step.omega[0] + step.omega[1] * step.omega[1] +
+                                    step.omega[2] * step.omega[2]);
+        if (wn != 0 && std::abs(wn - 1) > 1e-9) {
+          fail(tw->value, "w must be a unit vector or zero, |w| = " + format_short(wn));
+        }
+        for (int i = 0; i < 3; ++i) step.v[static_cast<size_t>(i)] = parsed(xi[i + 3]);
+        step.amount = parsed(required(sm, "by").value);
+      } else {
+        fail(item, "a step is {translate: [x, y, z]} or {twist: [wx, wy, wz, vx, vy, vz], by: q}");
+      }
+      out.steps.push_back(std::move(step));
+    }
+    out.point = point_formula(required(m, "point").value);
+    if (const Entry* t = m.find("description")) out.description = text(t->value);
+    return out;
+  }
+
+  // Names in output and derived expressions are resolved by check_derived() (machine/derived.hpp).
+  std::array<Expr, 3> point_formula(const Field& f) const {
+    const std::vector<Field> xyz = items(f, 3, 3, "[x, y, z]");
+    return {parsed(xyz[0]), parsed(xyz[1]), parsed(xyz[2])};
   }
 
   // Parent names to indices (file order).
