@@ -117,7 +117,7 @@ struct Builder {
   // Expr over parameters and coordinates (links, twist axes) → GiNaC.
   ex nominal(const Expr& e) const {
     const Poly p = value(e, {});
-    if (p.min_degree() > 0 || p.terms().size() > 1)
+    if (!p.is_constant())
       throw std::logic_error("nominal expression depends on errors: " + e.str());
     return p.constant();
   }
@@ -198,8 +198,7 @@ struct Builder {
       case Expr::Kind::Pow: {
         const Poly base = value(*e.a, names);
         const double k = e.b->number;
-        if (base.min_degree() == 0 && base.terms().size() <= 1)
-          return Poly(GiNaC::pow(base.constant(), exact_decimal(k)));
+        if (base.is_constant()) return Poly(GiNaC::pow(base.constant(), exact_decimal(k)));
         Poly p(1);
         for (int i = 0; i < static_cast<int>(k); ++i) p = p.mul(base, alg);
         return p;

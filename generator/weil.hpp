@@ -60,6 +60,8 @@ class Poly {
     return p;
   }
   int min_degree() const;  // of stored monomials; 0 for zero
+  // True when the element has no error term (zero or a constant): a nominal quantity.
+  bool is_constant() const { return terms_.empty() || (terms_.size() == 1 && min_degree() == 0); }
 
   Poly operator+(const Poly& o) const;
   Poly operator-(const Poly& o) const;

@@ -32,7 +32,10 @@ Eigen::Matrix4d rigid_inverse(const Eigen::Matrix4d& m) {
 }  // namespace
 
 NumericChain::NumericChain(Description desc)
-    : desc_(std::move(desc)), axis_bodies_(desc_.axes()), params_(desc_.parameter_defaults()) {}
+    : desc_(std::move(desc)),
+      axis_bodies_(desc_.axes()),
+      linked_bodies_(desc_.linked_axes()),
+      params_(desc_.parameter_defaults()) {}
 
 void NumericChain::set_parameters(const std::vector<double>& values) {
   if (values.size() != desc_.parameters.size())
@@ -137,12 +140,18 @@ Eigen::Matrix4d NumericChain::tool_in_workpiece(const std::vector<double>& axes,
   if (errors.size() != desc_.errors.size())
     throw std::invalid_argument("expected " + std::to_string(desc_.errors.size()) +
                                 " error values");
-  const std::map<std::string, double> values = coordinate_values(axes);
   std::vector<double> q_body(desc_.bodies.size(), 0.0);
-  for (std::size_t b = 0; b < desc_.bodies.size(); ++b) {
-    const Joint& j = desc_.bodies[b].joint;
-    if (j.type != JointType::Fixed) q_body[b] = values.at(j.coordinate);
-  }
+  for (std::size_t k = 0; k < axis_bodies_.size(); ++k)
+    q_body[static_cast<std::size_t>(axis_bodies_[k])] = axes[k];
+  // Names are needed only for linked coordinates and the output transform: serial machines
+  // evaluate without building them (this chain is the numeric engine's hot path).
+  if (linked_bodies_.empty() && !desc_.output)
+    return rigid_inverse(branch(desc_.workpiece, q_body, errors)) *
+           branch(desc_.tool, q_body, errors);
+  const std::map<std::string, double> values = coordinate_values(axes);
+  for (int b : linked_bodies_)
+    q_body[static_cast<std::size_t>(b)] =
+        values.at(desc_.bodies[static_cast<std::size_t>(b)].joint.coordinate);
   if (desc_.output) return output_transform(values, q_body, errors);
   return rigid_inverse(branch(desc_.workpiece, q_body, errors)) *
          branch(desc_.tool, q_body, errors);

@@ -54,6 +54,7 @@ class NumericChain {
 
   Description desc_;
   std::vector<int> axis_bodies_;
+  std::vector<int> linked_bodies_;  // bodies with a linked joint
   std::map<std::string, double> params_;
 };
 

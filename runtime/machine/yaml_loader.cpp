@@ -614,16 +614,25 @@ class Loader {
     return j;
   }
 
+  // The six fields of a twist [ωx, ωy, ωz, vx, vy, vz] and its ω: numbers, a unit vector or zero.
+  std::vector<Field> twist_fields(const Field& f, Vec3& w) const {
+    std::vector<Field> xi = items(f, 6, 6, "a twist [wx, wy, wz, vx, vy, vz]");
+    w = {number(xi[0]), number(xi[1]), number(xi[2])};
+    const double wn = std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+    if (wn != 0 && std::abs(wn - 1) > 1e-9)
+      fail(f, "w must be a unit vector or zero, |w| = " + format_short(wn));
+    return xi;
+  }
+
   // ξ = [ωx, ωy, ωz, vx, vy, vz] (the seed's twists): ω numbers, v expressions over parameters.
   void read_twist(const Field& f, std::optional<JointType> declared, Joint& j) const {
-    const std::vector<Field> xi = items(f, 6, 6, "a twist [wx, wy, wz, vx, vy, vz]");
-    const Vec3 w{number(xi[0]), number(xi[1]), number(xi[2])};
+    Vec3 w;
+    const std::vector<Field> xi = twist_fields(f, w);
     std::array<Expr, 3> v{expression(xi[3]), expression(xi[4]), expression(xi[5])};
-    const double wn = std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
     std::string textual;
     for (const Field& x : xi) textual += (textual.empty() ? "" : ", ") + text(x);
     j.twist = "[" + textual + "]";
-    if (wn == 0) {
+    if (w == Vec3{0, 0, 0}) {
       j.type = JointType::Prismatic;
       for (const Expr& c : v) {
         if (!c.is_number()) {
@@ -639,8 +648,6 @@ class Loader {
                     " (scale the coordinate's unit instead)");
       }
     } else {
-      if (std::abs(wn - 1) > 1e-9)
-        fail(f, "w must be a unit vector or zero, |w| = " + format_short(wn));
       j.type = JointType::Revolute;
       j.axis = w;
       double pitch = 0;
@@ -708,13 +715,7 @@ class Loader {
         for (int i = 0; i < 3; ++i) step.translation[static_cast<size_t>(i)] = parsed(xyz[i]);
       } else if (const Entry* tw = sm.find("twist")) {
         step.kind = TransformStep::Kind::Twist;
-        const std::vector<Field> xi = items(tw->value, 6, 6, "a twist [wx, wy, wz, vx, vy, vz]");
-        step.omega = {number(xi[0]), number(xi[1]), number(xi[2])};
-        const double wn = std::sqrt(step.omega[0] * step.omega[0] + step.omega[1] * step.omega[1] +
-                                    step.omega[2] * step.omega[2]);
-        if (wn != 0 && std::abs(wn - 1) > 1e-9) {
-          fail(tw->value, "w must be a unit vector or zero, |w| = " + format_short(wn));
-        }
+        const std::vector<Field> xi = twist_fields(tw->value, step.omega);
         for (int i = 0; i < 3; ++i) step.v[static_cast<size_t>(i)] = parsed(xi[i + 3]);
         step.amount = parsed(required(sm, "by").value);
       } else {
