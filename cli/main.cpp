@@ -41,6 +41,14 @@ const std::map<std::string, Verb>& verbs() {
        {weilgen::cli::verb_allocate,
         "allocate <machine> --grid ... --tolerance ... --min 0.95 --mean 0.97\n"
         "      tighten the most sensitive errors until the reliability targets hold"}},
+      {"iso230-2",
+       {weilgen::cli::verb_iso230_2,
+        "iso230-2 <data.csv> [--axis X] [--json FILE] [--plot FILE]\n"
+        "      ISO 230-2 positioning figures, with the thermal-drift-eliminated evaluation"}},
+      {"fit-pdge",
+       {weilgen::cli::verb_fit_pdge,
+        "fit-pdge <data.csv> [--basis poly|fourier|legendre|chebyshev|all] [--order n|auto]\n"
+        "      fit position-dependent errors, choose the order by cross-validation"}},
 #endif
   };
   return v;
