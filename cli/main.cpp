@@ -49,6 +49,11 @@ const std::map<std::string, Verb>& verbs() {
        {weilgen::cli::verb_fit_pdge,
         "fit-pdge <data.csv> [--basis poly|fourier|legendre|chebyshev|all] [--order n|auto]\n"
         "      fit position-dependent errors, choose the order by cross-validation"}},
+      {"identify",
+       {weilgen::cli::verb_identify,
+        "identify <machine> --data FILE [--pdge poly:3|E_YY=fourier:3] [--predict FILE]\n"
+        "      [--emit-params FILE]\n"
+        "      fit the error parameters, report what cannot be identified, predict, emit"}},
 #endif
   };
   return v;

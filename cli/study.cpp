@@ -20,7 +20,7 @@ namespace po = boost::program_options;
 
 namespace weilgen::cli {
 
-void add_study_options(po::options_description& opts, StudyFlags& f, bool with_tolerance) {
+po::options_description model_options(StudyFlags& f) {
   po::options_description model("Model");
   model.add_options()("order", po::value<int>(&f.order),
                       "algebra order r >= 1 overriding the machine file's (compiles a model)")(
@@ -32,6 +32,11 @@ void add_study_options(po::options_description& opts, StudyFlags& f, bool with_t
       "'none' disables compilation)")("param",
                                       po::value<std::vector<std::string>>(&f.params)->composing(),
                                       "NAME=VALUE machine parameter (mm or deg), repeatable");
+  return model;
+}
+
+void add_study_options(po::options_description& opts, StudyFlags& f, bool with_tolerance) {
+  const po::options_description model = model_options(f);
   po::options_description where("Poses and distributions (docs/study-inputs.md)");
   where.add_options()("at", po::value<std::vector<std::string>>(&f.at)->composing(),
                       "one pose, e.g. X=0,Y=1500,Z=600 (axis units mm/deg); repeatable")(
@@ -91,8 +96,7 @@ std::vector<double> parse_params(const Description& d, const std::vector<std::st
 
 }  // namespace
 
-Study open_study(const StudyFlags& f, bool need_tolerances) {
-  if (f.machine.empty()) throw std::invalid_argument("no machine given");
+std::shared_ptr<Model> open_model(const StudyFlags& f, const Description& desc) {
   if (f.order < 0) throw std::invalid_argument("--order must be >= 1");
   LoadOptions lo;
   lo.order = f.order;
@@ -109,7 +113,14 @@ Study open_study(const StudyFlags& f, bool need_tolerances) {
   lo.builtins = builtin_models();
   lo.generate = generate_for_loader;
   if (!f.quiet) lo.log = [](const std::string& m) { std::cerr << "weilgen: " << m << "\n"; };
+  std::shared_ptr<Model> model = load_model(desc, lo);
+  // Parameters are part of what the machine is: set before the model is shared.
+  if (!f.params.empty()) model->set_parameters(parse_params(desc, f.params, model->parameters()));
+  return model;
+}
 
+Study open_study(const StudyFlags& f, bool need_tolerances) {
+  if (f.machine.empty()) throw std::invalid_argument("no machine given");
   const Description desc = load_machine_file(resolve_machine(f.machine));
   Study s;
   s.poses = parse_poses(desc, f.at, f.grid);
@@ -118,10 +129,7 @@ Study open_study(const StudyFlags& f, bool need_tolerances) {
     if (f.tolerance.empty()) throw std::invalid_argument("no --tolerance given (e.g. dx=0.03mm)");
     s.tolerances = parse_tolerances(f.tolerance);
   }
-  std::shared_ptr<Model> model = load_model(desc, lo);
-  // Parameters are part of what the machine is: set before the model is shared.
-  if (!f.params.empty()) model->set_parameters(parse_params(desc, f.params, model->parameters()));
-  s.model = model;
+  s.model = open_model(f, desc);
   s.threads = resolve_threads(f.threads);
   return s;
 }

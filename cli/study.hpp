@@ -33,6 +33,13 @@ struct StudyFlags {
 void add_study_options(boost::program_options::options_description& opts, StudyFlags& flags,
                        bool with_tolerance);
 
+// The "Model" flags alone: --order --engine --compiler --param.
+boost::program_options::options_description model_options(StudyFlags& flags);
+
+// The machine's model (built-in, cached, compiled or numeric chain; logged to stderr unless
+// quiet) with --param applied. Throws std::invalid_argument for bad flags.
+std::shared_ptr<Model> open_model(const StudyFlags& flags, const Description& desc);
+
 struct Study {
   std::shared_ptr<const Model> model;
   PoseSet poses;

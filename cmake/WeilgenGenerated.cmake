@@ -25,11 +25,18 @@ if(WEILGEN_BUILD_TESTS)
     get_filename_component(model ${header} NAME_WE)
     foreach(std 17 20)
       set(tu ${CMAKE_CURRENT_BINARY_DIR}/header_check/${model}_cxx${std}.cpp)
+      if(model MATCHES "_params$")  # identified parameters (weilgen identify --emit-params)
+        file(CONFIGURE OUTPUT ${tu} CONTENT
+          "// Standalone compile check of generated/${model}.hpp (C++${std}).\n#include \"${model}.hpp\"\n\
+template void weilgen_models::${model}::Errors<double>(const std::array<double, weilgen_models::${model}::kNumAxes>&, std::array<double, weilgen_models::${model}::kNumErrors>*);\n\
+template void weilgen_models::${model}::Errors<float>(const std::array<float, weilgen_models::${model}::kNumAxes>&, std::array<float, weilgen_models::${model}::kNumErrors>*);\n")
+      else()
       file(CONFIGURE OUTPUT ${tu} CONTENT
         "// Standalone compile check of generated/${model}.hpp (C++${std}).\n#include \"${model}.hpp\"\n\
 template void weilgen_models::${model}::Deviation<double>(const std::array<double, weilgen_models::${model}::kNumAxes>&, const std::array<double, weilgen_models::${model}::kNumErrors>&, const std::array<double, weilgen_models::${model}::kNumParams>&, std::array<double, 3>*, std::array<double, 3>*);\n\
 template void weilgen_models::${model}::Deviation<float>(const std::array<float, weilgen_models::${model}::kNumAxes>&, const std::array<float, weilgen_models::${model}::kNumErrors>&, const std::array<float, weilgen_models::${model}::kNumParams>&, std::array<float, 3>*, std::array<float, 3>*);\n\
 template void weilgen_models::${model}::Coefficients<double>(const std::array<double, weilgen_models::${model}::kNumAxes>&, const std::array<double, weilgen_models::${model}::kNumParams>&, std::array<double, 3 * weilgen_models::${model}::kNumErrors>*, std::array<double, 3 * weilgen_models::${model}::kNumErrors>*);\n")
+      endif()
       add_library(header_check_${model}_cxx${std} OBJECT ${tu})
       target_include_directories(header_check_${model}_cxx${std} PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/generated)
       set_target_properties(header_check_${model}_cxx${std} PROPERTIES CXX_STANDARD ${std} CXX_EXTENSIONS OFF)

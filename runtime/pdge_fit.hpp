@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "pdge_basis.hpp"
+#include "machine/pdge_basis.hpp"
 
 namespace weilgen {
 

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "pdge_basis.hpp"
+#include "machine/pdge_basis.hpp"
 #include "pdge_fit.hpp"
 
 using namespace weilgen;

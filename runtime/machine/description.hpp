@@ -117,6 +117,10 @@ struct ErrorDef {
   ErrorPlacement placement = ErrorPlacement::After;
   int body = -1;  // index into Description::bodies
   std::string description;
+  // Identification basis of a PDGE ("poly:3", "fourier:2:20"; machine/pdge_basis.hpp); empty =
+  // the machine's pdge_basis, else the identify default.
+  std::string basis;
+  SourceLoc basis_loc;
   SourceLoc loc;
 };
 
@@ -213,6 +217,8 @@ struct Description {
   std::vector<ChainPoint> points;         // chain points used by derived quantities
   std::vector<Derived> derived;           // in evaluation (file) order
   std::optional<OutputTransform> output;  // replaces W⁻¹·T when present
+  std::string pdge_basis;                 // default identification basis of PDGEs ("poly:3")
+  SourceLoc pdge_basis_loc;
 
   // Index lookups; -1 when absent.
   int body_index(const std::string& name) const;

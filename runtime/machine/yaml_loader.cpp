@@ -17,6 +17,7 @@
 
 #include "machine/derived.hpp"
 #include "machine/iso_names.hpp"
+#include "machine/pdge_basis.hpp"
 #include "machine/text.hpp"
 #include "model_key.hpp"
 
@@ -48,9 +49,10 @@ const std::vector<Unit> kPrismaticUnits = {
 const std::vector<Unit> kRevoluteUnits = {{"deg", kPi / 180, true}, {"rad", 1, true}};
 const std::vector<Unit> kParameterUnits = {{"mm", 1, false}, {"deg", 1, true}};
 
-const std::vector<std::string> kTopKeys = {
-    "weilgen",        "name",   "title", "notes",     "algebra", "parameters", "groups",
-    "error_defaults", "bodies", "tool",  "workpiece", "points",  "derived",    "output"};
+const std::vector<std::string> kTopKeys = {"weilgen", "name",       "title",     "notes",
+                                           "algebra", "parameters", "groups",    "error_defaults",
+                                           "bodies",  "tool",       "workpiece", "points",
+                                           "derived", "output",     "pdge_basis"};
 const std::vector<std::string> kBodyKeys = {"parent", "offset", "joint", "errors"};
 const std::vector<std::string> kOffsetKeys = {"translation", "rotation"};
 const std::vector<std::string> kRotationKeys = {"axis", "angle"};
@@ -60,9 +62,9 @@ const std::vector<std::string> kDerivedKeys = {"value", "description"};
 const std::vector<std::string> kOutputKeys = {"transform", "point", "description"};
 const std::vector<std::string> kStepKeys = {"translate", "twist", "by"};
 const std::vector<std::string> kDistributionKeys = {"sigma", "normal", "uniform", "truncnormal"};
-const std::vector<std::string> kErrorKeys = {"aliases", "group",     "unit",      "dependence",
-                                             "effect",  "direction", "placement", "description",
-                                             "sigma",   "normal",    "uniform",   "truncnormal"};
+const std::vector<std::string> kErrorKeys = {
+    "aliases",     "group", "unit",   "dependence", "effect",      "direction", "placement",
+    "description", "sigma", "normal", "uniform",    "truncnormal", "basis"};
 const std::vector<std::string> kDefaultKeys = {"sigma", "normal", "uniform", "truncnormal", "unit"};
 const std::vector<std::string> kParameterKeys = {"value", "unit", "description"};
 const std::vector<std::string> kPointKeys = {"body", "point"};
@@ -177,9 +179,24 @@ class Loader {
       d_.workpiece = read_point_spec(required(top, "workpiece").value);
     }
     if (const Entry* e = top.find("algebra")) read_algebra(e->value);
+    if (const Entry* e = top.find("pdge_basis")) {
+      d_.pdge_basis = basis_text(e->value);
+      d_.pdge_basis_loc = loc(e->value.where);
+    }
     d_.source_file = file_;
     check_derived(d_);
     return std::move(d_);
+  }
+
+  // A PDGE basis spelling (poly:3, fourier:2:20); checked here so a typo names its line.
+  std::string basis_text(const Field& f) const {
+    const std::string s = text(f);
+    try {
+      parse_basis(s);
+    } catch (const std::invalid_argument& e) {
+      fail(f, e.what());
+    }
+    return s;
   }
 
   // read_distribution_keys(): the distribution keys of any mapping, other keys ignored.
@@ -964,6 +981,10 @@ class Loader {
                                                         {"axis", ErrorPlacement::Axis}});
     } else if (!iso) {
       err.placement = ErrorPlacement::After;
+    }
+    if (const Entry* e = m.find("basis")) {
+      err.basis = basis_text(e->value);
+      err.basis_loc = loc(e->value.where);
     }
     if (const Entry* e = m.find("dependence")) {
       err.dependence =

@@ -6,7 +6,7 @@
 #include <cstdlib>
 #include <stdexcept>
 
-#include "machine/text.hpp"
+#include "text.hpp"
 
 namespace weilgen {
 namespace {
