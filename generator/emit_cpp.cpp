@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "cse.hpp"
+#include "emit_compensation.hpp"
 #include "model_key.hpp"
 #include "printer.hpp"
 #include "version.hpp"
@@ -287,6 +288,35 @@ std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_la
     high = function_body(inputs, {{"terms", h}});
   }
 
+  // Nominal kinematics: the pose at zero errors and its Jacobian in the axes' units (a revolute
+  // column per deg is the per-rad derivative times to_base).
+  std::vector<ex> npos, nrot;
+  for (int i = 0; i < 3; ++i) {
+    npos.push_back(m.nominal[i][3]);
+    for (int j = 0; j < 3; ++j) nrot.push_back(m.nominal[i][j]);
+  }
+  const FunctionCode pose = function_body(inputs, {{"position", npos}, {"rotation", nrot}});
+  // A unit factor is a named constant, `_to_baseN * (...)`, not multiplied into every term.
+  InputTable jinputs = inputs;
+  std::map<double, GiNaC::symbol> unit_factor;
+  std::vector<ex> jac(m.nominal_jacobian.size());
+  const std::size_t na = m.axes.size();
+  for (std::size_t k = 0; k < jac.size(); ++k) {
+    const double to_base = d.bodies[m.axes[k % na].body].joint.to_base;
+    jac[k] = m.nominal_jacobian[k];
+    if (to_base == 1.0 || jac[k].is_zero()) continue;
+    auto it = unit_factor.find(to_base);
+    if (it == unit_factor.end()) {
+      const std::string code = "_to_base" + std::to_string(unit_factor.size());
+      it = unit_factor.emplace(to_base, GiNaC::symbol(code)).first;
+      jinputs.code_name[code] = code;
+      jinputs.definition[code] = "Scalar(" + format_double(to_base) + ")";
+      jinputs.order.push_back(code);
+    }
+    jac[k] = it->second * jac[k];
+  }
+  const FunctionCode jacobian = function_body(jinputs, {{"jacobian", jac}});
+
   std::vector<std::string> axis_names, error_names, param_names;
   for (const auto& a : m.axes) axis_names.push_back(d.bodies[a.body].joint.coordinate);
   for (const auto& e : d.errors) error_names.push_back(e.name);
@@ -308,6 +338,12 @@ std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_la
   os << "//   Coefficients: " << coef.ops.str() << ", " << coef.temps << " temporaries\n";
   if (!higher.empty())
     os << "//   HigherOrder:  " << high.ops.str() << ", " << high.temps << " temporaries\n";
+  os << "//   NominalPose:  " << pose.ops.str() << ", " << pose.temps << " temporaries\n";
+  os << "//   NominalJacobian: " << jacobian.ops.str() << ", " << jacobian.temps
+     << " temporaries\n";
+  os << "//   Compensate:   per iteration errors_at + Deviation + NominalPose + "
+     << (m.axes_turn_output() ? 6 : 3) << "x" << na
+     << " least-squares step; once per call NominalJacobian + NominalPose + Cholesky\n";
   os << "#pragma once\n\n#include <array>\n#include <cmath>\n#include <cstddef>\n\n";
   os << "namespace weilgen_models {\nnamespace " << d.name << " {\n\n";
 
@@ -430,6 +466,30 @@ std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_la
           "  using std::cos;\n  using std::sin;\n  using std::sqrt;\n"
        << high.body << "}\n";
   }
+  os << "\n// Nominal pose (every error zero) of "
+     << (d.output ? "the output transform" : "the tool frame in the workpiece frame")
+     << ":\n// position of the " << (d.output ? "output" : "tool")
+     << " point in mm, rotation row-major (R[i][j] at 3i+j). Null outputs are skipped.\n";
+  os << "template <typename Scalar>\nvoid NominalPose([[maybe_unused]] const std::array<Scalar, "
+        "kNumAxes>& axes,\n"
+        "                 [[maybe_unused]] const std::array<Scalar, kNumParams>& params,\n"
+        "                 std::array<Scalar, 3>* const position,\n"
+        "                 std::array<Scalar, 9>* const rotation = nullptr) {\n"
+        "  using std::cos;\n  using std::sin;\n  using std::sqrt;\n"
+     << pose.body << "}\n";
+  os << "\n// Jacobian of the nominal pose with respect to the axes, row-major [output][axis]: "
+        "rows "
+        "dx, dy, dz\n"
+        "// (mm per axis unit: mm/mm, mm/deg) and da, db, dc (rad per axis unit), the rotation "
+        "rate\n"
+        "// vee(dR/dq R^T) as in Deviation's orientation. Columns in kAxes order.\n";
+  os << "template <typename Scalar>\nvoid NominalJacobian([[maybe_unused]] const "
+        "std::array<Scalar, kNumAxes>& axes,\n"
+        "                     [[maybe_unused]] const std::array<Scalar, kNumParams>& params,\n"
+        "                     std::array<Scalar, 6 * kNumAxes>* const jacobian) {\n"
+        "  using std::cos;\n  using std::sin;\n  using std::sqrt;\n"
+     << jacobian.body << "}\n\n";
+  os << compensation_code(m.axes_turn_output());
   os << "\n}  // namespace " << d.name << "\n}  // namespace weilgen_models\n";
   return os.str();
 }

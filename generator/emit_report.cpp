@@ -195,6 +195,45 @@ std::string emit_report_markdown(const SymbolicModel& m, const std::string& sour
     os << " |\n";
   }
 
+  os << "\n## Nominal kinematics (NominalPose, NominalJacobian, Compensate)\n\n"
+     << "Nominal pose at zero errors: position of the " << (d.output ? "output" : "tool")
+     << " point in mm.\n\n```text\n";
+  for (int i = 0; i < 3; ++i)
+    os << kOutputNames[i][1] << "0 = " << pr.print(m.with_divisors(m.nominal[i][3])) << "\n";
+  os << "```\n\nJacobian of the nominal pose per mm (prismatic) or per rad (revolute); the "
+        "header's `NominalJacobian` is per axis unit (a column per deg is this times π/180). "
+        "Orientation rows are the rotation rate vee(∂R/∂q·Rᵀ).\n\n"
+        "| axis | dx | dy | dz | da | db | dc |\n| --- | --- | --- | --- | --- | --- | --- |\n";
+  const std::size_t na = m.axes.size();
+  std::vector<std::string> idle;
+  for (std::size_t k = 0; k < na; ++k) {
+    const std::string& name = d.bodies[m.axes[k].body].joint.coordinate;
+    os << "| " << name;
+    bool moves = false;
+    for (int o = 0; o < kNumOutputs; ++o) {
+      const ex c = m.with_divisors(m.nominal_jacobian[o * na + k]);
+      moves |= !c.is_zero();
+      os << " | " << (c.is_zero() ? "·" : pr.print(c));
+    }
+    os << " |\n";
+    if (!moves) idle.push_back(name);
+  }
+  os << "\n`Compensate` (docs/compensation.md) solves in least squares over the position rows"
+     << (m.axes_turn_output()
+             ? std::string(" and the orientation rows: the tilt of the tool axis (z) "
+                           "weighted by kCompensationLengthMm, the spin about it by "
+                           "kCompensationSpinWeight of that")
+             : std::string(" (no axis turns the ") + (d.output ? "output frame" : "tool") +
+                   ": orientation is not compensated)")
+     << ".";
+  if (!idle.empty()) {
+    os << " The nominal pose does not depend on ";
+    for (std::size_t i = 0; i < idle.size(); ++i)
+      os << (i == 0 ? "" : i + 1 == idle.size() ? " and " : ", ") << idle[i];
+    os << ": the least-squares problem is singular and `Compensate` returns -1.";
+  }
+  os << "\n";
+
   os << "\n## Errors\n\n| name | aliases | body | group | placement | PIGE/PDGE | unit | "
         "distribution |\n| --- | --- | --- | --- | --- | --- | --- | --- |\n";
   for (const auto& e : d.errors) {

@@ -355,7 +355,55 @@ std::vector<Monomial> relation_monomials(const Description& d) {
   return out;
 }
 
+// de/dq_axis in the axis' base unit (per mm, per rad). The chain rule through the symbols that
+// stand for functions of the coordinate: cos(q), sin(q) of a revolute one (d cos = −sin·dq,
+// d sin = cos·dq with q in rad) and the reciprocals (d(1/D) = −(1/D)²·dD); GiNaC differentiates
+// the rest (the coordinate itself, in its unit, and cos/sin functions of linked coordinates).
+ex axis_derivative(const SymbolicModel& m, const Algebra& alg, const ex& e, std::size_t axis) {
+  const AxisSymbols& a = m.axes[axis];
+  ex d = e.diff(a.coordinate) / exact_decimal(m.desc.bodies[a.body].joint.to_base);
+  if (a.revolute) d += e.diff(a.cos) * (-a.sin) + e.diff(a.sin) * a.cos;
+  for (const Reciprocal& r : m.reciprocals) {
+    const ex dr = e.diff(r.symbol);
+    if (!dr.is_zero()) d -= dr * GiNaC::pow(r.symbol, 2) * axis_derivative(m, alg, r.divisor, axis);
+  }
+  return alg.normalize(d);
+}
+
+// The nominal pose P0 of `p` and its Jacobian (SymbolicModel::nominal, nominal_jacobian).
+void set_nominal_kinematics(SymbolicModel& model, const Mat4& p, const Algebra& alg) {
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 4; ++j) model.nominal[i][j] = alg.normalize(p.m[i][j].constant());
+  const std::size_t n = model.axes.size();
+  model.nominal_jacobian.assign(6 * n, ex(0));
+  for (std::size_t k = 0; k < n; ++k) {
+    std::array<std::array<ex, 3>, 3> dr;  // dR0/dq
+    for (int i = 0; i < 3; ++i) {
+      model.nominal_jacobian[i * n + k] = axis_derivative(model, alg, model.nominal[i][3], k);
+      for (int j = 0; j < 3; ++j) dr[i][j] = axis_derivative(model, alg, model.nominal[i][j], k);
+    }
+    // Ω = dR0/dq · R0ᵀ is skew (R0 stays a rotation); its axial vector is the rotation rate. The
+    // antisymmetric part keeps it exact even where cos² + sin² of a linked angle is not reduced.
+    const auto omega = [&](int i, int j) {
+      ex s = 0;
+      for (int l = 0; l < 3; ++l) s += dr[i][l] * model.nominal[j][l];
+      return s;
+    };
+    const GiNaC::numeric half(1, 2);
+    model.nominal_jacobian[3 * n + k] = alg.normalize(half * (omega(2, 1) - omega(1, 2)));
+    model.nominal_jacobian[4 * n + k] = alg.normalize(half * (omega(0, 2) - omega(2, 0)));
+    model.nominal_jacobian[5 * n + k] = alg.normalize(half * (omega(1, 0) - omega(0, 1)));
+  }
+}
+
 }  // namespace
+
+bool SymbolicModel::axes_turn_output() const {
+  const std::size_t n = axes.size();
+  for (std::size_t i = 3 * n; i < nominal_jacobian.size(); ++i)
+    if (!nominal_jacobian[i].is_zero()) return true;
+  return false;
+}
 
 ex SymbolicModel::with_divisors(const ex& c) const {
   if (reciprocals.empty()) return c;
@@ -456,6 +504,7 @@ SymbolicModel build_model(const Description& desc, int order_override) {
   // Ratios with nominal divisors (derived quantities) expand into sums of fractions over the
   // same divisor; one fraction numerator/denominator reads better and costs fewer operations.
   for (Poly& out : model.outputs) out = out.mapped([&](const ex& c) { return b.as_fraction(c); });
+  set_nominal_kinematics(model, p, alg);
   return model;
 }
 

@@ -42,6 +42,16 @@ struct SymbolicModel {
   std::vector<GiNaC::symbol> params;
   std::array<Poly, kNumOutputs> outputs;  // deviation, as algebra elements (no constant term)
   std::vector<Reciprocal> reciprocals;    // symbols standing for 1/divisor in coefficients
+  // The nominal pose P0 (every error zero): rows 0..2 of the 4x4 transform, R0 | p0, over the
+  // coordinates, their cos/sin symbols and the parameters.
+  std::array<std::array<GiNaC::ex, 4>, 3> nominal;
+  // d(nominal output)/d(axis) in base units (per mm, per rad), row-major [output][axis], axes in
+  // `axes` order: position rows dp0/dq, orientation rows vee(dR0/dq · R0ᵀ) (the convention of
+  // the orientation outputs, ΔR = R·R0ᵀ). A derivative by the GiNaC differentiation of the chain.
+  std::vector<GiNaC::ex> nominal_jacobian;
+  // True when some axis turns the output frame (an orientation row of nominal_jacobian is not
+  // identically zero): Compensate then weighs orientation rows too.
+  bool axes_turn_output() const;
 
   // c with each reciprocal symbol replaced by 1/divisor: for printing and numeric evaluation.
   GiNaC::ex with_divisors(const GiNaC::ex& c) const;
