@@ -54,6 +54,10 @@ const std::map<std::string, Verb>& verbs() {
         "identify <machine> --data FILE [--pdge poly:3|E_YY=fourier:3] [--predict FILE]\n"
         "      [--emit-params FILE]\n"
         "      fit the error parameters, report what cannot be identified, predict, emit"}},
+      {"gap",
+       {weilgen::cli::verb_gap,
+        "gap <machine> --data FILE [--holdout ...] [--effects ...] [--json F] [--report F.md]\n"
+        "      where model and machine disagree, which unmodelled effect, how far it shrinks"}},
 #endif
   };
   return v;

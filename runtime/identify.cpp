@@ -271,6 +271,30 @@ std::vector<NullCombination> null_combinations(const SvdSolve& s,
 
 }  // namespace
 
+MatrixXd design_matrix(const Model& model, const ErrorParameterisation& param,
+                       const PointData& data) {
+  const std::size_t m = data.observations.size(), np = param.size(), ne = model.num_errors();
+  ModelData md(model);
+  std::vector<double> jac(np);
+  MatrixXd A(static_cast<Eigen::Index>(m), static_cast<Eigen::Index>(np));
+  std::size_t last_row = SIZE_MAX;
+  for (std::size_t i = 0; i < m; ++i) {
+    const PointObservation& ob = data.observations[i];
+    const double* pose = data.poses[ob.row].data();
+    if (ob.row != last_row) {
+      model.coefficients(md, pose, md.coeff.data());
+      param.derivatives(pose, jac.data());
+      last_row = ob.row;
+    }
+    const double* c = md.coeff.data() + static_cast<std::size_t>(ob.output) * ne;
+    for (std::size_t p = 0; p < np; ++p)
+      A(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(p)) =
+          kOutputScale[static_cast<std::size_t>(ob.output)] *
+          c[static_cast<std::size_t>(param.parameters()[p].error)] * jac[p];
+  }
+  return A;
+}
+
 Identification::Identification(const Model& model, const ErrorParameterisation& param,
                                IdentifyOptions options)
     : model_(model), param_(param), options_(std::move(options)) {}
@@ -296,30 +320,14 @@ void Identification::run(const PointData& data) {
   R.count = data.count;
 
   ModelData md(model_);
-  const std::size_t ne = model_.num_errors();
-  std::vector<double> jac(np);
   VectorXd y(static_cast<Eigen::Index>(m));
   for (std::size_t i = 0; i < m; ++i) y[static_cast<Eigen::Index>(i)] = data.observations[i].value;
 
-  // Linear model at zero error: A[i, p] = scale_o · C[o][err_p] · ∂err_p/∂θ_p.
+  // Linear model at zero error, without the fixed parameters.
+  const MatrixXd full = design_matrix(model_, param_, data);
   MatrixXd A(static_cast<Eigen::Index>(m), static_cast<Eigen::Index>(cols.size()));
-  std::size_t last_row = SIZE_MAX;
-  for (std::size_t i = 0; i < m; ++i) {
-    const PointObservation& ob = data.observations[i];
-    const double* pose = data.poses[ob.row].data();
-    if (ob.row != last_row) {
-      model_.coefficients(md, pose, md.coeff.data());
-      param_.derivatives(pose, jac.data());
-      last_row = ob.row;
-    }
-    const double* c = md.coeff.data() + static_cast<std::size_t>(ob.output) * ne;
-    for (std::size_t q = 0; q < cols.size(); ++q) {
-      const std::size_t p = cols[q];
-      A(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(q)) =
-          kOutputScale[static_cast<std::size_t>(ob.output)] *
-          c[static_cast<std::size_t>(param_.parameters()[p].error)] * jac[p];
-    }
-  }
+  for (std::size_t q = 0; q < cols.size(); ++q)
+    A.col(static_cast<Eigen::Index>(q)) = full.col(static_cast<Eigen::Index>(cols[q]));
   SvdSolve S = solve(A, y, options_.rank_tolerance);
   for (std::size_t q = 0; q < cols.size(); ++q)
     R.theta[cols[q]] = S.x[static_cast<Eigen::Index>(q)];

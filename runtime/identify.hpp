@@ -15,6 +15,7 @@
 // variance, identifiability flags and the residual RMS per output.
 #pragma once
 
+#include <Eigen/Dense>
 #include <array>
 #include <cstddef>
 #include <optional>
@@ -108,6 +109,11 @@ extern const std::array<const char*, 6> kDeviationColumns;
 // be a column (InputError "file: missing column 'Z' ..."), coordinate cells finite (file:line
 // naming the column), and at least one deviation cell measured.
 PointData point_data(const MeasurementTable& table, const Description& desc);
+
+// The first-order design matrix: row i is observation i, column p parameter p, in µm (µrad) per
+// unit of θ_p: scale_o · C[o][error_p](pose) · ∂error_p/∂θ_p(pose).
+Eigen::MatrixXd design_matrix(const Model& model, const ErrorParameterisation& param,
+                              const PointData& data);
 
 struct IdentifyOptions {
   double rank_tolerance = 1e-9;    // singular values below tol · σ_max (equilibrated) are null

@@ -68,16 +68,7 @@ std::string arg_error(const std::function<void()>& f) {
   return "no invalid_argument";
 }
 
-std::shared_ptr<Model> vmc_model() {
-  static std::shared_ptr<Model> m = [] {
-    LoadOptions o;
-    o.builtins = builtin_models();
-    o.cache_dir = test::fresh_dir("ballbar_cache").string();
-    o.compiler = "none";
-    return load_model(load_machine_file(test::machine_path("vmc_3axis")), o);
-  }();
-  return m;
-}
+std::shared_ptr<Model> vmc_model() { return test::builtin_model("vmc_3axis"); }
 
 // The seed's circle (section 4).
 BallbarCircle seed_circle(const BallbarMachine& m) {

@@ -22,16 +22,7 @@ using namespace weilgen;
 
 namespace {
 
-std::shared_ptr<Model> vmc() {
-  static std::shared_ptr<Model> m = [] {
-    LoadOptions o;
-    o.builtins = builtin_models();
-    o.cache_dir = test::fresh_dir("identify_cache").string();
-    o.compiler = "none";
-    return load_model(load_machine_file(test::machine_path("vmc_3axis")), o);
-  }();
-  return m;
-}
+std::shared_ptr<Model> vmc() { return test::builtin_model("vmc_3axis"); }
 
 PdgeBasisChoice basis(const std::string& spec) {
   PdgeBasisChoice c;

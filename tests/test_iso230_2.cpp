@@ -16,6 +16,8 @@
 #include "plot.hpp"
 #include "test_support.hpp"
 
+#include "bench/experiments/normal_deviates.hpp"
+
 using namespace weilgen;
 using nlohmann::json;
 using test::cli;
@@ -26,30 +28,7 @@ namespace {
 
 const double kSqrt2 = std::sqrt(2.0);
 
-// Deterministic standard normal deviates: Box-Muller on mt19937_64 (std::normal_distribution
-// differs between standard libraries).
-class Normal {
- public:
-  explicit Normal(std::uint64_t seed) : g_(seed) {}
-  double operator()() {
-    if (has_spare_) {
-      has_spare_ = false;
-      return spare_;
-    }
-    const double u1 = (static_cast<double>(g_() >> 11) + 1.0) * 0x1.0p-53;  // (0, 1]
-    const double u2 = static_cast<double>(g_() >> 11) * 0x1.0p-53;
-    const double r = std::sqrt(-2.0 * std::log(u1));
-    spare_ = r * std::sin(2 * M_PI * u2);
-    has_spare_ = true;
-    return r * std::cos(2 * M_PI * u2);
-  }
-  double uniform() { return static_cast<double>(g_() >> 11) * 0x1.0p-53; }
-
- private:
-  std::mt19937_64 g_;
-  double spare_ = 0;
-  bool has_spare_ = false;
-};
+using Normal = weilgen::bench::NormalDeviates;  // bench/experiments/normal_deviates.hpp
 
 std::string small_csv() {
   return std::string(WEILGEN_SOURCE_DIR) + "/examples/data/iso230_2_small.csv";

@@ -7,12 +7,16 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <map>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
 
 #include "machine/description.hpp"
+#include "builtin_models.hpp"
 #include "machine/yaml_loader.hpp"
+#include "model_loader.hpp"
 
 namespace weilgen::test {
 
@@ -110,6 +114,20 @@ inline double loglog_slope(const std::vector<double>& s, const std::vector<doubl
     sxx += (std::log(s[i]) - mx) * (std::log(s[i]) - mx);
   }
   return sxy / sxx;
+}
+
+// A shipped machine's built-in model (no compiler; one per name for the whole test run).
+inline std::shared_ptr<Model> builtin_model(const std::string& name) {
+  static std::map<std::string, std::shared_ptr<Model>> cache;
+  auto& m = cache[name];
+  if (!m) {
+    LoadOptions o;
+    o.builtins = builtin_models();
+    o.cache_dir = fresh_dir("builtin_" + name).string();
+    o.compiler = "none";
+    m = load_model(load_machine_file(machine_path(name)), o);
+  }
+  return m;
 }
 
 }  // namespace weilgen::test

@@ -30,6 +30,8 @@
 
 #include "generated/vmc_3axis.hpp"
 
+#include "bench/experiments/normal_deviates.hpp"
+
 namespace {
 
 namespace vmc = weilgen_models::vmc_3axis;
@@ -38,27 +40,7 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kCx = 343.507, kCy = -285.090, kCz = -286.430, kR = 100;
 constexpr double kOffsetX = 3.0, kOffsetY = -1.5, kLength = -0.8, kSigma = 0.2;  // µm
 
-class Normal {
- public:
-  explicit Normal(std::uint64_t seed) : rng_(seed) {}
-  double operator()(double sigma) {
-    if (has_spare_) {
-      has_spare_ = false;
-      return sigma * spare_;
-    }
-    const double u1 = (static_cast<double>(rng_() >> 11) + 1) * 0x1.0p-53;  // (0, 1]
-    const double u2 = static_cast<double>(rng_() >> 11) * 0x1.0p-53;
-    const double r = std::sqrt(-2 * std::log(u1));
-    spare_ = r * std::sin(2 * kPi * u2);
-    has_spare_ = true;
-    return sigma * r * std::cos(2 * kPi * u2);
-  }
-
- private:
-  std::mt19937_64 rng_;
-  double spare_ = 0;
-  bool has_spare_ = false;
-};
+using Normal = weilgen::bench::NormalDeviates;  // bench/experiments/normal_deviates.hpp
 
 // The errors at (x, y) in base units (mm, rad), kErrors order.
 std::array<double, vmc::kNumErrors> errors_at(double x, double y) {

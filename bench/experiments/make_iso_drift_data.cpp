@@ -18,29 +18,11 @@
 #include <random>
 #include <string>
 
+#include "bench/experiments/normal_deviates.hpp"
+
 namespace {
 
-class Normal {
- public:
-  explicit Normal(std::uint64_t seed) : g_(seed) {}
-  double operator()() {
-    if (has_spare_) {
-      has_spare_ = false;
-      return spare_;
-    }
-    const double u1 = (static_cast<double>(g_() >> 11) + 1.0) * 0x1.0p-53;
-    const double u2 = static_cast<double>(g_() >> 11) * 0x1.0p-53;
-    const double r = std::sqrt(-2.0 * std::log(u1));
-    spare_ = r * std::sin(2 * M_PI * u2);
-    has_spare_ = true;
-    return r * std::cos(2 * M_PI * u2);
-  }
-
- private:
-  std::mt19937_64 g_;
-  double spare_ = 0;
-  bool has_spare_ = false;
-};
+using Normal = weilgen::bench::NormalDeviates;  // bench/experiments/normal_deviates.hpp
 
 }  // namespace
 

@@ -23,6 +23,8 @@ class NormalDeviates {
     has_spare_ = true;
     return r * std::cos(2 * M_PI * u2);
   }
+  double operator()(double sigma) { return sigma * (*this)(); }
+  double uniform() { return static_cast<double>(g_() >> 11) * 0x1.0p-53; }  // [0, 1)
 
  private:
   std::mt19937_64 g_;

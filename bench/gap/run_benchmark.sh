@@ -1,0 +1,86 @@
+#!/usr/bin/env bash
+# The sim-to-real gap benchmark in one command (bench/gap/README.md): writes the suite with fixed
+# seeds, runs `weilgen gap` on every scenario (2 at a time by default), scores the verdicts.
+#
+#   bench/gap/run_benchmark.sh WEILGEN [WORKDIR] [--quick] [--jobs N] [--layouts grid,line]
+#                              [--reps N] [--nones N] [--resume] [-- EXTRA GAP ARGS]
+#
+# WEILGEN is the weilgen executable (or any program with its `gap` interface, e.g.
+# bench/gap/fake_gap.sh). WORKDIR defaults to build-gap/gap-bench. Results: WORKDIR/results.md
+# and WORKDIR/results.json. Exit status: 0 all targets pass, 3 some target fails, 1 error.
+# The synth and score programs are found in $WEILGEN_GAP_BIN, else build-gap/bench/gap or
+# build/bench/gap under the repository.
+set -euo pipefail
+
+here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+root=$(cd "$here/../.." && pwd)
+
+usage() { sed -n '2,12p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; }
+[[ $# -ge 1 && $1 != -h && $1 != --help ]] || { usage; exit 2; }
+
+weilgen=$1
+shift
+[[ -x $weilgen ]] || { echo "run_benchmark.sh: $weilgen is not executable" >&2; exit 2; }
+weilgen=$(cd "$(dirname "$weilgen")" && pwd)/$(basename "$weilgen")
+work=$root/build-gap/gap-bench
+if [[ $# -ge 1 && $1 != --* ]]; then work=$1; shift; fi
+jobs=2
+resume=0
+synth_args=()
+gap_args=()
+while [[ $# -gt 0 ]]; do
+  case $1 in
+    --quick) synth_args+=(--quick); shift ;;
+    --jobs) jobs=$2; shift 2 ;;
+    --layouts | --reps | --nones | --machine) synth_args+=("$1" "$2"); shift 2 ;;
+    --resume) resume=1; shift ;;
+    --) shift; gap_args=("$@"); break ;;
+    *) echo "run_benchmark.sh: unknown option $1" >&2; exit 2 ;;
+  esac
+done
+
+bin=${WEILGEN_GAP_BIN:-}
+if [[ -z $bin ]]; then
+  for d in "$root/build-gap/bench/gap" "$root/build/bench/gap"; do
+    [[ -x $d/weilgen_gap_synth && -x $d/weilgen_gap_score ]] && { bin=$d; break; }
+  done
+fi
+[[ -n $bin ]] || {
+  echo "run_benchmark.sh: build weilgen_gap_synth and weilgen_gap_score first:" >&2
+  echo "  cmake -B build-gap && cmake --build build-gap -j2 --target weilgen_gap_synth weilgen_gap_score" >&2
+  exit 1
+}
+
+start=$(date +%s)
+if [[ $resume == 0 || ! -f $work/manifest.tsv ]]; then
+  "$bin/weilgen_gap_synth" --suite "$work" --threads "$jobs" "${synth_args[@]}"
+fi
+
+# One scenario: its wall time goes to gap.time, its output to gap.log, its exit status to gap.rc.
+run_one() {
+  local dir=$1 model=$2 d=$work/$1
+  if [[ $resume == 1 && -f $d/gap.json && $d/gap.json -nt $d/data.csv ]]; then return 0; fi
+  rm -f "$d/gap.json"
+  local t0 t1 rc=0
+  t0=$(date +%s.%N)
+  "$weilgen" gap "$model" --data "$d/data.csv" --json "$d/gap.json" ${GAP_ARGS:-} \
+    >"$d/gap.log" 2>&1 || rc=$?
+  t1=$(date +%s.%N)
+  echo "$t0 $t1" | awk '{printf "%.3f\n", $2 - $1}' >"$d/gap.time"
+  echo "$rc" >"$d/gap.rc"
+  [[ $rc == 0 ]] || echo "  $dir ($model): weilgen gap exited $rc, see $d/gap.log" >&2
+}
+export -f run_one
+export work weilgen resume
+GAP_ARGS="${gap_args[*]:-}"
+export GAP_ARGS
+
+n=$(grep -vc '^#' "$work/manifest.tsv")
+echo "running $weilgen gap on $n scenarios, $jobs at a time ..."
+grep -v '^#' "$work/manifest.tsv" | cut -f1,3 | tr '\t' '\n' |
+  xargs -d '\n' -n 2 -P "$jobs" bash -c 'run_one "$1" "$2"' _
+echo "ran in $(( $(date +%s) - start )) s"
+
+rc=0
+"$bin/weilgen_gap_score" "$work" || rc=$?
+exit $rc

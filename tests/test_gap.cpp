@@ -1,0 +1,323 @@
+// Gap diagnosis (runtime/gap.hpp): each effect's fit on a small synthetic set, the false-positive
+// rate on effect-free data, the held-out splits and bad data.
+#include <doctest/doctest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <set>
+#include <sstream>
+
+#include "builtin_models.hpp"
+#include "gap.hpp"
+#include "model_loader.hpp"
+#include "numeric_chain.hpp"
+#include "test_support.hpp"
+
+using namespace weilgen;
+
+namespace {
+
+std::shared_ptr<const Model> vmc() { return test::builtin_model("vmc_3axis"); }
+
+struct Row {
+  double X, Y, Z, t_s, dir_X, cycle, T;
+};
+
+// Effect added to (dx, dy, dz) in µm at a row.
+using EffectFn = std::function<std::array<double, 3>(const Row&)>;
+
+// A grid of X, Y, Z visited in `cycles` cycles (X back and forth: dir_X), 60 s per pose, a
+// spindle temperature rising 2 K with a 1 h lag; deviations from the machine's own model with
+// random errors (poly:2), plus the effect and N(0, noise²).
+std::string synth(std::uint32_t seed, const EffectFn& effect, double noise = 0.5, int cycles = 4,
+                  int nx = 6, const std::function<std::array<double, 3>(const Row&)>& truth = {}) {
+  const Model& m = *vmc();
+  const Description& d = m.description();
+  PdgeBasisChoice c;
+  c.all = "poly:2";
+  const ErrorParameterisation p(d, c);
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> n(0, 1);
+  std::vector<double> theta;
+  for (const IdentParameter& ip : p.parameters())
+    theta.push_back(d.errors[static_cast<std::size_t>(ip.error)].distribution.b * n(rng));
+  ModelData md(m);
+  std::ostringstream s;
+  s << "X,Y,Z,t_s,dir_X,cycle,T_spindle,dx_um,dy_um,dz_um\n";
+  double t = 0;
+  for (int cy = 1; cy <= cycles; ++cy)
+    for (double Z : {-250.0, -150.0, -50.0})
+      for (double Y : {-350.0, -200.0, -50.0})
+        for (int k = 0; k < 2 * nx; ++k) {
+          const bool up = k < nx;
+          const int i = up ? k : 2 * nx - 1 - k;
+          const double X = 500.0 * i / (nx - 1);
+          const Row r{X,
+                      Y,
+                      Z,
+                      t,
+                      up ? 1.0 : -1.0,
+                      static_cast<double>(cy),
+                      22 + 2 * (1 - std::exp(-t / 3600))};
+          const double q[3] = {Y, X, Z};
+          std::array<double, 6> dev = predict_deviation(m, md, p, theta, q);
+          if (truth) {
+            const auto tr = truth(r);
+            for (int o = 0; o < 3; ++o)
+              dev[static_cast<std::size_t>(o)] = tr[static_cast<std::size_t>(o)];
+          }
+          const std::array<double, 3> e = effect(r);
+          s << X << "," << Y << "," << Z << "," << t << "," << r.dir_X << "," << cy << "," << r.T;
+          for (int o = 0; o < 3; ++o)
+            s << ","
+              << dev[static_cast<std::size_t>(o)] + e[static_cast<std::size_t>(o)] + noise * n(rng);
+          s << "\n";
+          t += 60;
+        }
+  return s.str();
+}
+
+GapResult diagnose(const std::string& csv, std::shared_ptr<const Model> model = vmc(),
+                   const std::string& holdout = "cycle:4") {
+  const MeasurementTable t = parse_measurements(csv, "g.csv");
+  PdgeBasisChoice c;
+  c.all = "poly:2";
+  const ErrorParameterisation p(model->description(), c, model->parameters());
+  const GapData d = gap_data(t, model->description());
+  GapDiagnosis g(model, p);
+  g.run(d, *parse_holdout(holdout), "test");
+  return g.result();
+}
+
+const EffectFit* effect(const GapResult& r, const std::string& name) {
+  for (const EffectFit& e : r.explanation)
+    if (e.name == name) return &e;
+  return nullptr;
+}
+
+EffectFn none = [](const Row&) { return std::array<double, 3>{0, 0, 0}; };
+
+}  // namespace
+
+TEST_CASE("gap: reversal on X is named, with its size") {
+  const GapResult r = diagnose(synth(1, [](const Row& w) {
+    return std::array<double, 3>{2.0 * w.dir_X, 0, 0};  // B = 4 µm in dx
+  }));
+  CHECK(r.verdict == "reversal");
+  const EffectFit* e = effect(r, "reversal");
+  REQUIRE(e);
+  CHECK(e->params.at("reversal_dx") == doctest::Approx(4.0).epsilon(0.1));
+  CHECK(e->heldout_rms_after_um < 1.2 * r.noise.sigma_um);
+  CHECK(r.noise.sigma_um == doctest::Approx(0.5).epsilon(0.15));
+}
+
+TEST_CASE("gap: a periodic error along X: period and amplitude") {
+  const GapResult r = diagnose(synth(
+      2,
+      [](const Row& w) {
+        return std::array<double, 3>{0, 3.0 * std::sin(2 * M_PI * w.X / 125.0), 0};
+      },
+      0.5, 3, 21));
+  CHECK(r.verdict == "periodic");
+  const EffectFit* e = effect(r, "periodic");
+  REQUIRE(e);
+  CHECK(e->params.at("period_mm") == doctest::Approx(125).epsilon(0.05));
+  CHECK(e->params.at("amplitude") == doctest::Approx(3.0).epsilon(0.15));
+  REQUIRE(e->region);
+  CHECK(e->region->output == "dy");
+}
+
+TEST_CASE("gap: thermal drift with a lagged sensor") {
+  const GapResult r = diagnose(synth(3, [](const Row& w) {
+    return std::array<double, 3>{3.0 * (w.T - 22), 0, -1.0 * (w.T - 22)};
+  }));
+  CHECK(r.verdict == "thermal_drift");
+  const EffectFit* e = effect(r, "thermal_drift");
+  REQUIRE(e);
+  CHECK(e->heldout_rms_after_um < 1.2 * r.noise.sigma_um);
+}
+
+TEST_CASE("gap: a local bump along Y in dz is localised") {
+  const GapResult r = diagnose(synth(
+      4,
+      [](const Row& w) {
+        return std::array<double, 3>{0, 0, 4.0 * std::exp(-0.5 * std::pow((w.X - 300) / 40, 2))};
+      },
+      0.5, 3, 11));
+  CHECK(r.verdict == "pdge_shape");
+  const EffectFit* e = effect(r, "pdge_shape");
+  REQUIRE(e);
+  REQUIRE(e->region);
+  CHECK(e->region->by == "X");
+  CHECK(e->region->from <= 300);
+  CHECK(e->region->to >= 300);
+}
+
+TEST_CASE("gap: an angular error the machine file leaves out is named") {
+  // The model lacks E_AX (roll of X); the data come from the full machine with
+  // E_AX(x) = 40 µrad · u², u = (2x − 500)/500. (A constant E_AX, or a missing squareness,
+  // would be absorbed by E_AY's or E_CY's constant term: not a gap.)
+  std::string yaml;
+  {
+    std::ifstream in(test::machine_path("vmc_3axis"));
+    std::stringstream ss;
+    ss << in.rdbuf();
+    yaml = ss.str();
+  }
+  const auto at = yaml.find("      E_AX:");
+  REQUIRE(at != std::string::npos);
+  yaml.erase(at, yaml.find('\n', at) - at + 1);
+  const Description reduced = load_machine_text(yaml, "vmc_no_AX.yaml");
+  auto model = std::make_shared<const Model>(reduced, 1, "numeric chain");
+  const Model& full = *vmc();
+  ModelData md(full);
+  const int k = full.description().error_index("E_AX");
+  const GapResult r =
+      diagnose(synth(5, none, 0.5, 3, 6,
+                     [&](const Row& w) {
+                       std::vector<double> e(full.num_errors(), 0.0);
+                       const double u = (2 * w.X - 500) / 500;
+                       e[static_cast<std::size_t>(k)] = 40e-6 * u * u;
+                       const double q[3] = {w.Y, w.X, w.Z};
+                       std::array<double, 6> out{};
+                       full.deviation(md, q, e.data(), out.data());
+                       return std::array<double, 3>{out[0] * 1e3, out[1] * 1e3, out[2] * 1e3};
+                     }),
+               model);
+  CHECK(r.verdict == "missing_error");
+  const EffectFit* e = effect(r, "missing_error");
+  REQUIRE(e);
+  CHECK(e->variant == "E_AX");
+  CHECK(e->params.at("E_AX_peak") == doctest::Approx(40).epsilon(0.15));
+}
+
+TEST_CASE("gap: no false positive on effect-free data (stated rate alpha = 0.01 per decision)") {
+  int named = 0;
+  const int seeds = 30;
+  for (int s = 0; s < seeds; ++s) {
+    const GapResult r = diagnose(synth(100 + static_cast<std::uint32_t>(s), none, 0.5, 3, 5));
+    if (r.verdict != "none") ++named;
+  }
+  // With alpha = 0.01 for the gap test, P(more than 2 of 30 flagged) < 0.004.
+  CHECK(named <= 2);
+}
+
+TEST_CASE("gap: held-out splits never share an observation and cover every one once") {
+  const MeasurementTable t = parse_measurements(synth(7, none), "g.csv");
+  const GapData d = gap_data(t, vmc()->description());
+  for (const char* scheme : {"cycle:4", "time:5", "space:X:3"}) {
+    const std::vector<Split> splits = make_splits(d, *parse_holdout(scheme), 20);
+    std::vector<int> held(d.points.observations.size(), 0);
+    for (const Split& s : splits) {
+      std::vector<bool> in_train(held.size(), false);
+      for (std::size_t i : s.train) in_train[i] = true;
+      for (std::size_t i : s.test) {
+        CHECK_FALSE(in_train[i]);
+        ++held[i];
+      }
+      CHECK(s.train.size() + s.test.size() == held.size());
+    }
+    for (int h : held) CHECK(h == 1);
+  }
+  // Cycle folds keep a cycle together.
+  const std::vector<Split> by_cycle = make_splits(d, *parse_holdout("cycle:4"), 20);
+  for (const Split& s : by_cycle) {
+    std::set<double> cycles;
+    for (std::size_t i : s.test) cycles.insert(d.cycle[d.points.observations[i].row]);
+    CHECK(cycles.size() == 1);
+  }
+}
+
+TEST_CASE("gap: bad data get a message, not a verdict") {
+  const Description& desc = vmc()->description();
+  auto error_of = [&](const std::string& csv, const std::string& holdout = "auto") {
+    try {
+      const MeasurementTable t = parse_measurements(csv, "b.csv");
+      const GapData d = gap_data(t, desc);
+      const auto h = parse_holdout(holdout);
+      make_splits(d, h ? *h : default_holdout(d), 20);
+    } catch (const std::exception& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  CHECK(error_of("X,Y,Z,t_s\n0,0,0,1\n") ==
+        "b.csv:1: no deviation column (dx_um, dy_um, dz_um, da_urad, db_urad, dc_urad; "
+        "columns: X, Y, Z, t_s)");
+  std::string constant = "X,Y,Z,T_a,dx_um\n";
+  for (int i = 0; i < 12; ++i) constant += std::to_string(i * 10) + ",0,0,21.5,1\n";
+  CHECK(error_of(constant) ==
+        "b.csv:1: column 'T_a' is constant (21.5 degC): it cannot explain anything; drop the "
+        "column");
+  std::string nan = "X,Y,Z,T_a,dx_um\n";
+  for (int i = 0; i < 12; ++i)
+    nan += std::to_string(i * 10) + ",0,0," + (i == 4 ? "" : "21." + std::to_string(i)) + ",1\n";
+  CHECK(error_of(nan) ==
+        "b.csv:6: column 'T_a' is empty or not a number where a deviation is measured (the "
+        "diagnosis needs it in every row)");
+  CHECK(error_of("X,Y,Z,dx_um\n0,0,0,1\n1,0,0,2\n") ==
+        "b.csv: only 2 observations: the diagnosis needs at least 10");
+  std::string few = "X,Y,Z,cycle,dx_um\n";
+  for (int i = 0; i < 12; ++i)
+    few += std::to_string(i * 10) + ",0,0," + (i < 11 ? "1" : "2") + ",1\n";
+  CHECK(error_of(few, "cycle") ==
+        "b.csv: --holdout cycle:5: too few observations: a training part has 1, the model needs at "
+        "least 20");
+  CHECK(error_of("Y,Z,dx_um\n0,0,1\n") ==
+        "b.csv:1: missing column 'X' (give the coordinate of a pose the data do not vary with "
+        "--at X=VALUE; columns: Y, Z, dx_um)");
+  CHECK_THROWS_WITH_AS(parse_holdout("weekly"),
+                       "--holdout \"weekly\": unknown scheme 'weekly' (expected cycle[:K], "
+                       "time[:K], space[:AXIS][:K], forward[:FRACTION] or auto)",
+                       std::invalid_argument);
+}
+
+TEST_CASE("gap CLI: JSON schema, report, and bad flags or data") {
+  const std::filesystem::path dir = test::fresh_dir("gap_cli");
+  const std::string data = (dir / "rev.csv").string();
+  std::ofstream(data) << synth(9, [](const Row& w) {
+    return std::array<double, 3>{1.5 * w.dir_X, 0, 0};
+  });
+  const std::string json = (dir / "gap.json").string(), md = (dir / "gap.md").string();
+  const test::Run ok = test::run(test::cli("gap vmc_3axis -q --pdge poly:2 --data " + data +
+                                           " --json " + json + " --report " + md));
+  REQUIRE_MESSAGE(ok.status == 0, ok.out);
+  CHECK(ok.out.find("Verdict: reversal") != std::string::npos);
+  std::ifstream in(json);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  CHECK(j["verdict"]["effect"] == "reversal");
+  CHECK(j["verdict"]["explanation"][0] == "reversal");
+  CHECK(j["baseline"]["holdout"] == "cycle:4");
+  CHECK(j["noise_floor_source"] == "repeats");
+  CHECK(j["noise_floor_um"].get<double>() == doctest::Approx(0.5).epsilon(0.2));
+  REQUIRE(j["effects"].size() >= 5);
+  for (const char* key : {"name", "params", "heldout_rms_before_um", "heldout_rms_after_um",
+                          "shrink_pct", "significant", "p_value"})
+    CHECK(j["effects"][0].contains(key));
+  CHECK(j["effects"][0]["name"] == "reversal");
+  CHECK(j["effects"][0]["params"]["reversal_dx"].get<double>() ==
+        doctest::Approx(3.0).epsilon(0.1));
+  CHECK(j["where"][0]["output"] == "dx");
+  CHECK(std::filesystem::exists(md));
+
+  const test::Run bad1 =
+      test::run(test::cli("gap vmc_3axis -q --data " + data + " --holdout weekly"));
+  CHECK(bad1.status == 2);
+  const test::Run bad2 =
+      test::run(test::cli("gap vmc_3axis -q --data " + data + " --effects gremlins"));
+  CHECK(bad2.status == 2);
+  CHECK(bad2.out.find("unknown effect 'gremlins'") != std::string::npos);
+  const std::string flat = (dir / "flat.csv").string();
+  std::string text = "X,Y,Z,T_a,dx_um\n";
+  for (int i = 0; i < 12; ++i) text += std::to_string(i * 10) + ",0,0,21.5,1\n";
+  std::ofstream(flat) << text;
+  const std::string never = (dir / "never.json").string();
+  const test::Run bad3 =
+      test::run(test::cli("gap vmc_3axis -q --data " + flat + " --json " + never));
+  CHECK(bad3.status == 3);
+  CHECK(bad3.out.find("flat.csv:1: column 'T_a' is constant") != std::string::npos);
+  CHECK_FALSE(std::filesystem::exists(never));
+}
