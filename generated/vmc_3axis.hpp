@@ -21,7 +21,7 @@ namespace vmc_3axis {
 inline constexpr const char* kMachineName = "vmc_3axis";
 inline constexpr int kOrder = 1;
 // Machine-file text, order and weilgen version: identifies the model (runtime/model_key.hpp).
-inline constexpr const char* kModelKey = "10e79afa6b9c4aee";
+inline constexpr const char* kModelKey = "5c916ea7bfaab479";
 inline constexpr std::size_t kNumAxes = 3;
 inline constexpr std::size_t kNumErrors = 21;
 inline constexpr std::size_t kNumParams = 1;

@@ -16,7 +16,7 @@ namespace weilgen_models {
 namespace vmc_3axis_params {
 
 inline constexpr const char* kMachineName = "vmc_3axis";
-inline constexpr const char* kModelKey = "10e79afa6b9c4aee";  // the model header's kModelKey
+inline constexpr const char* kModelKey = "5c916ea7bfaab479";  // the model header's kModelKey
 inline constexpr std::size_t kNumAxes = 3;
 inline constexpr std::size_t kNumErrors = 21;
 inline constexpr std::size_t kNumParams = 1;
