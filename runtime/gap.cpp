@@ -443,8 +443,9 @@ NoiseFloor noise_floor(const GapData& d, const VectorXd& heldout) {
     seq[static_cast<std::size_t>(obs[idx[0]].output)].push_back(s);
   }
   const bool repeats = repeated * 10 >= obs.size() * 3;  // >= 30 % of observations repeated
-  if (!repeats) {
-    for (auto& s : seq) s.clear();
+  // Small-scale sequences: the held-out residual in time (or row) order, per output.
+  std::array<std::vector<std::vector<double>>, 6> small;
+  {
     std::vector<std::size_t> order(obs.size());
     std::iota(order.begin(), order.end(), 0);
     std::stable_sort(order.begin(), order.end(),
@@ -453,26 +454,53 @@ NoiseFloor noise_floor(const GapData& d, const VectorXd& heldout) {
     for (std::size_t i : order)
       if (std::isfinite(heldout[static_cast<Index>(i)]))
         s[static_cast<std::size_t>(obs[i].output)].push_back(heldout[static_cast<Index>(i)]);
-    for (std::size_t o = 0; o < 6; ++o) seq[o].push_back(s[o]);
+    for (std::size_t o = 0; o < 6; ++o) small[o].push_back(s[o]);
   }
-  std::vector<std::vector<double>> all;
-  nf.per_output.fill(kNaN);
-  for (std::size_t o = 0; o < 6; ++o) {
-    double s2 = 0, dof = 0;
+  struct Estimate {
+    std::array<double, 6> per_output{};
+    double sigma = kNaN, dof = 0;
     std::size_t n = 0;
-    mssd(seq[o], s2, dof, n);
-    if (n) nf.per_output[o] = std::sqrt(s2);
-    for (auto& s : seq[o]) all.push_back(s);
+  };
+  auto estimate = [](const std::array<std::vector<std::vector<double>>, 6>& sq) {
+    Estimate e;
+    std::vector<std::vector<double>> all;
+    e.per_output.fill(kNaN);
+    for (std::size_t o = 0; o < 6; ++o) {
+      double s2 = 0, dof = 0;
+      std::size_t n = 0;
+      mssd(sq[o], s2, dof, n);
+      if (n) e.per_output[o] = std::sqrt(s2);
+      for (const auto& x : sq[o]) all.push_back(x);
+    }
+    double s2 = 0;
+    mssd(all, s2, e.dof, e.n);
+    e.sigma = std::sqrt(s2);
+    return e;
+  };
+  const Estimate from_small = estimate(small);
+  // Repeats are the floor unless a drift or step between them (every repeat straddles it)
+  // makes them read higher than the residual's small-scale structure: then the smaller one.
+  Estimate chosen = from_small;
+  bool use_repeats = false;
+  std::string other;
+  if (repeats) {
+    const Estimate from_repeats = estimate(seq);
+    use_repeats = !(from_small.sigma < from_repeats.sigma);
+    if (use_repeats) chosen = from_repeats;
+    other = use_repeats ? "; the small-scale estimate is " + format_short(from_small.sigma)
+                        : "; repeats read " + format_short(from_repeats.sigma) +
+                              " (a drift or step between them)";
   }
-  double s2 = 0;
-  std::size_t n = 0;
-  mssd(all, s2, nf.dof, n);
-  nf.sigma_um = std::sqrt(s2);
-  nf.source = repeats ? "repeats" : "small-scale";
-  nf.detail = std::to_string(n) + (repeats ? " successive differences of repeated observations "
-                                             "(same pose, direction and output, in time order)"
-                                           : " successive differences of the held-out residual "
-                                             "in time (or row) order");
+  nf.per_output = chosen.per_output;
+  nf.sigma_um = chosen.sigma;
+  nf.dof = chosen.dof;
+  nf.source = use_repeats ? "repeats" : "small-scale";
+  nf.detail = std::to_string(chosen.n) +
+              (use_repeats ? " successive differences of repeated observations (same pose, "
+                             "direction and output, in time order)"
+                           : " successive differences of the held-out residual in time (or row) "
+                             "order") +
+              other;
   if (!(nf.sigma_um > 0))
     throw InputError(SourceLoc{d.points.file, 0, 0},
                      "cannot estimate the noise floor (no repeated observations and too few "

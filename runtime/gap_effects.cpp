@@ -257,7 +257,7 @@ MatrixXd one_output(const GapData& d, int output,
 
 void add_periodic(const EffectContext& ctx, std::vector<Candidate>& out) {
   const GapData& d = *ctx.data;
-  const std::vector<AxisInfo> axes = varying_axes(d, 8);
+  const std::vector<AxisInfo> axes = varying_axes(d, 6);
   if (axes.empty()) return;
   Candidate c;
   c.name = "periodic";
@@ -268,7 +268,9 @@ void add_periodic(const EffectContext& ctx, std::vector<Candidate>& out) {
     for (std::size_t i = 1; i < L.size(); ++i) gaps.push_back(L[i] - L[i - 1]);
     std::nth_element(gaps.begin(), gaps.begin() + static_cast<long>(gaps.size() / 2), gaps.end());
     const double step = gaps[gaps.size() / 2], span = L.back() - L.front();
-    const double lo = 2.5 * step, hi = span;
+    // At least 1.5 periods within the data: a single half-wave is a shape (pdge_shape), and a
+    // longer "period" would fit steps and trends that are not periodic.
+    const double lo = 2.5 * step, hi = span / 1.5;
     if (!(hi > lo)) continue;
     const int grid = 40;
     const double ratio = std::pow(hi / lo, 1.0 / (grid - 1));
