@@ -11,7 +11,6 @@ namespace weilgen::cli {
 
 namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-const std::array<const char*, 6> kNames = {"dx", "dy", "dz", "da", "db", "dc"};
 }  // namespace
 
 Prediction predict_table(const Model& model, const ErrorParameterisation& param,
@@ -69,7 +68,7 @@ void print_prediction(std::ostream& os, const Prediction& p) {
     if (!p.compared[o]) continue;
     if (!any) os << "output  measured rms  rms(measured - predicted)  max\n";
     any = true;
-    os << std::left << std::setw(8) << kNames[o] << std::right << std::setw(12)
+    os << std::left << std::setw(8) << output_name(o) << std::right << std::setw(12)
        << format_short(p.rms_measured[o]) << std::setw(27) << format_short(p.rms_difference[o])
        << std::setw(10) << format_short(p.max_difference[o]) << "  " << (o < 3 ? "µm" : "µrad")
        << "\n";
@@ -82,10 +81,10 @@ nlohmann::json prediction_json(const Prediction& p) {
   for (std::size_t o = 0; o < 6; ++o) {
     if (!p.compared[o]) continue;
     const std::string u = o < 3 ? "_um" : "_urad";
-    outputs[kNames[o]] = {{"compared", p.compared[o]},
-                          {"rms_measured" + u, json_number(p.rms_measured[o])},
-                          {"rms_difference" + u, json_number(p.rms_difference[o])},
-                          {"max_difference" + u, json_number(p.max_difference[o])}};
+    outputs[output_name(o)] = {{"compared", p.compared[o]},
+                               {"rms_measured" + u, json_number(p.rms_measured[o])},
+                               {"rms_difference" + u, json_number(p.rms_difference[o])},
+                               {"max_difference" + u, json_number(p.max_difference[o])}};
   }
   nlohmann::json rows = nlohmann::json::array();
   for (std::size_t i = 0; i < p.poses.size(); ++i) {

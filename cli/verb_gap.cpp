@@ -23,7 +23,6 @@ namespace weilgen::cli {
 namespace {
 
 using nlohmann::json;
-const std::array<const char*, 6> kOutputs = {"dx", "dy", "dz", "da", "db", "dc"};
 
 std::string f3(double v) { return std::isfinite(v) ? format_short(v) : "-"; }
 
@@ -42,7 +41,7 @@ json region_json(const GapRegion& g) {
 json per_output_json(const std::array<double, 6>& v, const std::array<std::size_t, 6>& count) {
   json j = json::object();
   for (std::size_t o = 0; o < 6; ++o)
-    if (count[o]) j[kOutputs[o]] = json_number(v[o]);
+    if (count[o]) j[output_name(o)] = json_number(v[o]);
   return j;
 }
 
@@ -131,10 +130,10 @@ void print_report(std::ostream& os, const GapResult& r, const Model& model, cons
   for (std::size_t o = 0; o < 6; ++o) {
     if (!r.count[o]) continue;
     if (markdown)
-      os << "| " << kOutputs[o] << " | " << f3(r.baseline_rms[o]) << " | " << f3(r.baseline_max[o])
-         << " | " << f3(r.final_rms[o]) << " |\n";
+      os << "| " << output_name(o) << " | " << f3(r.baseline_rms[o]) << " | "
+         << f3(r.baseline_max[o]) << " | " << f3(r.final_rms[o]) << " |\n";
     else
-      os << std::left << std::setw(8) << kOutputs[o] << std::right << std::setw(12)
+      os << std::left << std::setw(8) << output_name(o) << std::right << std::setw(12)
          << f3(r.baseline_rms[o]) << std::setw(9) << f3(r.baseline_max[o]) << std::setw(11)
          << f3(r.final_rms[o]) << "  " << (o < 3 ? "µm" : "µrad") << "\n";
   }
@@ -289,10 +288,8 @@ int verb_gap(const Args& args) {
   const std::shared_ptr<Model> model = open_model(flags, desc);
   const ErrorParameterisation param(model->description(), parse_pdge_flags(desc, pdge),
                                     model->parameters());
-  ReadOptions ro;
-  for (int b : desc.axes()) ro.coordinates.push_back(desc.bodies[b].joint.coordinate);
-  ro.allow_unknown = vm.count("allow-unknown") > 0;
-  const MeasurementTable table = read_measurements(data, ro);
+  const MeasurementTable table =
+      read_measurements(data, machine_read_options(desc, vm.count("allow-unknown") > 0));
   for (const auto& w : table.warnings) std::cerr << w << "\n";
   const GapData gd = gap_data(table, desc, fixed);
   const HoldoutScheme scheme = given ? *given : default_holdout(gd);

@@ -30,15 +30,7 @@ std::string fmt(double v, int precision = 3) {
   return s.str();
 }
 
-const std::array<const char*, 6> kOutputNames = {"dx", "dy", "dz", "da", "db", "dc"};
 const char* output_unit(int o) { return o < 3 ? "µm" : "µrad"; }
-
-ReadOptions read_options(const Description& desc, bool allow_unknown) {
-  ReadOptions ro;
-  for (int b : desc.axes()) ro.coordinates.push_back(desc.bodies[b].joint.coordinate);
-  ro.allow_unknown = allow_unknown;
-  return ro;
-}
 
 // All --data files as one set of observations (rows keep their file for messages).
 PointData merged_data(const std::vector<std::string>& files, const Description& desc,
@@ -97,7 +89,7 @@ json result_json(const Model& model, const ErrorParameterisation& param, const I
   for (int o = 0; o < 6; ++o) {
     if (!r.count[static_cast<std::size_t>(o)]) continue;
     const std::string u = o < 3 ? "_um" : "_urad";
-    outputs[kOutputNames[static_cast<std::size_t>(o)]] = {
+    outputs[output_name(static_cast<std::size_t>(o))] = {
         {"observations", r.count[static_cast<std::size_t>(o)]},
         {"rms_before" + u, json_number(r.rms_before[static_cast<std::size_t>(o)])},
         {"rms_after" + u, json_number(r.rms_after[static_cast<std::size_t>(o)])},
@@ -127,7 +119,7 @@ void print_result(std::ostream& os, const Model& model, const ErrorParameterisat
   bool first = true;
   for (int o = 0; o < 6; ++o)
     if (r.count[static_cast<std::size_t>(o)])
-      os << (first ? "" : ", ") << kOutputNames[static_cast<std::size_t>(o)] << " "
+      os << (first ? "" : ", ") << output_name(static_cast<std::size_t>(o)) << " "
          << r.count[static_cast<std::size_t>(o)],
           first = false;
   os << ")\n";
@@ -150,7 +142,7 @@ void print_result(std::ostream& os, const Model& model, const ErrorParameterisat
   for (int o = 0; o < 6; ++o) {
     const auto u = static_cast<std::size_t>(o);
     if (!r.count[u]) continue;
-    os << std::left << std::setw(8) << kOutputNames[u] << std::right << std::setw(10)
+    os << std::left << std::setw(8) << output_name(u) << std::right << std::setw(10)
        << fmt(r.rms_before[u]) << std::setw(11) << fmt(r.rms_after[u]) << std::setw(11)
        << fmt(r.max_after[u]) << "  " << output_unit(o) << "\n";
   }
@@ -230,7 +222,7 @@ int verb_identify(const Args& args) {
   const PdgeBasisChoice choice = parse_pdge_flags(desc, pdge);
   const std::shared_ptr<Model> model = open_model(flags, desc);
   const ErrorParameterisation param(model->description(), choice, model->parameters());
-  const ReadOptions ro = read_options(desc, vm.count("allow-unknown") > 0);
+  const ReadOptions ro = machine_read_options(desc, vm.count("allow-unknown") > 0);
   const PointData points = merged_data(data, desc, ro);
 
   IdentifyOptions io;

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "gap_effects.hpp"
+#include "lsq.hpp"
 #include "machine/text.hpp"
 
 namespace weilgen {
@@ -18,7 +19,6 @@ using Eigen::MatrixXd;
 using Eigen::VectorXd;
 using Index = Eigen::Index;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-const std::array<const char*, 6> kOutputs = {"dx", "dy", "dz", "da", "db", "dc"};
 
 // Upper tail of F(d1, d2); 1 for degenerate inputs.
 double f_sf(double f, double d1, double d2) {
@@ -274,7 +274,7 @@ namespace {
 // The training fit of one split: A_tr = U S Vᵀ (equilibrated, rank r), the pseudo-inverse as
 // VS·Uᵀ, residuals and test leverages.
 struct FoldFit {
-  MatrixXd U, VS;
+  MatrixXd U, VS, W;  // W = A_test · VS
   VectorXd theta, res_train, res_test, lev_test;
   std::size_t rank = 0;
 };
@@ -296,26 +296,25 @@ FoldFit fit_fold(const MatrixXd& A, const VectorXd& y, const Split& s) {
   FoldFit f;
   const MatrixXd Atr = rows_of(A, s.train), Ate = rows_of(A, s.test);
   const VectorXd ytr = rows_of(y, s.train), yte = rows_of(y, s.test);
-  VectorXd scale = Atr.colwise().norm().transpose();
-  for (Index p = 0; p < scale.size(); ++p)
-    if (!(scale[p] > 0)) scale[p] = 1;
-  const MatrixXd As = Atr * scale.cwiseInverse().asDiagonal();
-  Eigen::BDCSVD<MatrixXd> svd(As, Eigen::ComputeThinU | Eigen::ComputeThinV);
-  const VectorXd& sv = svd.singularValues();
-  std::size_t r = 0;
-  while (r < static_cast<std::size_t>(sv.size()) && sv[static_cast<Index>(r)] > 1e-9 * sv[0]) ++r;
-  f.rank = r;
-  const auto R = static_cast<Index>(r);
-  f.U = svd.matrixU().leftCols(R);
-  f.VS = scale.cwiseInverse().asDiagonal() * svd.matrixV().leftCols(R) *
-         sv.head(R).cwiseInverse().asDiagonal();
-  f.theta = f.VS * (f.U.transpose() * ytr);
+  const EquilibratedSvd svd(Atr, 1e-9, /*full_v=*/false);
+  f.rank = svd.rank();
+  f.U = svd.U().leftCols(static_cast<Index>(f.rank));
+  f.VS = svd.pinv_right();
+  f.theta = svd.solve(ytr);
   f.res_train = ytr - Atr * f.theta;
   f.res_test = yte - Ate * f.theta;
   // h_i = a_iᵀ (AᵀA)⁺ a_i = |S⁻¹ Vᵀ (a_i / scale)|² = |VSᵀ a_i|².
-  const MatrixXd W = Ate * f.VS;
-  f.lev_test = W.rowwise().squaredNorm();
+  f.W = Ate * f.VS;
+  f.lev_test = f.W.rowwise().squaredNorm();
   return f;
+}
+
+// The split that trains on every observation (and holds none out).
+Split all_rows(std::size_t n) {
+  Split s;
+  s.train.resize(n);
+  std::iota(s.train.begin(), s.train.end(), 0);
+  return s;
 }
 
 struct Engine {
@@ -326,18 +325,22 @@ struct Engine {
   std::vector<FoldFit> folds;
   double full_sse = 0;
   std::size_t full_rank = 0;
-  std::vector<double> full_theta;
+  VectorXd full_theta;
 
-  void refit() {
-    folds.clear();
-    for (const Split& s : splits) folds.push_back(fit_fold(A, y, s));
-    Split all;
-    all.train.resize(static_cast<std::size_t>(y.size()));
-    std::iota(all.train.begin(), all.train.end(), 0);
-    const FoldFit f = fit_fold(A, y, all);
+  // The fit on all data (its rank sizes the splits; its SSE is the F tests' reference).
+  void fit_full() {
+    const FoldFit f = fit_fold(A, y, all_rows(static_cast<std::size_t>(y.size())));
     full_sse = f.res_train.squaredNorm();
     full_rank = f.rank;
-    full_theta.assign(f.theta.data(), f.theta.data() + f.theta.size());
+    full_theta = f.theta;
+  }
+  void fit_folds() {
+    folds.clear();
+    for (const Split& s : splits) folds.push_back(fit_fold(A, y, s));
+  }
+  void refit() {
+    fit_full();
+    fit_folds();
   }
   // Held-out residual and leverage per observation.
   void heldout(VectorXd& r, VectorXd& h) const {
@@ -563,7 +566,7 @@ std::vector<GapRegion> localise(const GapData& d, const VectorXd& r, const Vecto
     if (idx.empty()) continue;
     GapRegion g;
     g.by = "output";
-    g.output = kOutputs[static_cast<std::size_t>(o)];
+    g.output = output_name(static_cast<std::size_t>(o));
     stats(g, idx);
     bins.push_back(g);
     for (const Dim& dm : dims) {
@@ -587,7 +590,7 @@ std::vector<GapRegion> localise(const GapData& d, const VectorXd& r, const Vecto
       for (std::size_t b = 0; b < nb; ++b) {
         GapRegion reg;
         reg.by = dm.by;
-        reg.output = kOutputs[static_cast<std::size_t>(o)];
+        reg.output = output_name(static_cast<std::size_t>(o));
         reg.from = range[b].first;
         reg.to = range[b].second;
         stats(reg, members[b]);
@@ -682,8 +685,7 @@ Evaluated evaluate(const gap_detail::Candidate& c, const Engine& e, std::size_t 
                    double n_candidates) {
   Evaluated best;
   double best_train = INFINITY;
-  const std::vector<double> full_theta = split_theta(
-      Eigen::Map<const VectorXd>(e.full_theta.data(), static_cast<Index>(e.full_theta.size())), np);
+  const std::vector<double> full_theta = split_theta(e.full_theta, np);
   // Training SSE over the splits and the held-out residual of one variant; false when the
   // model already spans its columns.
   auto score = [&](const gap_detail::Variant& v, double& train_sse, VectorXd& after,
@@ -709,8 +711,7 @@ Evaluated evaluate(const gap_detail::Candidate& c, const Engine& e, std::size_t 
       if (qr.rank() == 0) return false;  // the model already spans these columns
       const VectorXd coef = norm.cwiseInverse().asDiagonal() * qr.solve(ff.res_train);
       train_sse += (ff.res_train - Eperp * coef).squaredNorm();
-      const MatrixXd Ate = rows_of(e.A, s.test);
-      const VectorXd delta = (Ete - Ate * (ff.VS * P)) * coef;
+      const VectorXd delta = (Ete - ff.W * P) * coef;
       for (std::size_t i = 0; i < s.test.size(); ++i)
         after[static_cast<Index>(s.test[i])] =
             ff.res_test[static_cast<Index>(i)] - delta[static_cast<Index>(i)];
@@ -810,10 +811,7 @@ Evaluated evaluate(const gap_detail::Candidate& c, const Engine& e, std::size_t 
   const MatrixXd& E = best.columns;
   MatrixXd AE(e.A.rows(), e.A.cols() + E.cols());
   AE << e.A, E;
-  Split all;
-  all.train.resize(static_cast<std::size_t>(e.y.size()));
-  std::iota(all.train.begin(), all.train.end(), 0);
-  const FoldFit f1 = fit_fold(AE, e.y, all);
+  const FoldFit f1 = fit_fold(AE, e.y, all_rows(static_cast<std::size_t>(e.y.size())));
   const double q = static_cast<double>(f1.rank) - static_cast<double>(e.full_rank);
   const double sse1 = f1.res_train.squaredNorm();
   const double d2 = static_cast<double>(e.y.size()) - static_cast<double>(f1.rank);
@@ -845,19 +843,15 @@ void GapDiagnosis::run(const GapData& data, const HoldoutScheme& scheme,
   Engine e{data, design_matrix(*model_, param_, data.points), {}, {}, {}, 0, 0, {}};
   e.y.resize(static_cast<Index>(obs.size()));
   for (std::size_t i = 0; i < obs.size(); ++i) e.y[static_cast<Index>(i)] = obs[i].value;
-  {
-    Split all;
-    all.train.resize(obs.size());
-    std::iota(all.train.begin(), all.train.end(), 0);
-    R.rank = fit_fold(e.A, e.y, all).rank;
-  }
+  e.fit_full();
+  R.rank = e.full_rank;
   e.splits = make_splits(data, scheme, R.rank + 5);
   if (scheme.kind != HoldoutScheme::Kind::Forward) {  // the folds actually used (K <= groups)
     HoldoutScheme used = scheme;
     used.folds = static_cast<int>(e.splits.size());
     R.holdout = used.str();
   }
-  e.refit();
+  e.fit_folds();
   VectorXd r, h;
   e.heldout(r, h);
   R.noise = noise_floor(data, r);
@@ -883,14 +877,16 @@ void GapDiagnosis::run(const GapData& data, const HoldoutScheme& scheme,
     }
     total = na ? std::sqrt(all / static_cast<double>(na)) : kNaN;
   };
-  auto overall = [&](const VectorXd& res, const VectorXd& lev, double& excess, double& p) {
+  // Σ r² and its expectation σ²(1 + h) over the held-out residuals.
+  auto held_gap = [&](const VectorXd& res, const VectorXd& lev) {
     Gap g;
     for (Index i = 0; i < res.size(); ++i)
       if (std::isfinite(res[i])) g.ss += res[i] * res[i], g.expected += s2 * (1 + lev[i]), ++g.n;
-    gap_stats(g, R.noise.dof, excess, p);
+    return g;
   };
   summarise(r, R.baseline_rms, R.baseline_rms_um, &R.baseline_max);
-  overall(r, h, R.baseline_excess_um, R.baseline_p_value);
+  const Gap base = held_gap(r, h);
+  gap_stats(base, R.noise.dof, R.baseline_excess_um, R.baseline_p_value);
   R.where = localise(data, r, h, R.noise, options_.alpha);
   R.residual_before.assign(r.data(), r.data() + r.size());
 
@@ -898,8 +894,9 @@ void GapDiagnosis::run(const GapData& data, const HoldoutScheme& scheme,
   ctx.data = &data;
   ctx.model = model_.get();
   ctx.param = &param_;
-  ctx.chain = std::make_shared<NumericChain>(model_->description());
-  const_cast<NumericChain&>(*ctx.chain).set_parameters(model_->parameters());
+  auto chain = std::make_shared<NumericChain>(model_->description());
+  chain->set_parameters(model_->parameters());
+  ctx.chain = chain;
   const std::vector<std::string>& names =
       options_.effects.empty() ? gap_effect_names() : options_.effects;
   std::vector<gap_detail::Candidate> candidates = gap_detail::effect_candidates(ctx, names);
@@ -907,16 +904,6 @@ void GapDiagnosis::run(const GapData& data, const HoldoutScheme& scheme,
 
   const bool gap_significant = R.baseline_p_value < options_.alpha;
   VectorXd cur_r = r, cur_h = h;
-  double explained_ss = 0;
-  const double base_ss = [&] {
-    double s = 0;
-    for (Index i = 0; i < r.size(); ++i)
-      if (std::isfinite(r[i])) s += r[i] * r[i];
-    return s;
-  }();
-  double base_expected = 0;
-  for (Index i = 0; i < r.size(); ++i)
-    if (std::isfinite(r[i])) base_expected += s2 * (1 + h[i]);
   std::vector<bool> used(candidates.size(), false);
   for (int step = 0; step < options_.max_effects; ++step) {
     std::vector<Evaluated> ev;
@@ -947,29 +934,26 @@ void GapDiagnosis::run(const GapData& data, const HoldoutScheme& scheme,
     EffectFit fit = pick->fit;
     MatrixXd AE(e.A.rows(), e.A.cols() + pick->columns.cols());
     AE << e.A, pick->columns;
-    double ss_before = 0, ss_after = 0;
-    for (Index i = 0; i < cur_r.size(); ++i)
-      if (std::isfinite(cur_r[i])) ss_before += cur_r[i] * cur_r[i];
     e.A = AE;
     e.refit();
     e.heldout(cur_r, cur_h);
-    for (Index i = 0; i < cur_r.size(); ++i)
-      if (std::isfinite(cur_r[i])) ss_after += cur_r[i] * cur_r[i];
-    explained_ss += ss_before - ss_after;
     R.explanation.push_back(fit);
     // Thermal drift may need a second sensor or lag; other effects are taken once.
     for (std::size_t k = 0; k < candidates.size(); ++k)
       if (candidates[k].name == fit.name && fit.name != "thermal_drift") used[k] = true;
     double ex = 0, p = 1;
-    overall(cur_r, cur_h, ex, p);
+    gap_stats(held_gap(cur_r, cur_h), R.noise.dof, ex, p);
     if (p >= options_.alpha) break;
   }
   summarise(cur_r, R.final_rms, R.final_rms_um, nullptr);
-  overall(cur_r, cur_h, R.final_excess_um, R.final_p_value);
+  const Gap final_gap = held_gap(cur_r, cur_h);
+  gap_stats(final_gap, R.noise.dof, R.final_excess_um, R.final_p_value);
   R.residual_after.assign(cur_r.data(), cur_r.data() + cur_r.size());
-  const double excess_ss = std::max(0.0, base_ss - base_expected);
+  // Of the excess over the floor (of the whole held-out SS when the floor exceeds it).
+  const double explained_ss = base.ss - final_gap.ss;
+  const double excess_ss = std::max(0.0, base.ss - base.expected);
   const double explained =
-      excess_ss > 0 ? explained_ss / excess_ss : (base_ss > 0 ? explained_ss / base_ss : 0);
+      excess_ss > 0 ? explained_ss / excess_ss : (base.ss > 0 ? explained_ss / base.ss : 0);
   if (!gap_significant && R.explanation.empty())
     R.verdict = "none";
   else if (R.explanation.empty())

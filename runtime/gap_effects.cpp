@@ -15,7 +15,6 @@ namespace {
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
 using Index = Eigen::Index;
-const std::array<const char*, 6> kOutputs = {"dx", "dy", "dz", "da", "db", "dc"};
 const char* unit_of(int o) { return o < 3 ? "µm" : "µrad"; }
 
 std::string num(double v, int digits = 3) {
@@ -49,9 +48,9 @@ std::string per_output_text(const std::vector<int>& outs, const VectorXd& c, dou
   std::string s;
   for (std::size_t k = 0; k < outs.size(); ++k) {
     const double v = c[static_cast<Index>(k)] * scale;
-    s += (s.empty() ? "" : ", ") + std::string(kOutputs[static_cast<std::size_t>(outs[k])]) + " " +
-         (v >= 0 ? "+" : "") + num(v, 2) + " " + unit_of(outs[k]) + unit_suffix;
-    fit.params[key + "_" + kOutputs[static_cast<std::size_t>(outs[k])]] = v;
+    s += (s.empty() ? "" : ", ") + std::string(output_name(static_cast<std::size_t>(outs[k]))) +
+         " " + (v >= 0 ? "+" : "") + num(v, 2) + " " + unit_of(outs[k]) + unit_suffix;
+    fit.params[key + "_" + output_name(static_cast<std::size_t>(outs[k]))] = v;
   }
   return s;
 }
@@ -102,7 +101,7 @@ void add_thermal(const EffectContext& ctx, std::vector<Candidate>& out) {
     for (std::size_t j = 0; j < sensors.size(); ++j) {
       const std::string head =
           "temperature " + sensors[j] +
-          (target < 0 ? "" : std::string(" on ") + kOutputs[static_cast<std::size_t>(target)]);
+          (target < 0 ? "" : std::string(" on ") + output_name(static_cast<std::size_t>(target)));
       c.variants.push_back({head, {2, static_cast<double>(j), 0, target}});
       if (time)
         for (double f : {0.03, 0.1, 0.3})
@@ -277,7 +276,7 @@ void add_periodic(const EffectContext& ctx, std::vector<Candidate>& out) {
     for (int o : outputs_of(d))
       for (int g = 0; g < grid; ++g) {
         const double period = lo * std::pow(ratio, g);
-        c.variants.push_back({axes[k].name + ", " + kOutputs[static_cast<std::size_t>(o)],
+        c.variants.push_back({axes[k].name + ", " + output_name(static_cast<std::size_t>(o)),
                               {static_cast<double>(k), static_cast<double>(o), period},
                               false,
                               {{2, period / ratio, period * ratio}}});
@@ -298,10 +297,10 @@ void add_periodic(const EffectContext& ctx, std::vector<Candidate>& out) {
     fit.params["period_mm"] = v.hyper[2];
     fit.params["amplitude"] = amp;
     fit.summary = "period " + num(v.hyper[2], 3) + " mm, " + num(amp, 2) + " " + unit_of(o) +
-                  " in " + kOutputs[static_cast<std::size_t>(o)] + " along " + a.name;
+                  " in " + output_name(static_cast<std::size_t>(o)) + " along " + a.name;
     GapRegion r;
     r.by = a.name;
-    r.output = kOutputs[static_cast<std::size_t>(o)];
+    r.output = output_name(static_cast<std::size_t>(o));
     r.from = a.levels.front();
     r.to = a.levels.back();
     fit.region = r;
@@ -320,7 +319,7 @@ void add_pdge_shape(const EffectContext& ctx, std::vector<Candidate>& out) {
     const auto& L = axes[k].levels;
     const double span = L.back() - L.front();
     for (int o : outputs_of(d)) {
-      const std::string head = axes[k].name + ", " + kOutputs[static_cast<std::size_t>(o)];
+      const std::string head = axes[k].name + ", " + output_name(static_cast<std::size_t>(o));
       c.variants.push_back(
           {head + ", degrees 4-5", {static_cast<double>(k), static_cast<double>(o), 1, 0, 0}});
       const std::size_t stride = std::max<std::size_t>(1, L.size() / 25);
@@ -354,10 +353,11 @@ void add_pdge_shape(const EffectContext& ctx, std::vector<Candidate>& out) {
     const int o = static_cast<int>(v.hyper[1]);
     GapRegion r;
     r.by = a.name;
-    r.output = kOutputs[static_cast<std::size_t>(o)];
+    r.output = output_name(static_cast<std::size_t>(o));
     if (v.hyper[2] == 1) {
-      fit.summary = "more shape along " + a.name + " in " + kOutputs[static_cast<std::size_t>(o)] +
-                    ": u^4 " + num(coef[0], 2) + ", u^5 " + num(coef[1], 2) + " " + unit_of(o);
+      fit.summary = "more shape along " + a.name + " in " +
+                    output_name(static_cast<std::size_t>(o)) + ": u^4 " + num(coef[0], 2) +
+                    ", u^5 " + num(coef[1], 2) + " " + unit_of(o);
       r.from = a.levels.front();
       r.to = a.levels.back();
     } else {
@@ -365,7 +365,7 @@ void add_pdge_shape(const EffectContext& ctx, std::vector<Candidate>& out) {
       fit.params["width"] = v.hyper[4];
       fit.params["amplitude"] = coef[0];
       fit.summary = "bump " + num(coef[0], 2) + " " + unit_of(o) + " in " +
-                    kOutputs[static_cast<std::size_t>(o)] + " at " + a.name + " = " +
+                    output_name(static_cast<std::size_t>(o)) + " at " + a.name + " = " +
                     num(v.hyper[3], 4) + " (width " + num(v.hyper[4], 3) + ")";
       r.from = v.hyper[3] - 2 * v.hyper[4];
       r.to = v.hyper[3] + 2 * v.hyper[4];
@@ -381,7 +381,7 @@ void add_pdge_shape(const EffectContext& ctx, std::vector<Candidate>& out) {
 std::array<double, 6> exact(const NumericChain& chain, const std::vector<double>& pose,
                             const std::vector<double>& errors) {
   std::array<double, 6> v = chain.deviation(pose, errors);
-  for (std::size_t o = 0; o < 6; ++o) v[o] *= o < 3 ? 1e3 : 1e6;
+  for (std::size_t o = 0; o < 6; ++o) v[o] *= kObservationScale[o];
   return v;
 }
 
@@ -584,7 +584,7 @@ void add_setup(const EffectContext& ctx, std::vector<Candidate>& out) {
     if (it == d.axes.end() ||
         axis_values(d, static_cast<std::size_t>(it - d.axes.begin())).size() < 3)
       continue;
-    c.variants.push_back({std::string(kOutputs[static_cast<std::size_t>(o)]) + " along " + axis,
+    c.variants.push_back({std::string(output_name(static_cast<std::size_t>(o))) + " along " + axis,
                           {static_cast<double>(o), static_cast<double>(it - d.axes.begin())}});
   }
   if (c.variants.empty()) return;

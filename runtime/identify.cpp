@@ -1,13 +1,13 @@
 #include "identify.hpp"
 
 #include <Eigen/Dense>
-#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <map>
 #include <stdexcept>
 
+#include "lsq.hpp"
 #include "machine/derived.hpp"
 #include "machine/text.hpp"
 #include "study_units.hpp"
@@ -20,8 +20,6 @@ const std::array<const char*, 6> kDeviationColumns = {"dx_um",   "dy_um",   "dz_
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-// Model outputs are mm and rad; observations µm and µrad.
-constexpr std::array<double, 6> kOutputScale = {1e3, 1e3, 1e3, 1e6, 1e6, 1e6};
 
 int error_of_name(const Description& d, const std::string& name, const std::string& what) {
   const int k = d.error_index(name);
@@ -198,54 +196,24 @@ namespace {
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
 
-// Minimum-norm least squares by a column-equilibrated SVD.
+// The equilibrated SVD (lsq.hpp) with its minimum-norm solution.
 struct SvdSolve {
-  VectorXd x;      // solution (original column scale)
-  VectorXd scale;  // column norms (1 for zero columns)
-  VectorXd sigma;  // singular values, descending
-  MatrixXd V;      // full right singular vectors (equilibrated)
-  std::size_t rank = 0;
+  EquilibratedSvd svd;
+  VectorXd x;
+  SvdSolve(const MatrixXd& A, const VectorXd& y, double tol)
+      : svd(A, tol, /*full_v=*/true), x(svd.solve(y)) {}
 };
-
-SvdSolve solve(const MatrixXd& A, const VectorXd& y, double tol) {
-  SvdSolve s;
-  const Eigen::Index n = A.cols();
-  s.scale = A.colwise().norm().transpose();
-  for (Eigen::Index p = 0; p < n; ++p)
-    if (!(s.scale[p] > 0)) s.scale[p] = 1;
-  const MatrixXd As = A * s.scale.cwiseInverse().asDiagonal();
-  Eigen::BDCSVD<MatrixXd> svd(As, Eigen::ComputeThinU | Eigen::ComputeFullV);
-  s.sigma = VectorXd::Zero(n);
-  s.sigma.head(svd.singularValues().size()) = svd.singularValues();
-  s.V = svd.matrixV();
-  const double smax = s.sigma.size() ? s.sigma[0] : 0;
-  while (s.rank < static_cast<std::size_t>(n) &&
-         s.sigma[static_cast<Eigen::Index>(s.rank)] > tol * smax && smax > 0)
-    ++s.rank;
-  VectorXd z = VectorXd::Zero(n);
-  const MatrixXd& U = svd.matrixU();
-  for (std::size_t i = 0; i < s.rank; ++i) {
-    const auto c = static_cast<Eigen::Index>(i);
-    z += s.V.col(c) * (U.col(c).dot(y) / s.sigma[c]);
-  }
-  s.x = z.cwiseQuotient(s.scale);
-  // A column the data never excites stays exactly zero (not rounding noise).
-  const VectorXd norms = A.colwise().norm().transpose();
-  for (Eigen::Index p = 0; p < n; ++p)
-    if (!(norms[p] > 0)) s.x[p] = 0;
-  return s;
-}
 
 // Readable null-space basis: reduced row echelon form of Nᵀ (each combination has a leading
 // parameter the others do not contain), in θ units, leading coefficient 1.
-std::vector<NullCombination> null_combinations(const SvdSolve& s,
+std::vector<NullCombination> null_combinations(const EquilibratedSvd& s,
                                                const std::vector<std::size_t>& cols) {
-  const Eigen::Index n = s.V.rows(), k = n - static_cast<Eigen::Index>(s.rank);
+  const Eigen::Index n = s.V().rows(), k = n - static_cast<Eigen::Index>(s.rank());
   std::vector<NullCombination> out;
   if (k <= 0) return out;
   // Rows: null vectors in θ units (z / scale).
-  MatrixXd N = s.V.rightCols(k).transpose();
-  for (Eigen::Index p = 0; p < n; ++p) N.col(p) /= s.scale[p];
+  MatrixXd N = s.V().rightCols(k).transpose();
+  for (Eigen::Index p = 0; p < n; ++p) N.col(p) /= s.scale()[p];
   Eigen::Index row = 0;
   for (Eigen::Index c = 0; c < n && row < k; ++c) {
     Eigen::Index piv = row;
@@ -289,7 +257,7 @@ MatrixXd design_matrix(const Model& model, const ErrorParameterisation& param,
     const double* c = md.coeff.data() + static_cast<std::size_t>(ob.output) * ne;
     for (std::size_t p = 0; p < np; ++p)
       A(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(p)) =
-          kOutputScale[static_cast<std::size_t>(ob.output)] *
+          kObservationScale[static_cast<std::size_t>(ob.output)] *
           c[static_cast<std::size_t>(param.parameters()[p].error)] * jac[p];
   }
   return A;
@@ -328,7 +296,7 @@ void Identification::run(const PointData& data) {
   MatrixXd A(static_cast<Eigen::Index>(m), static_cast<Eigen::Index>(cols.size()));
   for (std::size_t q = 0; q < cols.size(); ++q)
     A.col(static_cast<Eigen::Index>(q)) = full.col(static_cast<Eigen::Index>(cols[q]));
-  SvdSolve S = solve(A, y, options_.rank_tolerance);
+  SvdSolve S(A, y, options_.rank_tolerance);
   for (std::size_t q = 0; q < cols.size(); ++q)
     R.theta[cols[q]] = S.x[static_cast<Eigen::Index>(q)];
 
@@ -361,7 +329,7 @@ void Identification::run(const PointData& data) {
       }
       // Directions the first-order data cannot see become weakly visible through products of
       // errors; a looser rank cut keeps the step out of them, and halving keeps it descending.
-      S = solve(J, r, std::max(options_.rank_tolerance, 1e-6));
+      S = SvdSolve(J, r, std::max(options_.rank_tolerance, 1e-6));
       const double before = r.squaredNorm();
       std::vector<double> trial = R.theta;
       double step = 0, size = 0, t = 1;
@@ -386,24 +354,26 @@ void Identification::run(const PointData& data) {
     }
   }
 
-  R.rank = S.rank;
-  R.singular_values.assign(S.sigma.data(), S.sigma.data() + S.sigma.size());
-  R.condition = S.rank ? S.sigma[0] / S.sigma[static_cast<Eigen::Index>(S.rank - 1)] : kNaN;
+  const EquilibratedSvd& sv = S.svd;
+  R.rank = sv.rank();
+  R.singular_values.assign(sv.sigma().data(), sv.sigma().data() + sv.sigma().size());
+  R.condition =
+      sv.rank() ? sv.sigma()[0] / sv.sigma()[static_cast<Eigen::Index>(sv.rank() - 1)] : kNaN;
   const double sse = r.squaredNorm();
-  const double dof = static_cast<double>(m) - static_cast<double>(S.rank);
+  const double dof = static_cast<double>(m) - static_cast<double>(sv.rank());
   R.residual_sigma = dof > 0 ? std::sqrt(sse / dof) : kNaN;
   const Eigen::Index nf = static_cast<Eigen::Index>(cols.size());
   for (Eigen::Index q = 0; q < nf; ++q) {
     double null_weight = 0, var = 0;
-    for (Eigen::Index i = static_cast<Eigen::Index>(S.rank); i < nf; ++i)
-      null_weight += S.V(q, i) * S.V(q, i);
-    for (Eigen::Index i = 0; i < static_cast<Eigen::Index>(S.rank); ++i)
-      var += S.V(q, i) * S.V(q, i) / (S.sigma[i] * S.sigma[i]);
+    for (Eigen::Index i = static_cast<Eigen::Index>(sv.rank()); i < nf; ++i)
+      null_weight += sv.V()(q, i) * sv.V()(q, i);
+    for (Eigen::Index i = 0; i < static_cast<Eigen::Index>(sv.rank()); ++i)
+      var += sv.V()(q, i) * sv.V()(q, i) / (sv.sigma()[i] * sv.sigma()[i]);
     const std::size_t p = cols[static_cast<std::size_t>(q)];
     R.identifiable[p] = null_weight < 1e-12;
-    if (R.identifiable[p]) R.standard_error[p] = R.residual_sigma * std::sqrt(var) / S.scale[q];
+    if (R.identifiable[p]) R.standard_error[p] = R.residual_sigma * std::sqrt(var) / sv.scale()[q];
   }
-  R.unidentifiable = null_combinations(S, cols);
+  R.unidentifiable = null_combinations(sv, cols);
 
   std::array<double, 6> ss_before{}, ss_after{};
   R.max_after.fill(0);
@@ -429,7 +399,7 @@ std::array<double, 6> predict_deviation(const Model& model, ModelData& data,
   param.errors_at(axes, theta.data(), data.errors.data());
   std::array<double, 6> out{};
   model.deviation(data, axes, data.errors.data(), out.data());
-  for (std::size_t o = 0; o < 6; ++o) out[o] *= kOutputScale[o];
+  for (std::size_t o = 0; o < 6; ++o) out[o] *= kObservationScale[o];
   return out;
 }
 

@@ -26,6 +26,7 @@
 #include "machine/pdge_basis.hpp"
 #include "measurement_csv.hpp"
 #include "model.hpp"
+#include "study_spec.hpp"
 
 namespace weilgen {
 
@@ -101,6 +102,9 @@ struct PointData {
   std::vector<PointObservation> observations;
   std::array<std::size_t, 6> count{};  // observations per output
 };
+
+// From the model's outputs (mm, rad) to the measured µm and µrad, per output 0..5.
+inline constexpr std::array<double, 6> kObservationScale = {1e3, 1e3, 1e3, 1e6, 1e6, 1e6};
 
 // Output names and units as in the measurement format: dx_um ... dc_urad.
 extern const std::array<const char*, 6> kDeviationColumns;

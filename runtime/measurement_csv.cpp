@@ -296,4 +296,12 @@ MeasurementTable read_measurements(const std::string& path, const ReadOptions& o
   return parse_measurements(text, path, options);
 }
 
+ReadOptions machine_read_options(const Description& desc, bool allow_unknown) {
+  ReadOptions ro;
+  for (int b : desc.axes())
+    ro.coordinates.push_back(desc.bodies[static_cast<std::size_t>(b)].joint.coordinate);
+  ro.allow_unknown = allow_unknown;
+  return ro;
+}
+
 }  // namespace weilgen

@@ -56,6 +56,10 @@ struct ReadOptions {
   bool allow_unknown = false;
 };
 
+// The options of a verb that knows the machine: its independent coordinates are the coordinate
+// columns.
+ReadOptions machine_read_options(const Description& desc, bool allow_unknown);
+
 struct MeasurementTable {
   std::string file;                                   // path as given
   std::vector<std::string> columns;                   // header names, file order

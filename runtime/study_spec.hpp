@@ -51,8 +51,12 @@ enum class OutputId { Dx, Dy, Dz, Da, Db, Dc, Dp };
 constexpr int kNumOutputs = 7;
 const std::vector<OutputId>& all_outputs();  // Dx ... Dp
 const char* output_name(OutputId id);        // "dx"
-const char* output_unit(OutputId id);        // "mm" or "rad"
-bool output_is_angle(OutputId id);           // da, db, dc
+// Outputs 0..5 (dx ... dc) by index, for per-output arrays of measurements.
+inline const char* output_name(std::size_t index) {
+  return output_name(static_cast<OutputId>(index));
+}
+const char* output_unit(OutputId id);  // "mm" or "rad"
+bool output_is_angle(OutputId id);     // da, db, dc
 // "dx" ... "dp" (case-insensitive); throws std::invalid_argument listing the outputs.
 OutputId parse_output(const std::string& name);
 

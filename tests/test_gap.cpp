@@ -162,13 +162,7 @@ TEST_CASE("gap: an angular error the machine file leaves out is named") {
   // The model lacks E_AX (roll of X); the data come from the full machine with
   // E_AX(x) = 40 µrad · u², u = (2x − 500)/500. (A constant E_AX, or a missing squareness,
   // would be absorbed by E_AY's or E_CY's constant term: not a gap.)
-  std::string yaml;
-  {
-    std::ifstream in(test::machine_path("vmc_3axis"));
-    std::stringstream ss;
-    ss << in.rdbuf();
-    yaml = ss.str();
-  }
+  std::string yaml = test::read_text(test::machine_path("vmc_3axis"));
   const auto at = yaml.find("      E_AX:");
   REQUIRE(at != std::string::npos);
   yaml.erase(at, yaml.find('\n', at) - at + 1);

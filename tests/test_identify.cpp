@@ -343,11 +343,10 @@ TEST_CASE("identify: the committed params header is current and evaluates the id
   const IdentifyResult& r = id.result();
   // The same text as `weilgen identify vmc_3axis --data examples/data/vmc_3axis_points.csv
   // --emit-params generated/vmc_3axis_params.hpp` (scripts/regenerate_params.sh).
-  std::ifstream in(std::string(WEILGEN_SOURCE_DIR) + "/generated/vmc_3axis_params.hpp");
-  std::stringstream committed;
-  committed << in.rdbuf();
+  const std::string committed =
+      test::read_text(std::string(WEILGEN_SOURCE_DIR) + "/generated/vmc_3axis_params.hpp");
   const std::string text = params_header(m, p, r.theta, identify_provenance(r));
-  CHECK_MESSAGE(text == committed.str(),
+  CHECK_MESSAGE(text == committed,
                 "generated/vmc_3axis_params.hpp is stale: run scripts/regenerate_params.sh");
   namespace hp = weilgen_models::vmc_3axis_params;
   static_assert(hp::kNumErrors == 21 && hp::kNumAxes == 3);
@@ -383,12 +382,8 @@ TEST_CASE("identify CLI: points, a ballbar prediction of the same machine, JSON 
   CHECK(bb["kind"] == "ballbar");
   CHECK(bb["compared"][0]["rms_difference_um"].get<double>() < 0.3);
   CHECK(bb["compared"][0]["centred_correlation"].get<double>() > 0.95);
-  std::ifstream committed(std::string(WEILGEN_SOURCE_DIR) + "/generated/vmc_3axis_params.hpp"),
-      written(hpp);
-  std::stringstream a, b;
-  a << committed.rdbuf();
-  b << written.rdbuf();
-  CHECK(a.str() == b.str());
+  CHECK(test::read_text(std::string(WEILGEN_SOURCE_DIR) + "/generated/vmc_3axis_params.hpp") ==
+        test::read_text(hpp));
 
   // Bad input: named file and line, non-zero exit, no output written.
   const std::string bad = (dir / "bad.csv").string();

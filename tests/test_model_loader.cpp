@@ -35,13 +35,6 @@ LoadOptions options_in(const std::string& cache, std::vector<std::string>* log =
 
 std::string fresh_dir(const std::string& name) { return test::fresh_dir(name).string(); }
 
-std::string read_text(const std::string& path) {
-  std::ifstream in(path);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 // Largest difference between two models' deviation and coefficients over random poses/errors.
 double max_disagreement(const Model& a, const Model& b, double error_scale) {
   std::mt19937 rng(7);
@@ -57,8 +50,8 @@ double max_disagreement(const Model& a, const Model& b, double error_scale) {
     a.coefficients(da, q.data(), da.coeff.data());
     b.coefficients(db, q.data(), db.coeff.data());
     for (std::size_t k = 0; k < da.coeff.size(); ++k)
-      worst = std::max(worst, std::abs(da.coeff[k] - db.coeff[k]) /
-                                  std::max(1.0, std::abs(da.coeff[k])));
+      worst = std::max(worst,
+                       std::abs(da.coeff[k] - db.coeff[k]) / std::max(1.0, std::abs(da.coeff[k])));
   }
   return worst;
 }
@@ -86,7 +79,7 @@ TEST_CASE("model loader: shipped machines are built in and match the exact chain
 TEST_CASE("model loader: an edited machine is compiled once, then loaded from the cache") {
   const std::string dir = fresh_dir("loader_edit");
   const std::string cache = dir + "/cache";
-  std::string text = read_text(test::machine_path("vmc_3axis"));
+  std::string text = test::read_text(test::machine_path("vmc_3axis"));
   // A different tool length: a new machine that no built-in model serves.
   text += "\n# edited by test_model_loader\n";
   const Description d = load_machine_text(text, dir + "/vmc_edit.yaml");
@@ -145,7 +138,7 @@ TEST_CASE("model loader: order override compiles an order-2 model that converges
 
 TEST_CASE("model loader: without a compiler, the numeric chain with a warning") {
   const std::string cache = fresh_dir("loader_nocxx");
-  std::string text = read_text(test::machine_path("two_axis")) + "\n# edited\n";
+  std::string text = test::read_text(test::machine_path("two_axis")) + "\n# edited\n";
   const Description d = load_machine_text(text, cache + "/two_axis_edit.yaml");
   std::vector<std::string> log;
   LoadOptions o = options_in(cache, &log);
@@ -155,8 +148,7 @@ TEST_CASE("model loader: without a compiler, the numeric chain with a warning") 
   REQUIRE(log.size() == 1);
   CHECK(log[0].find("warning: no C++ compiler found (tried /nonexistent/c++)") == 0);
   o.engine = EngineChoice::Compiled;
-  CHECK_THROWS_WITH_AS(load_model(d, o),
-                       doctest::Contains("cannot compile the model of two_axis"),
+  CHECK_THROWS_WITH_AS(load_model(d, o), doctest::Contains("cannot compile the model of two_axis"),
                        std::runtime_error);
   o.compiler = "none";
   o.engine = EngineChoice::Auto;
@@ -167,7 +159,7 @@ TEST_CASE("model loader: without a compiler, the numeric chain with a warning") 
 
 TEST_CASE("model loader: a compile failure reports the compiler's message") {
   const std::string cache = fresh_dir("loader_fail");
-  std::string text = read_text(test::machine_path("two_axis")) + "\n# edited again\n";
+  std::string text = test::read_text(test::machine_path("two_axis")) + "\n# edited again\n";
   const Description d = load_machine_text(text, cache + "/two_axis_fail.yaml");
   LoadOptions o = options_in(cache);
   o.generate = [](const Description&, int) {

@@ -37,13 +37,6 @@ double convergence_slope(const Description& d, int order, unsigned seed, double*
   return test::loglog_slope(s, err);
 }
 
-std::string read_text(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 }  // namespace
 
 TEST_CASE("order-r model differs from the exact chain by O(s^(r+1)) on every shipped machine") {
@@ -99,7 +92,7 @@ TEST_CASE("first-order coefficients equal central differences of the exact chain
 }
 
 TEST_CASE("deviation in the workpiece frame does not depend on the workpiece point") {
-  std::string text = read_text(test::machine_path("vmc_3axis"));
+  std::string text = test::read_text(test::machine_path("vmc_3axis"));
   const Description a = load_machine_text(text, "vmc_3axis.yaml");
   const auto pos = text.find("workpiece: {body: workpiece, point: [0, 0, 0]}");
   REQUIRE(pos != std::string::npos);
@@ -117,7 +110,7 @@ TEST_CASE("deviation in the workpiece frame does not depend on the workpiece poi
 TEST_CASE("a relation ideal gives exactly the order-r model with the ideal's monomials removed") {
   // R[e]/I is a quotient ring: truncating inside every product must equal the full order-r model
   // with the monomials of I dropped afterwards.
-  std::string text = read_text(test::machine_path("five_axis_ac"));
+  std::string text = test::read_text(test::machine_path("five_axis_ac"));
   const Description plain = load_machine_text(text, "five_axis_ac.yaml");
   const std::string from = "algebra: {order: 1}";
   text.replace(text.find(from), from.size(),

@@ -123,13 +123,6 @@ std::array<double, 6> generated(const std::vector<double>& q, const std::vector<
   return {pos[0], pos[1], pos[2], ori[0], ori[1], ori[2]};
 }
 
-std::string read_text(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 std::string replaced(std::string text, const std::string& from, const std::string& to) {
   const auto at = text.find(from);
   REQUIRE(at != std::string::npos);
@@ -231,7 +224,7 @@ TEST_CASE("pipe cutter: closed forms of the seed's Ex, Ey, Ez at A12 = A04 = 0")
 }
 
 TEST_CASE("pipe cutter: bad parallel-chain constructs are rejected with their line") {
-  const std::string text = read_text(test::machine_path("pipe_cutter"));
+  const std::string text = test::read_text(test::machine_path("pipe_cutter"));
   // A derived quantity naming an unknown chain point.
   std::string msg = load_error(replaced(text, "(E031.x + E032.x)/2", "(E031.x + E039.x)/2"));
   CHECK(msg.find("edited.yaml:") == 0);
@@ -317,7 +310,7 @@ workpiece: {body: table, point: [10, 5, 0]}
 }
 
 TEST_CASE("pipe cutter regenerates after an edit: a third jaw pair on the feeding chuck") {
-  std::string text = read_text(test::machine_path("pipe_cutter"));
+  std::string text = test::read_text(test::machine_path("pipe_cutter"));
   // Two more jaws along z on the feeding chuck, their errors, tips, and the feeding chuck's z
   // concentricity from the new pair (the way the main chuck takes z from its vertical pair).
   const std::string jaws = R"(  jaw_23_3:

@@ -13,8 +13,9 @@
 #include <string>
 #include <vector>
 
-#include "machine/description.hpp"
+#include "atomic_file.hpp"
 #include "builtin_models.hpp"
+#include "machine/description.hpp"
 #include "machine/yaml_loader.hpp"
 #include "model_loader.hpp"
 
@@ -114,6 +115,13 @@ inline double loglog_slope(const std::vector<double>& s, const std::vector<doubl
     sxx += (std::log(s[i]) - mx) * (std::log(s[i]) - mx);
   }
   return sxy / sxx;
+}
+
+// A file's whole text (runtime/atomic_file.hpp's read_file), "" when it cannot be read.
+inline std::string read_text(const std::string& path) {
+  std::string text;
+  read_file(path, text);
+  return text;
 }
 
 // A shipped machine's built-in model (no compiler; one per name for the whole test run).
