@@ -35,6 +35,15 @@ po::options_description model_options(StudyFlags& f) {
   return model;
 }
 
+po::options_description ballbar_circle_options(BallbarFlags& c) {
+  po::options_description o("Ballbar circle (over the file's '# plane/centre/radius/feed' keys)");
+  o.add_options()("plane", po::value<std::string>(&c.plane), "the circle's plane: XY, YZ, ZX")(
+      "centre", po::value<std::string>(&c.centre), "the centre, e.g. X=250,Y=0,Z=-100 (mm, deg)")(
+      "radius", po::value<std::string>(&c.radius), "the radius, e.g. 100mm")(
+      "feed", po::value<std::string>(&c.feed), "ccw or cw");
+  return o;
+}
+
 void add_study_options(po::options_description& opts, StudyFlags& f, bool with_tolerance) {
   const po::options_description model = model_options(f);
   po::options_description where("Poses and distributions (docs/study-inputs.md)");

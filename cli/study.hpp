@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "ballbar.hpp"
 #include "distribution.hpp"
 #include "model.hpp"
 #include "study_spec.hpp"
@@ -35,6 +36,8 @@ void add_study_options(boost::program_options::options_description& opts, StudyF
 
 // The "Model" flags alone: --order --engine --compiler --param.
 boost::program_options::options_description model_options(StudyFlags& flags);
+// --plane, --centre, --radius, --feed: a ballbar circle over the file's header keys.
+boost::program_options::options_description ballbar_circle_options(BallbarFlags& circle);
 
 // The machine's model (built-in, cached, compiled or numeric chain; logged to stderr unless
 // quiet) with --param applied. Throws std::invalid_argument for bad flags.

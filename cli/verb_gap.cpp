@@ -38,14 +38,15 @@ json region_json(const GapRegion& g) {
           {"significant", g.significant}};
 }
 
-json per_output_json(const std::array<double, 6>& v, const std::array<std::size_t, 6>& count) {
+json per_output_json(const std::array<double, kObservationKinds>& v,
+                     const std::array<std::size_t, kObservationKinds>& count) {
   json j = json::object();
-  for (std::size_t o = 0; o < 6; ++o)
-    if (count[o]) j[output_name(o)] = json_number(v[o]);
+  for (std::size_t o = 0; o < kObservationKinds; ++o)
+    if (count[o]) j[observation_name(o)] = json_number(v[o]);
   return j;
 }
 
-json effect_json(const EffectFit& e, const std::array<std::size_t, 6>& count) {
+json effect_json(const EffectFit& e, const std::array<std::size_t, kObservationKinds>& count) {
   json params = json::object();
   for (const auto& [k, v] : e.params) params[k] = json_number(v);
   json j = {{"name", e.name},
@@ -64,6 +65,9 @@ json effect_json(const EffectFit& e, const std::array<std::size_t, 6>& count) {
             {"p_value", json_number(e.p_value)},
             {"significant", e.significant}};
   if (e.region) j["region"] = region_json(*e.region);
+  if (e.shape_dof_free || e.shape_dof_used)
+    j["shape_dof"] = {{"free", e.shape_dof_free}, {"used", e.shape_dof_used}};
+  j["distinguishable"] = e.distinguishable;
   return j;
 }
 
@@ -95,12 +99,19 @@ json result_json(const GapResult& r, const Model& model, const std::string& data
           {"effects", effects},
           {"verdict",
            {{"effect", r.verdict},
+            {"reason", r.verdict_reason},
             {"explanation", names},
             {"steps", expl},
             {"heldout_rms_after_um", per_output_json(r.final_rms, r.count)},
             {"heldout_rms_after_all_um", json_number(r.final_rms_um)},
             {"remaining_excess_um", json_number(r.final_excess_um)},
             {"remaining_p_value", json_number(r.final_p_value)}}}};
+}
+
+std::string not_distinguishable(const EffectFit& e) {
+  return " (uses " + std::to_string(e.shape_dof_used) + " of the " +
+         std::to_string(e.shape_dof_free) +
+         " shape degrees of freedom the data leave: any shape fits)";
 }
 
 void print_report(std::ostream& os, const GapResult& r, const Model& model, const std::string& data,
@@ -115,7 +126,9 @@ void print_report(std::ostream& os, const GapResult& r, const Model& model, cons
       os << (i ? ", then " : "") << r.explanation[i].summary;
     os << ")";
   }
-  os << "\n\n" << h2 << "Baseline\n\n";
+  os << "\n"
+     << (markdown ? "\n" : "") << "Why: " << r.verdict_reason << ".\n\n"
+     << h2 << "Baseline\n\n";
   os << "identified on the training part, predicted on the held-out part (" << r.holdout << "; "
      << r.holdout_reason << "): " << r.observations << " observations, " << r.parameters
      << " parameters (rank " << r.rank << ").\n";
@@ -127,15 +140,15 @@ void print_report(std::ostream& os, const GapResult& r, const Model& model, cons
     os << "| output | held-out RMS before | max | after the explanation |\n|---|---|---|---|\n";
   else
     os << "output  held-out rms  max      after\n";
-  for (std::size_t o = 0; o < 6; ++o) {
+  for (std::size_t o = 0; o < kObservationKinds; ++o) {
     if (!r.count[o]) continue;
     if (markdown)
-      os << "| " << output_name(o) << " | " << f3(r.baseline_rms[o]) << " | "
+      os << "| " << observation_name(o) << " | " << f3(r.baseline_rms[o]) << " | "
          << f3(r.baseline_max[o]) << " | " << f3(r.final_rms[o]) << " |\n";
     else
-      os << std::left << std::setw(8) << output_name(o) << std::right << std::setw(12)
+      os << std::left << std::setw(8) << observation_name(o) << std::right << std::setw(12)
          << f3(r.baseline_rms[o]) << std::setw(9) << f3(r.baseline_max[o]) << std::setw(11)
-         << f3(r.final_rms[o]) << "  " << (o < 3 ? "µm" : "µrad") << "\n";
+         << f3(r.final_rms[o]) << "  " << (o < 3 || o == kRadialOutput ? "µm" : "µrad") << "\n";
   }
   os << "\n" << h2 << "Where\n\n";
   std::size_t shown = 0;
@@ -154,14 +167,16 @@ void print_report(std::ostream& os, const GapResult& r, const Model& model, cons
           "significant |\n|---|---|---|---|---|---|\n";
   for (const EffectFit& e : r.effects) {
     if (markdown)
-      os << "| " << e.name << " | " << e.summary << " | " << f3(e.heldout_rms_before_um) << " → "
-         << f3(e.heldout_rms_after_um) << " | " << f3(e.shrink_pct) << " % | " << f3(e.p_value)
-         << " | " << (e.significant ? "yes" : "no") << " |\n";
+      os << "| " << e.name << " | " << e.summary
+         << (e.distinguishable ? "" : not_distinguishable(e)) << " | "
+         << f3(e.heldout_rms_before_um) << " → " << f3(e.heldout_rms_after_um) << " | "
+         << f3(e.shrink_pct) << " % | " << f3(e.p_value) << " | " << (e.significant ? "yes" : "no")
+         << " |\n";
     else
       os << "  " << std::left << std::setw(14) << e.name << std::right << std::setw(8)
          << f3(e.heldout_rms_after_um) << " µm (" << std::setw(6) << f3(e.shrink_pct) << " %)  p "
          << std::setw(8) << f3(e.p_value) << (e.significant ? "  *  " : "     ") << e.summary
-         << "\n";
+         << (e.distinguishable ? "" : not_distinguishable(e)) << "\n";
   }
   os << "\n" << h2 << "How far it shrinks\n\n";
   os << "held-out RMS " << f3(r.baseline_rms_um) << " → " << f3(r.final_rms_um) << " µm ("
@@ -252,6 +267,8 @@ int verb_gap(const Args& args) {
       "draw residual-versus-coordinate and effect-ranking plots into DIR (PNG)")(
       "allow-unknown", "warn about unknown columns instead of failing")(
       "quiet,q", po::bool_switch(&flags.quiet), "no model messages on stderr");
+  BallbarFlags circle;
+  opts.add(ballbar_circle_options(circle));
   opts.add(model_options(flags));
   po::variables_map vm;
   if (auto stop = parse_args<std::string>("gap", args, opts, "machine", 1, vm)) return *stop;
@@ -291,7 +308,7 @@ int verb_gap(const Args& args) {
   const MeasurementTable table =
       read_measurements(data, machine_read_options(desc, vm.count("allow-unknown") > 0));
   for (const auto& w : table.warnings) std::cerr << w << "\n";
-  const GapData gd = gap_data(table, desc, fixed);
+  const GapData gd = gap_data(table, desc, fixed, circle, model->parameters());
   const HoldoutScheme scheme = given ? *given : default_holdout(gd);
   const std::string reason =
       given ? "given"

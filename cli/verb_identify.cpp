@@ -198,15 +198,9 @@ int verb_identify(const Args& args) {
       "json", po::value<std::string>(&json_path), "write the results as JSON to FILE")(
       "emit-params", po::value<std::string>(&emit),
       "write the identified parameters as a standalone C++ header to FILE")(
-      "plane", po::value<std::string>(&circle.plane),
-      "ballbar --predict files: the circle's plane (XY, YZ, ZX) over the '# plane:' key")(
-      "centre", po::value<std::string>(&circle.centre),
-      "ballbar: the centre, e.g. X=250,Y=0,Z=-100 (mm, deg) over '# centre:'")(
-      "radius", po::value<std::string>(&circle.radius),
-      "ballbar: the radius, e.g. 100mm, over '# radius:'")(
-      "feed", po::value<std::string>(&circle.feed), "ballbar: ccw or cw, over '# feed:'")(
       "allow-unknown", "warn about unknown columns instead of failing")(
       "quiet,q", po::bool_switch(&flags.quiet), "no model messages on stderr");
+  opts.add(ballbar_circle_options(circle));
   opts.add(model_options(flags));
   po::variables_map vm;
   if (auto stop = parse_args<std::string>("identify", args, opts, "machine", 1, vm)) return *stop;

@@ -534,6 +534,17 @@ std::vector<double> ballbar_pose(const BallbarMachine& machine, const BallbarCir
   return q;
 }
 
+std::vector<std::array<double, 3>> ballbar_directions(const BallbarMachine& machine,
+                                                      const BallbarCircle& circle,
+                                                      const std::vector<double>& angles_deg) {
+  std::vector<std::array<double, 3>> out;
+  for (const V3& v : nominal_vectors(machine, circle, angles_deg)) {
+    const double len = norm(v);
+    out.push_back({v[0] / len, v[1] / len, v[2] / len});
+  }
+  return out;
+}
+
 std::vector<double> ballbar_angles(const BallbarCircle& circle, std::size_t points) {
   if (points == 0) throw std::invalid_argument("ballbar: a trace needs at least one point");
   std::vector<double> a(points);

@@ -92,6 +92,11 @@ BallbarCircle parse_ballbar_circle(const BallbarFlags& flags, const BallbarMachi
 // The pose at angle θ (Description::axes() order and units).
 std::vector<double> ballbar_pose(const BallbarMachine& machine, const BallbarCircle& circle,
                                  double angle_deg);
+// The unit vector from the table ball to the tool ball at each angle (workpiece frame, nominal
+// kinematics): to first order dr = direction · (dx, dy, dz). Throws as predict_ballbar.
+std::vector<std::array<double, 3>> ballbar_directions(const BallbarMachine& machine,
+                                                      const BallbarCircle& circle,
+                                                      const std::vector<double>& angles_deg);
 // `points` angles in feed order from start_angle_deg, evenly spaced over one turn, each reduced
 // to [0, 360): ccw 0, 1, ..., 359; cw 0, 359, ..., 1 (points = 360).
 std::vector<double> ballbar_angles(const BallbarCircle& circle, std::size_t points);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <boost/math/distributions/fisher_f.hpp>
 #include <cmath>
+#include <cstdio>
 #include <numeric>
 #include <set>
 #include <stdexcept>
@@ -37,14 +38,55 @@ std::size_t distinct(const std::vector<double>& v) {
 
 // ---- Data ------------------------------------------------------------------------------------
 
+namespace {
+
+// A ballbar trace's dr observations: poses on the circle, the ball-to-ball unit vectors.
+PointData ballbar_points(const MeasurementTable& t, const Description& desc,
+                         const BallbarFlags& flags, const std::vector<double>& parameters,
+                         std::optional<BallbarCircle>& circle) {
+  const BallbarMachine machine = ballbar_machine(desc, parameters);
+  circle = parse_ballbar_circle(t, machine, flags);
+  if (!t.has("angle_deg"))
+    throw InputError(SourceLoc{t.file, t.header_line, 0},
+                     "a ballbar trace needs an 'angle_deg' column beside 'dr_um' (columns: " +
+                         join(t.columns) + ")");
+  const std::vector<double>& angle = t.column("angle_deg");
+  const std::vector<double>& dr = t.column("dr_um");
+  PointData p;
+  p.file = t.file;
+  p.poses.assign(t.rows(), {});
+  for (std::size_t r = 0; r < t.rows(); ++r) {
+    if (!std::isfinite(dr[r])) continue;
+    if (!std::isfinite(angle[r]))
+      throw InputError(SourceLoc{t.file, t.lines[r], 0},
+                       "column 'angle_deg' is empty but dr_um is measured");
+    p.poses[r] = ballbar_pose(machine, *circle, angle[r]);
+    PointObservation ob;
+    ob.row = r;
+    ob.line = t.lines[r];
+    ob.output = kRadialOutput;
+    ob.value = dr[r];
+    ob.radial = ballbar_directions(machine, *circle, {angle[r]}).front();
+    p.observations.push_back(ob);
+    ++p.count[kRadialOutput];
+  }
+  if (p.observations.empty())
+    throw InputError(SourceLoc{t.file, 0, 0}, "no observations (no row has a measured dr_um)");
+  return p;
+}
+
+}  // namespace
+
 GapData gap_data(const MeasurementTable& table, const Description& desc,
-                 const std::map<std::string, double>& fixed) {
+                 const std::map<std::string, double>& fixed, const BallbarFlags& ballbar,
+                 const std::vector<double>& parameters) {
   MeasurementTable t = table;
   GapData g;
+  const bool trace = t.has("dr_um");
   for (int b : desc.axes()) {
     const std::string& c = desc.bodies[static_cast<std::size_t>(b)].joint.coordinate;
     g.axes.push_back(c);
-    if (t.has(c)) continue;
+    if (trace || t.has(c)) continue;
     const auto it = fixed.find(c);
     if (it == fixed.end())
       throw InputError(SourceLoc{t.file, t.header_line, 0},
@@ -59,7 +101,7 @@ GapData gap_data(const MeasurementTable& table, const Description& desc,
     t.info.push_back(info);
     g.fixed_axes.push_back(c);
   }
-  g.points = point_data(t, desc);
+  g.points = trace ? ballbar_points(t, desc, ballbar, parameters, g.circle) : point_data(t, desc);
   const std::size_t rows = t.rows();
   g.time_s = t.has("t_s") ? t.column("t_s") : std::vector<double>(rows, kNaN);
   g.cycle = t.has("cycle") ? t.column("cycle") : std::vector<double>(rows, kNaN);
@@ -92,8 +134,17 @@ GapData gap_data(const MeasurementTable& table, const Description& desc,
   }
   if (t.has("t_s")) check_varies("t_s", g.time_s, "s");
   // Directions: dir_<axis>, or `dir` for the axis that varies most.
+  if (trace) {
+    check_varies("angle_deg", t.column("angle_deg"), "deg");
+    g.covariate["angle_deg"] = t.column("angle_deg");
+  }
   for (const std::string& c : t.columns_with(ColumnRole::Direction)) {
     std::string axis = t.info_of(c).axis;
+    if (axis.empty() && trace) {  // a trace's `dir` is its feed (ccw +1, cw -1)
+      check_varies("dir", t.column(c), "");
+      g.covariate["feed"] = t.column(c);
+      continue;
+    }
     if (axis.empty()) {
       std::size_t best = 0;
       for (const std::string& a : g.axes) {
@@ -435,7 +486,7 @@ NoiseFloor noise_floor(const GapData& d, const VectorXd& heldout) {
     groups[key].push_back(i);
   }
   std::size_t repeated = 0;
-  std::array<std::vector<std::vector<double>>, 6> seq;
+  std::array<std::vector<std::vector<double>>, kObservationKinds> seq;
   for (auto& [key, idx] : groups) {
     if (idx.size() < 2) continue;
     repeated += idx.size();
@@ -447,28 +498,28 @@ NoiseFloor noise_floor(const GapData& d, const VectorXd& heldout) {
   }
   const bool repeats = repeated * 10 >= obs.size() * 3;  // >= 30 % of observations repeated
   // Small-scale sequences: the held-out residual in time (or row) order, per output.
-  std::array<std::vector<std::vector<double>>, 6> small;
+  std::array<std::vector<std::vector<double>>, kObservationKinds> small;
   {
     std::vector<std::size_t> order(obs.size());
     std::iota(order.begin(), order.end(), 0);
     std::stable_sort(order.begin(), order.end(),
                      [&](std::size_t a, std::size_t b) { return time_of(a) < time_of(b); });
-    std::array<std::vector<double>, 6> s;
+    std::array<std::vector<double>, kObservationKinds> s;
     for (std::size_t i : order)
       if (std::isfinite(heldout[static_cast<Index>(i)]))
         s[static_cast<std::size_t>(obs[i].output)].push_back(heldout[static_cast<Index>(i)]);
-    for (std::size_t o = 0; o < 6; ++o) small[o].push_back(s[o]);
+    for (std::size_t o = 0; o < kObservationKinds; ++o) small[o].push_back(s[o]);
   }
   struct Estimate {
-    std::array<double, 6> per_output{};
+    std::array<double, kObservationKinds> per_output{};
     double sigma = kNaN, dof = 0;
     std::size_t n = 0;
   };
-  auto estimate = [](const std::array<std::vector<std::vector<double>>, 6>& sq) {
+  auto estimate = [](const std::array<std::vector<std::vector<double>>, kObservationKinds>& sq) {
     Estimate e;
     std::vector<std::vector<double>> all;
     e.per_output.fill(kNaN);
-    for (std::size_t o = 0; o < 6; ++o) {
+    for (std::size_t o = 0; o < kObservationKinds; ++o) {
       double s2 = 0, dof = 0;
       std::size_t n = 0;
       mssd(sq[o], s2, dof, n);
@@ -559,14 +610,14 @@ std::vector<GapRegion> localise(const GapData& d, const VectorXd& r, const Vecto
     g.rms_um = gp.n ? std::sqrt(ss / static_cast<double>(gp.n)) : 0;
     gap_stats(gp, nf.dof, g.excess_um, g.p_value);
   };
-  for (int o = 0; o < 6; ++o) {
+  for (int o = 0; o < static_cast<int>(kObservationKinds); ++o) {
     std::vector<std::size_t> idx;
     for (std::size_t i = 0; i < obs.size(); ++i)
       if (obs[i].output == o) idx.push_back(i);
     if (idx.empty()) continue;
     GapRegion g;
     g.by = "output";
-    g.output = output_name(static_cast<std::size_t>(o));
+    g.output = observation_name(static_cast<std::size_t>(o));
     stats(g, idx);
     bins.push_back(g);
     for (const Dim& dm : dims) {
@@ -590,7 +641,7 @@ std::vector<GapRegion> localise(const GapData& d, const VectorXd& r, const Vecto
       for (std::size_t b = 0; b < nb; ++b) {
         GapRegion reg;
         reg.by = dm.by;
-        reg.output = output_name(static_cast<std::size_t>(o));
+        reg.output = observation_name(static_cast<std::size_t>(o));
         reg.from = range[b].first;
         reg.to = range[b].second;
         stats(reg, members[b]);
@@ -778,8 +829,8 @@ Evaluated evaluate(const gap_detail::Candidate& c, const Engine& e, std::size_t 
   if (!std::isfinite(best_train)) return best;
   // Held-out before/after.
   Gap before, afterg;
-  std::array<double, 6> sb{}, sa{};
-  std::array<std::size_t, 6> n{};
+  std::array<double, kObservationKinds> sb{}, sa{};
+  std::array<std::size_t, kObservationKinds> n{};
   const auto& obs = e.data.points.observations;
   best.heldout_sse = 0;
   for (Index i = 0; i < e.y.size(); ++i) {
@@ -794,7 +845,7 @@ Evaluated evaluate(const gap_detail::Candidate& c, const Engine& e, std::size_t 
     ++before.n;
   }
   best.heldout_sse = afterg.ss;
-  for (std::size_t o = 0; o < 6; ++o) {
+  for (std::size_t o = 0; o < kObservationKinds; ++o) {
     best.fit.rms_before[o] = n[o] ? std::sqrt(sb[o] / static_cast<double>(n[o])) : kNaN;
     best.fit.rms_after[o] = n[o] ? std::sqrt(sa[o] / static_cast<double>(n[o])) : kNaN;
   }
@@ -828,6 +879,86 @@ Evaluated evaluate(const gap_detail::Candidate& c, const Engine& e, std::size_t 
   return best;
 }
 
+// The shape degrees of freedom the data leave along coordinate `axis` in `output` beyond the
+// baseline design A0 (rank rank0): the rank that one free value per distinct position adds.
+std::size_t shape_dof_free(const MatrixXd& A0, std::size_t rank0, const GapData& d, int axis,
+                           int output) {
+  const auto& obs = d.points.observations;
+  std::vector<double> levels;
+  for (const auto& o : obs)
+    if (observation_weight(o, output) != 0)
+      levels.push_back(d.points.poses[o.row][static_cast<std::size_t>(axis)]);
+  std::sort(levels.begin(), levels.end());
+  levels.erase(std::unique(levels.begin(), levels.end()), levels.end());
+  MatrixXd AG = MatrixXd::Zero(A0.rows(), A0.cols() + static_cast<Index>(levels.size()));
+  AG.leftCols(A0.cols()) = A0;
+  for (std::size_t i = 0; i < obs.size(); ++i) {
+    const double w = observation_weight(obs[i], output);
+    if (w == 0) continue;
+    const double q = d.points.poses[obs[i].row][static_cast<std::size_t>(axis)];
+    const auto l = std::lower_bound(levels.begin(), levels.end(), q) - levels.begin();
+    AG(static_cast<Index>(i), A0.cols() + l) = w;
+  }
+  const std::size_t r = EquilibratedSvd(AG, 1e-9, /*full_v=*/false).rank();
+  return r > rank0 ? r - rank0 : 0;
+}
+
+std::string pct(double fraction) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.0f %%", 100 * fraction);
+  return b;
+}
+
+// The verdict and its reason from the greedy explanation (docs/gap.md, "Verdict"). `shape` holds
+// each accepted effect's (coordinate, output) when it is a shape along a coordinate.
+void decide_verdict(GapResult& R, const GapOptions& opt, const std::vector<std::string>& axes,
+                    bool gap_significant, double explained,
+                    const std::vector<std::pair<int, int>>& shape) {
+  auto unexplained = [&](std::string why) {
+    R.verdict = "unexplained";
+    R.verdict_reason = std::move(why);
+  };
+  if (R.explanation.empty()) {
+    if (gap_significant)
+      unexplained("a significant held-out gap that no candidate of the library removes");
+    else
+      R.verdict = "none", R.verdict_reason = "the held-out gap is at the noise floor";
+    return;
+  }
+  const EffectFit& first = R.explanation.front();
+  for (std::size_t k = 0; k < R.explanation.size(); ++k) {
+    const EffectFit& f = R.explanation[k];
+    if (f.distinguishable || (k > 0 && shape[k] != shape[0])) continue;
+    const std::string along = axes[static_cast<std::size_t>(shape[k].first)];
+    const std::string out = observation_name(static_cast<std::size_t>(shape[k].second));
+    return unexplained(f.name + " along " + along + " in " + out + " fits, but " +
+                       f.indistinct_reason);
+  }
+  if (shape[0].first >= 0 && first.explained_fraction < opt.explain_fraction)
+    for (std::size_t k = 1; k < R.explanation.size(); ++k)
+      if (shape[k] == shape[0])
+        return unexplained(first.name + " removes " + pct(first.explained_fraction) +
+                           " of the excess and needs " + R.explanation[k].name +
+                           " along the same coordinate and output: a shape outside the library");
+  if (first.explained_fraction < 0.5)
+    return unexplained("the first effect, " + first.name + ", removes only " +
+                       pct(first.explained_fraction) + " of the excess held-out sum of squares");
+  if (R.final_p_value < opt.alpha) {
+    if (explained < opt.explain_fraction)
+      return unexplained("the accepted effects remove " + pct(explained) +
+                         " of the excess and leave a significant gap");
+    if (R.final_rms_um > 2 * R.noise.sigma_um)
+      return unexplained("the accepted effects leave a significant held-out RMS of more than " +
+                         std::string("twice the noise floor"));
+  }
+  R.verdict = first.name;
+  R.verdict_reason =
+      first.name + " removes " + pct(first.explained_fraction) +
+      " of the excess held-out sum of squares" +
+      (R.explanation.size() > 1 ? ", the accepted effects " + pct(explained) : "") +
+      (R.final_p_value >= opt.alpha ? "; the remaining gap is at the noise floor" : "");
+}
+
 }  // namespace
 
 void GapDiagnosis::run(const GapData& data, const HoldoutScheme& scheme,
@@ -857,10 +988,10 @@ void GapDiagnosis::run(const GapData& data, const HoldoutScheme& scheme,
   R.noise = noise_floor(data, r);
   const double s2 = R.noise.sigma_um * R.noise.sigma_um;
 
-  auto summarise = [&](const VectorXd& res, std::array<double, 6>& rms, double& total,
-                       std::array<double, 6>* mx) {
-    std::array<double, 6> ss{};
-    std::array<std::size_t, 6> n{};
+  auto summarise = [&](const VectorXd& res, std::array<double, kObservationKinds>& rms,
+                       double& total, std::array<double, kObservationKinds>* mx) {
+    std::array<double, kObservationKinds> ss{};
+    std::array<std::size_t, kObservationKinds> n{};
     double all = 0;
     std::size_t na = 0;
     if (mx) mx->fill(0);
@@ -871,7 +1002,7 @@ void GapDiagnosis::run(const GapData& data, const HoldoutScheme& scheme,
       ss[o] += v * v, ++n[o], all += v * v, ++na;
       if (mx) (*mx)[o] = std::max((*mx)[o], std::abs(v));
     }
-    for (std::size_t o = 0; o < 6; ++o) {
+    for (std::size_t o = 0; o < kObservationKinds; ++o) {
       rms[o] = n[o] ? std::sqrt(ss[o] / static_cast<double>(n[o])) : kNaN;
       if (mx && !n[o]) (*mx)[o] = kNaN;
     }
@@ -905,6 +1036,30 @@ void GapDiagnosis::run(const GapData& data, const HoldoutScheme& scheme,
   const bool gap_significant = R.baseline_p_value < options_.alpha;
   VectorXd cur_r = r, cur_h = h;
   std::vector<bool> used(candidates.size(), false);
+  // Shape effects: free shape dof per (coordinate, output), and the dof the accepted ones use.
+  const MatrixXd A0 = e.A;
+  const std::size_t rank0 = e.full_rank;
+  std::map<std::pair<int, int>, std::size_t> dof_free, dof_used;
+  std::vector<std::pair<int, int>> accepted_shape;  // per accepted effect; (-1, -1) if none
+  auto check_shape = [&](const gap_detail::Variant& v, EffectFit& fit) {
+    if (v.shape_axis < 0) return;
+    const std::pair<int, int> key{v.shape_axis, v.shape_output};
+    if (!dof_free.count(key))
+      dof_free[key] = shape_dof_free(A0, rank0, data, v.shape_axis, v.shape_output);
+    fit.shape_dof_free = dof_free[key];
+    fit.shape_dof_used = dof_used[key] + fit.extra_parameters + v.refine.size();
+    if (fit.shape_dof_used >= fit.shape_dof_free) {
+      const std::string along = data.axes[static_cast<std::size_t>(v.shape_axis)];
+      fit.distinguishable = false;
+      fit.indistinct_reason =
+          "the data leave " + std::to_string(fit.shape_dof_free) +
+          " shape degrees of freedom along " + along + " beyond the model and the fitted shape" +
+          (dof_used[key] ? "s use " : " uses ") + std::to_string(fit.shape_dof_used) +
+          ": any shape would fit as well (a step, a bump, a period); measure "
+          "more positions along " +
+          along;
+    }
+  };
   for (int step = 0; step < options_.max_effects; ++step) {
     std::vector<Evaluated> ev;
     for (std::size_t k = 0; k < candidates.size(); ++k) {
@@ -913,6 +1068,7 @@ void GapDiagnosis::run(const GapData& data, const HoldoutScheme& scheme,
           evaluate(candidates[k], e, param_.size(), cur_r, cur_h, s2, options_.alpha, n_candidates);
       if (!std::isfinite(x.heldout_sse)) continue;
       candidates[k].describe(x.variant, x.coef, x.fit);
+      check_shape(x.variant, x.fit);
       ev.push_back(std::move(x));
       ev.back().fit.name = candidates[k].name;
     }
@@ -938,6 +1094,12 @@ void GapDiagnosis::run(const GapData& data, const HoldoutScheme& scheme,
     e.refit();
     e.heldout(cur_r, cur_h);
     R.explanation.push_back(fit);
+    if (pick->variant.shape_axis >= 0) {
+      accepted_shape.emplace_back(pick->variant.shape_axis, pick->variant.shape_output);
+      dof_used[accepted_shape.back()] = fit.shape_dof_used;
+    } else {
+      accepted_shape.emplace_back(-1, -1);
+    }
     // Thermal drift may need a second sensor or lag; other effects are taken once.
     for (std::size_t k = 0; k < candidates.size(); ++k)
       if (candidates[k].name == fit.name && fit.name != "thermal_drift") used[k] = true;
@@ -954,15 +1116,7 @@ void GapDiagnosis::run(const GapData& data, const HoldoutScheme& scheme,
   const double excess_ss = std::max(0.0, base.ss - base.expected);
   const double explained =
       excess_ss > 0 ? explained_ss / excess_ss : (base.ss > 0 ? explained_ss / base.ss : 0);
-  if (!gap_significant && R.explanation.empty())
-    R.verdict = "none";
-  else if (R.explanation.empty())
-    R.verdict = "unexplained";
-  else if ((R.final_p_value >= options_.alpha || explained >= options_.explain_fraction) &&
-           R.explanation.front().explained_fraction >= 0.5)
-    R.verdict = R.explanation.front().name;  // named only when it carries most of the gap
-  else
-    R.verdict = "unexplained";
+  decide_verdict(R, options_, data.axes, gap_significant, explained, accepted_shape);
   result_ = std::move(R);
 }
 

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "ballbar.hpp"
 #include "identify.hpp"
 #include "measurement_csv.hpp"
 #include "model.hpp"
@@ -33,14 +34,22 @@ struct GapData {
   std::map<std::string, std::vector<double>> temperature;  // T_<name> -> °C per row
   std::map<std::string, std::vector<double>> covariate;    // rpm, ... per row
   std::vector<std::string> fixed_axes;  // coordinates not in the table, taken from `fixed`
+  std::optional<BallbarCircle> circle;  // a ballbar trace: its circle (observations are dr)
 };
 
 // Reads a table. Coordinates missing from the table take `fixed` values (mm, deg; else
 // InputError naming the missing column). InputError for: no deviation column, NaN coordinates,
 // a covariate or temperature column that is constant (it cannot explain anything), fewer than
 // 10 observations.
+//
+// A ballbar trace (a dr_um column; docs/data-format.md) gives one dr observation per row with a
+// measured dr_um: the pose is the circle's at angle_deg (axis columns, if present, are not
+// read), the circle comes from the `# plane/centre/radius/feed` keys with `ballbar` flags
+// overriding, and the nominal kinematics from the machine with `parameters` (empty: defaults).
+// A `dir` column there is the feed direction (covariate `feed`); `angle_deg` is a covariate.
 GapData gap_data(const MeasurementTable& table, const Description& desc,
-                 const std::map<std::string, double>& fixed = {});
+                 const std::map<std::string, double>& fixed = {}, const BallbarFlags& ballbar = {},
+                 const std::vector<double>& parameters = {});
 
 // How observations are split into training and held-out parts (no observation in both parts of
 // one split; every observation held out exactly once over the splits, except `forward`).
@@ -70,11 +79,11 @@ std::vector<Split> make_splits(const GapData& data, const HoldoutScheme& scheme,
                                std::size_t min_train);
 
 struct NoiseFloor {
-  double sigma_um = 0;                 // pooled over outputs (µm or µrad as measured)
-  std::array<double, 6> per_output{};  // NaN where not measured
-  double dof = 0;                      // degrees of freedom of sigma² (for the F tests)
-  std::string source;                  // "repeats" or "small-scale"
-  std::string detail;                  // "412 successive differences of repeated poses"
+  double sigma_um = 0;  // pooled over outputs (µm or µrad as measured)
+  std::array<double, kObservationKinds> per_output{};  // NaN where not measured
+  double dof = 0;      // degrees of freedom of sigma² (for the F tests)
+  std::string source;  // "repeats" or "small-scale"
+  std::string detail;  // "412 successive differences of repeated poses"
 };
 
 struct GapRegion {
@@ -96,26 +105,36 @@ struct EffectFit {
   std::size_t extra_parameters = 0;
   double tested_variants = 1;  // the multiplicity the p-value is corrected for
   double heldout_rms_before_um = 0, heldout_rms_after_um = 0, shrink_pct = 0;
-  std::array<double, 6> rms_before{}, rms_after{};  // held-out per output
-  double f_statistic = 0, p_value = 1;              // training nested-model test, corrected
+  std::array<double, kObservationKinds> rms_before{}, rms_after{};  // held-out per output
+  double f_statistic = 0, p_value = 1;  // training nested-model test, corrected
   bool significant = false;
   double explained_fraction = 0;  // of the held-out excess variance over the noise floor
+  // Shapes along one coordinate (periodic, pdge_shape): the shape degrees of freedom the data
+  // leave there beyond the model (distinct positions in this output, less what the model
+  // absorbs) and those the effect uses (columns plus refined hyper-parameters, with the shapes
+  // accepted before it along the same coordinate and output). When it uses them all it fits any
+  // shape — a step as well as a bump — and the verdict cannot name it.
+  std::size_t shape_dof_free = 0, shape_dof_used = 0;
+  // False also for a bump over fewer than 3 sample positions (it cannot be told from a step).
+  bool distinguishable = true;
+  std::string indistinct_reason;  // why not, one clause
 };
 
 struct GapResult {
   std::string holdout;         // the scheme used
   std::string holdout_reason;  // why (default choice) or "given"
   std::size_t observations = 0, parameters = 0, rank = 0;
-  std::array<std::size_t, 6> count{};
+  std::array<std::size_t, kObservationKinds> count{};
   NoiseFloor noise;
-  std::array<double, 6> baseline_rms{}, baseline_max{};  // held-out, per output
+  std::array<double, kObservationKinds> baseline_rms{}, baseline_max{};  // held-out, per output
   double baseline_rms_um = 0;
   double baseline_excess_um = 0, baseline_p_value = 1;  // held-out gap over the noise floor
   std::vector<GapRegion> where;        // significant regions first (by p-value), then the rest
   std::vector<EffectFit> effects;      // ranked by held-out improvement (first step)
   std::vector<EffectFit> explanation;  // the greedy sequence that was accepted
   std::string verdict;                 // an effect name, "none" or "unexplained"
-  std::array<double, 6> final_rms{};   // held-out after the accepted effects
+  std::string verdict_reason;          // one sentence: why this verdict
+  std::array<double, kObservationKinds> final_rms{};  // held-out after the accepted effects
   double final_rms_um = 0, final_excess_um = 0, final_p_value = 1;
   // Held-out residuals for plots: per observation (NaN when never held out).
   std::vector<double> residual_before, residual_after;

@@ -15,7 +15,7 @@ namespace {
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
 using Index = Eigen::Index;
-const char* unit_of(int o) { return o < 3 ? "µm" : "µrad"; }
+const char* unit_of(int o) { return o < 3 || o == kRadialOutput ? "µm" : "µrad"; }
 
 std::string num(double v, int digits = 3) {
   char b[48];
@@ -23,21 +23,27 @@ std::string num(double v, int digits = 3) {
   return b;
 }
 
+// The deviation outputs (0..5) the observations see: their own, and for ballbar dr the
+// in-plane directions.
 std::vector<int> outputs_of(const GapData& d) {
-  std::vector<int> o;
-  for (int k = 0; k < 6; ++k)
-    if (d.points.count[static_cast<std::size_t>(k)]) o.push_back(k);
-  return o;
+  std::set<int> o;
+  for (const auto& ob : d.points.observations)
+    for (int k = 0; k < 6; ++k)
+      if (observation_weight(ob, k) != 0) o.insert(k);
+  return {o.begin(), o.end()};
 }
 
-// Per observation: f(row) on the rows of output o, zero elsewhere; one column per output.
+// Per observation: f(row) in output o (as much of it as the observation sees, for dr its radial
+// component), zero elsewhere; one column per output.
 template <typename F>
 MatrixXd per_output(const GapData& d, const std::vector<int>& outs, F f) {
   const auto& obs = d.points.observations;
   MatrixXd E = MatrixXd::Zero(static_cast<Index>(obs.size()), static_cast<Index>(outs.size()));
   for (std::size_t i = 0; i < obs.size(); ++i)
-    for (std::size_t k = 0; k < outs.size(); ++k)
-      if (obs[i].output == outs[k]) E(static_cast<Index>(i), static_cast<Index>(k)) = f(obs[i].row);
+    for (std::size_t k = 0; k < outs.size(); ++k) {
+      const double w = observation_weight(obs[i], outs[k]);
+      if (w != 0) E(static_cast<Index>(i), static_cast<Index>(k)) = w * f(obs[i].row);
+    }
   return E;
 }
 
@@ -152,12 +158,13 @@ void add_thermal(const EffectContext& ctx, std::vector<Candidate>& out) {
     MatrixXd E = MatrixXd::Zero(static_cast<Index>(obs.size()), static_cast<Index>(outs_v.size()));
     for (std::size_t i = 0; i < obs.size(); ++i)
       for (std::size_t k = 0; k < outs_v.size(); ++k) {
-        if (obs[i].output != outs_v[k] || outs_v[k] > 2) continue;
+        const double w = observation_weight(obs[i], outs_v[k]);
+        if (w == 0 || outs_v[k] > 2) continue;
         const std::string axis(1, static_cast<char>('X' + outs_v[k]));
         const auto it = std::find(d.axes.begin(), d.axes.end(), axis);
         if (it == d.axes.end()) continue;
         const double q = d.points.poses[obs[i].row][static_cast<std::size_t>(it - d.axes.begin())];
-        E(static_cast<Index>(i), static_cast<Index>(k)) = (T[obs[i].row] - Tm) * q / 1000.0;
+        E(static_cast<Index>(i), static_cast<Index>(k)) = w * (T[obs[i].row] - Tm) * q / 1000.0;
       }
     std::vector<Index> keep;  // scale columns that vary (a fixed coordinate adds nothing)
     for (Index k = 0; k < E.cols(); ++k)
@@ -246,10 +253,11 @@ MatrixXd one_output(const GapData& d, int output,
   const auto& obs = d.points.observations;
   MatrixXd E = MatrixXd::Zero(static_cast<Index>(obs.size()), static_cast<Index>(f.size()));
   for (std::size_t i = 0; i < obs.size(); ++i) {
-    if (obs[i].output != output) continue;
+    const double w = observation_weight(obs[i], output);
+    if (w == 0) continue;
     const double q = d.points.poses[obs[i].row][axis];
     for (std::size_t k = 0; k < f.size(); ++k)
-      E(static_cast<Index>(i), static_cast<Index>(k)) = f[k](q);
+      E(static_cast<Index>(i), static_cast<Index>(k)) = w * f[k](q);
   }
   return E;
 }
@@ -271,15 +279,21 @@ void add_periodic(const EffectContext& ctx, std::vector<Candidate>& out) {
     // longer "period" would fit steps and trends that are not periodic.
     const double lo = 2.5 * step, hi = span / 1.5;
     if (!(hi > lo)) continue;
-    const int grid = 40;
-    const double ratio = std::pow(hi / lo, 1.0 / (grid - 1));
+    // Periods uniform in the number of cycles over the span, a quarter cycle apart (at least
+    // 40): a wave fitted with a period a quarter cycle off over the span has lost its phase by
+    // its far end, so a coarser grid can miss a short period on a long axis altogether.
+    const double c_lo = span / hi, c_hi = span / lo;
+    const int grid = std::max(40, static_cast<int>(std::ceil((c_hi - c_lo) / 0.25)) + 1);
+    const double dcyc = (c_hi - c_lo) / (grid - 1);
     for (int o : outputs_of(d))
       for (int g = 0; g < grid; ++g) {
-        const double period = lo * std::pow(ratio, g);
+        const double cycles = c_lo + dcyc * g, period = span / cycles;
         c.variants.push_back({axes[k].name + ", " + output_name(static_cast<std::size_t>(o)),
                               {static_cast<double>(k), static_cast<double>(o), period},
                               false,
-                              {{2, period / ratio, period * ratio}}});
+                              {{2, span / (cycles + dcyc), span / std::max(cycles - dcyc, 1.0)}}});
+        c.variants.back().shape_axis = static_cast<int>(axes[k].index);
+        c.variants.back().shape_output = o;
       }
   }
   if (c.variants.empty()) return;
@@ -322,14 +336,25 @@ void add_pdge_shape(const EffectContext& ctx, std::vector<Candidate>& out) {
       const std::string head = axes[k].name + ", " + output_name(static_cast<std::size_t>(o));
       c.variants.push_back(
           {head + ", degrees 4-5", {static_cast<double>(k), static_cast<double>(o), 1, 0, 0}});
-      const std::size_t stride = std::max<std::size_t>(1, L.size() / 25);
-      for (std::size_t i = 0; i < L.size(); i += stride)
-        for (double f : {1.0 / 30, 1.0 / 15, 1.0 / 8})
+      c.variants.back().shape_axis = static_cast<int>(axes[k].index);
+      c.variants.back().shape_output = o;
+      // Centres at a quarter of the sample spacing (at most 61): on a coarse grid the fit of a
+      // bump between two sample positions differs by orders of magnitude from one centred on
+      // either, so centres on the samples alone miss the truth's local minimum.
+      const std::size_t nc = std::min<std::size_t>(61, 4 * (L.size() - 1) + 1);
+      const double dc = span / static_cast<double>(nc - 1);
+      for (std::size_t i = 0; i < nc; ++i) {
+        const double centre = L.front() + dc * static_cast<double>(i);
+        for (double f : {1.0 / 30, 1.0 / 15, 1.0 / 8}) {
           c.variants.push_back(
               {head + ", bump",
-               {static_cast<double>(k), static_cast<double>(o), 0, L[i], span * f},
+               {static_cast<double>(k), static_cast<double>(o), 0, centre, span * f},
                false,
-               {{3, L[i] - span / 25, L[i] + span / 25}, {4, span * f / 2, span * f * 2}}});
+               {{3, centre - dc, centre + dc}, {4, span * f / 2, span * f * 2}}});
+          c.variants.back().shape_axis = static_cast<int>(axes[k].index);
+          c.variants.back().shape_output = o;
+        }
+      }
     }
   }
   c.columns = [&d, axes](const Variant& v, const std::vector<double>&) {
@@ -369,6 +394,18 @@ void add_pdge_shape(const EffectContext& ctx, std::vector<Candidate>& out) {
                     num(v.hyper[3], 4) + " (width " + num(v.hyper[4], 3) + ")";
       r.from = v.hyper[3] - 2 * v.hyper[4];
       r.to = v.hyper[3] + 2 * v.hyper[4];
+      // A bump is resolved when at least 3 sample positions carry a tenth of its height or
+      // more (|q - c| < 2.15 w); over one or two it is a step or a single position's offset.
+      const auto covered = std::count_if(a.levels.begin(), a.levels.end(), [&](double q) {
+        return std::abs(q - v.hyper[3]) < 2.15 * v.hyper[4];
+      });
+      fit.params["positions_covered"] = static_cast<double>(covered);
+      if (covered < 3) {
+        fit.distinguishable = false;
+        fit.indistinct_reason = "the bump covers " + std::to_string(covered) + " sample position" +
+                                (covered == 1 ? "" : "s") + " along " + a.name +
+                                ": narrower than the sampling, it cannot be told from a step";
+      }
     }
     fit.region = r;
   };
@@ -407,7 +444,7 @@ void add_higher_order(const EffectContext& ctx, std::vector<Candidate>& out) {
             predict_deviation(*ctx.model, md, *ctx.param, theta, q.data());
         for (std::size_t o = 0; o < 6; ++o) nonlinear[o] = full[o] - lin[o];
       }
-      E(static_cast<Index>(i), 0) = nonlinear[static_cast<std::size_t>(obs[i].output)];
+      E(static_cast<Index>(i), 0) = observe(obs[i], nonlinear);
     }
     return E;
   };
@@ -474,7 +511,7 @@ void add_missing_error(const EffectContext& ctx, std::vector<Candidate>& out) {
           const auto m2 = exact(chain, d.points.poses[row], err);
           for (std::size_t o = 0; o < 6; ++o) g[o] = (p[o] - m2[o]) / 2;
         }
-        mi.unit(static_cast<Index>(i), 0) = g[static_cast<std::size_t>(obs[i].output)];
+        mi.unit(static_cast<Index>(i), 0) = observe(obs[i], g);
       }
       if (mi.unit.norm() > 0) missing->push_back(std::move(mi));
     }
@@ -556,7 +593,7 @@ void add_tool_offset(const EffectContext& ctx, std::vector<Candidate>& out) {
         const auto p = exact(plus, q, err), m = exact(minus, q, err);
         for (std::size_t o = 0; o < 6; ++o) g[o] = (p[o] - m[o]) / 20;
       }
-      E(static_cast<Index>(i), 0) = g[static_cast<std::size_t>(obs[i].output)];
+      E(static_cast<Index>(i), 0) = observe(obs[i], g);
     }
     return E;
   };
@@ -587,14 +624,31 @@ void add_setup(const EffectContext& ctx, std::vector<Candidate>& out) {
     c.variants.push_back({std::string(output_name(static_cast<std::size_t>(o))) + " along " + axis,
                           {static_cast<double>(o), static_cast<double>(it - d.axes.begin())}});
   }
+  // A ballbar's length calibration: a constant dr (µm).
+  if (d.points.count[kRadialOutput]) c.variants.push_back({"ballbar length", {-1, 0}});
   if (c.variants.empty()) return;
   c.columns = [&d](const Variant& v, const std::vector<double>&) {
+    if (v.hyper[0] < 0) {
+      const auto& obs = d.points.observations;
+      MatrixXd E = MatrixXd::Zero(static_cast<Index>(obs.size()), 1);
+      for (std::size_t i = 0; i < obs.size(); ++i)
+        if (obs[i].output == kRadialOutput) E(static_cast<Index>(i), 0) = 1;
+      return E;
+    }
     const std::size_t a = static_cast<std::size_t>(v.hyper[1]);
     return one_output(d, static_cast<int>(v.hyper[0]),
                       {[](double q) { return q / 1000.0; }, [](double q) { return q * q / 1e6; }},
                       a);
   };
-  c.describe = [](const Variant& v, const VectorXd& coef, EffectFit& fit) {
+  c.describe = [&d](const Variant& v, const VectorXd& coef, EffectFit& fit) {
+    if (v.hyper[0] < 0) {
+      fit.params["length_um"] = coef[0];
+      const double r = d.circle ? d.circle->radius_mm : 0;
+      if (r > 0) fit.params["scale_ppm"] = coef[0] / r * 1000;
+      fit.summary = "ballbar length " + num(coef[0], 3) + " µm" +
+                    (r > 0 ? " (" + num(coef[0] / r * 1000, 3) + " µm/m of the radius)" : "");
+      return;
+    }
     fit.params["scale_ppm"] = coef[0];
     fit.params["quadratic_um_per_m2"] = coef[1];
     fit.summary = "measuring set-up: scale " + num(coef[0], 3) + " µm/m (ppm) in " + v.label +

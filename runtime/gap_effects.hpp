@@ -33,6 +33,10 @@ struct Variant {
   bool needs_theta = false;   // columns depend on the identified parameters
   // Continuous hyper-parameters refined around the grid value: (index, lo, hi) bounds.
   std::vector<Refine> refine;
+  // A shape along one coordinate in one output (periodic, pdge_shape): GapData::axes index and
+  // output 0..5; -1 for other effects. The diagnosis checks that the data can tell the shape
+  // from any other along that coordinate.
+  int shape_axis = -1, shape_output = -1;
 };
 
 struct Variant::Refine {

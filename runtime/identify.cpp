@@ -14,6 +14,10 @@
 
 namespace weilgen {
 
+const char* observation_name(std::size_t output) {
+  return output == kRadialOutput ? "dr" : output_name(output);
+}
+
 const std::array<const char*, 6> kDeviationColumns = {"dx_um",   "dy_um",   "dz_um",
                                                       "da_urad", "db_urad", "dc_urad"};
 
@@ -254,11 +258,17 @@ MatrixXd design_matrix(const Model& model, const ErrorParameterisation& param,
       param.derivatives(pose, jac.data());
       last_row = ob.row;
     }
-    const double* c = md.coeff.data() + static_cast<std::size_t>(ob.output) * ne;
-    for (std::size_t p = 0; p < np; ++p)
-      A(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(p)) =
-          kObservationScale[static_cast<std::size_t>(ob.output)] *
-          c[static_cast<std::size_t>(param.parameters()[p].error)] * jac[p];
+    for (std::size_t p = 0; p < np; ++p) {
+      const auto err = static_cast<std::size_t>(param.parameters()[p].error);
+      double v = 0;
+      for (int o = 0; o < 6; ++o) {
+        const double w = observation_weight(ob, o);
+        if (w != 0)
+          v += w * kObservationScale[static_cast<std::size_t>(o)] *
+               md.coeff[static_cast<std::size_t>(o) * ne + err];
+      }
+      A(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(p)) = v * jac[p];
+    }
   }
   return A;
 }

@@ -86,13 +86,37 @@ class ErrorParameterisation {
   std::vector<double> to_base_;       // declared unit → base unit, per error
 };
 
-// One measured value: output o (0..5 = dx dy dz da db dc) at a pose, in µm or µrad.
+// What an observation measures: the deviation outputs 0..5 (dx dy dz da db dc) or, 6, a ballbar's
+// change of ball distance dr (the deviation's component along the ball-to-ball direction).
+inline constexpr std::size_t kObservationKinds = 7;
+inline constexpr int kRadialOutput = 6;
+
+// One measured value: output o (0..5 = dx dy dz da db dc, 6 = dr) at a pose, in µm or µrad.
 struct PointObservation {
   std::size_t row = 0;  // row in the table
   int line = 0;         // source line
   int output = 0;
-  double value = 0;  // µm (dx..dz) or µrad (da..dc)
+  double value = 0;  // µm (dx..dz, dr) or µrad (da..dc)
+  // dr only: the unit vector from the table ball to the tool ball (workpiece frame), so that
+  // dr = radial · (dx, dy, dz) to first order.
+  std::array<double, 3> radial{};
 };
+
+// "dx" ... "dc", "dr".
+const char* observation_name(std::size_t output);
+
+// How much of deviation output o (0..5) observation `ob` sees: 1 for its own output, the radial
+// component for dr, else 0.
+inline double observation_weight(const PointObservation& ob, int o) {
+  if (ob.output == o) return 1;
+  if (ob.output == kRadialOutput && o < 3) return ob.radial[static_cast<std::size_t>(o)];
+  return 0;
+}
+// The observation's value (µm, µrad) for a deviation given per output in µm and µrad.
+inline double observe(const PointObservation& ob, const std::array<double, 6>& deviation) {
+  if (ob.output != kRadialOutput) return deviation[static_cast<std::size_t>(ob.output)];
+  return ob.radial[0] * deviation[0] + ob.radial[1] * deviation[1] + ob.radial[2] * deviation[2];
+}
 
 // Point measurements of a machine: the poses (independent axes, Description::axes() order, in
 // their units) and one observation per measured deviation cell.
@@ -100,7 +124,7 @@ struct PointData {
   std::string file;
   std::vector<std::vector<double>> poses;  // per table row
   std::vector<PointObservation> observations;
-  std::array<std::size_t, 6> count{};  // observations per output
+  std::array<std::size_t, kObservationKinds> count{};  // observations per output (and dr)
 };
 
 // From the model's outputs (mm, rad) to the measured µm and µrad, per output 0..5.
@@ -143,7 +167,7 @@ struct IdentifyResult {
   std::vector<NullCombination> unidentifiable;
   double residual_sigma = 0;  // √(SSE / (m − rank)), µm/µrad mixed as measured
   std::array<double, 6> rms_before{}, rms_after{}, max_after{};  // per output (NaN if none)
-  std::array<std::size_t, 6> count{};
+  std::array<std::size_t, kObservationKinds> count{};
   int gauss_newton_iterations = 0;
 };
 

@@ -15,12 +15,23 @@ EquilibratedSvd::EquilibratedSvd(const MatrixXd& A, double rank_tolerance, bool 
     if (zero_column_[static_cast<std::size_t>(p)]) scale_[p] = 1;
   }
   const MatrixXd As = A * scale_.cwiseInverse().asDiagonal();
-  Eigen::BDCSVD<MatrixXd> svd(
-      As, Eigen::ComputeThinU | (full_v ? Eigen::ComputeFullV : Eigen::ComputeThinV));
+  const unsigned options =
+      Eigen::ComputeThinU | (full_v ? Eigen::ComputeFullV : Eigen::ComputeThinV);
+  Eigen::BDCSVD<MatrixXd> svd(As, options);
   sigma_ = VectorXd::Zero(n);
-  sigma_.head(svd.singularValues().size()) = svd.singularValues();
-  U_ = svd.matrixU();
-  V_ = svd.matrixV();
+  if (svd.singularValues().allFinite() && svd.matrixU().allFinite() && svd.matrixV().allFinite()) {
+    sigma_.head(svd.singularValues().size()) = svd.singularValues();
+    U_ = svd.matrixU();
+    V_ = svd.matrixV();
+  } else {
+    // Eigen 3.4's divide-and-conquer SVD returns NaN for some strongly rank-deficient matrices
+    // (a 1010 × 75 design of rank 4, one linear axis measured: tests/test_lsq.cpp); the
+    // one-sided Jacobi SVD is slower but does not.
+    Eigen::JacobiSVD<MatrixXd> jacobi(As, options);
+    sigma_.head(jacobi.singularValues().size()) = jacobi.singularValues();
+    U_ = jacobi.matrixU();
+    V_ = jacobi.matrixV();
+  }
   const double smax = sigma_.size() ? sigma_[0] : 0;
   while (rank_ < static_cast<std::size_t>(std::min(n, U_.cols())) &&
          sigma_[static_cast<Index>(rank_)] > rank_tolerance * smax && smax > 0)

@@ -29,22 +29,45 @@ struct Row {
 // Effect added to (dx, dy, dz) in µm at a row.
 using EffectFn = std::function<std::array<double, 3>(const Row&)>;
 
+// vmc_3axis with random errors within their spreads (PDGEs quadratic, poly:2): its deviation
+// (µm, µrad) at a pose, and N(0, 1) deviates for the noise from a separate stream.
+class Truth {
+ public:
+  explicit Truth(std::uint32_t seed)
+      : choice_(poly2()),
+        param_(vmc()->description(), choice_),
+        md_(*vmc()),
+        noise_rng_(seed + 7919) {
+    const Description& d = vmc()->description();
+    std::mt19937 rng(seed);
+    for (const IdentParameter& ip : param_.parameters())
+      theta_.push_back(d.errors[static_cast<std::size_t>(ip.error)].distribution.b * n_(rng));
+  }
+  std::array<double, 6> deviation(const double* pose) {
+    return predict_deviation(*vmc(), md_, param_, theta_, pose);
+  }
+  double normal() { return n_(noise_rng_); }
+
+ private:
+  static PdgeBasisChoice poly2() {
+    PdgeBasisChoice c;
+    c.all = "poly:2";
+    return c;
+  }
+  PdgeBasisChoice choice_;
+  ErrorParameterisation param_;
+  ModelData md_;
+  std::vector<double> theta_;
+  std::mt19937 noise_rng_;
+  std::normal_distribution<double> n_{0, 1};
+};
+
 // A grid of X, Y, Z visited in `cycles` cycles (X back and forth: dir_X), 60 s per pose, a
 // spindle temperature rising 2 K with a 1 h lag; deviations from the machine's own model with
 // random errors (poly:2), plus the effect and N(0, noise²).
 std::string synth(std::uint32_t seed, const EffectFn& effect, double noise = 0.5, int cycles = 4,
                   int nx = 6, const std::function<std::array<double, 3>(const Row&)>& truth = {}) {
-  const Model& m = *vmc();
-  const Description& d = m.description();
-  PdgeBasisChoice c;
-  c.all = "poly:2";
-  const ErrorParameterisation p(d, c);
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> n(0, 1);
-  std::vector<double> theta;
-  for (const IdentParameter& ip : p.parameters())
-    theta.push_back(d.errors[static_cast<std::size_t>(ip.error)].distribution.b * n(rng));
-  ModelData md(m);
+  Truth truth_machine(seed);
   std::ostringstream s;
   s << "X,Y,Z,t_s,dir_X,cycle,T_spindle,dx_um,dy_um,dz_um\n";
   double t = 0;
@@ -63,7 +86,7 @@ std::string synth(std::uint32_t seed, const EffectFn& effect, double noise = 0.5
                       static_cast<double>(cy),
                       22 + 2 * (1 - std::exp(-t / 3600))};
           const double q[3] = {Y, X, Z};
-          std::array<double, 6> dev = predict_deviation(m, md, p, theta, q);
+          std::array<double, 6> dev = truth_machine.deviation(q);
           if (truth) {
             const auto tr = truth(r);
             for (int o = 0; o < 3; ++o)
@@ -73,7 +96,8 @@ std::string synth(std::uint32_t seed, const EffectFn& effect, double noise = 0.5
           s << X << "," << Y << "," << Z << "," << t << "," << r.dir_X << "," << cy << "," << r.T;
           for (int o = 0; o < 3; ++o)
             s << ","
-              << dev[static_cast<std::size_t>(o)] + e[static_cast<std::size_t>(o)] + noise * n(rng);
+              << dev[static_cast<std::size_t>(o)] + e[static_cast<std::size_t>(o)] +
+                     noise * truth_machine.normal();
           s << "\n";
           t += 60;
         }
@@ -138,8 +162,13 @@ TEST_CASE("gap: thermal drift with a lagged sensor") {
   const EffectFit* e = effect(r, "thermal_drift");
   REQUIRE(e);
   CHECK(e->params.count("sensor_T_spindle") == 1);
-  // Held-out RMS after, against the noise (0.5 µm) inflated by the held-out leverage.
-  CHECK(r.final_rms_um < 1.3 * 0.5);
+  CHECK(e->params.at("per_K_dx") == doctest::Approx(3.0).epsilon(0.1));
+  CHECK(e->params.at("per_K_dz") == doctest::Approx(-1.0).epsilon(0.1));
+  // What remains is noise: no significant gap against σ²(1 + h). The held-out RMS after exceeds
+  // the noise (0.5 µm) by the leverage of the heating cycle, whose temperatures the other
+  // cycles do not span.
+  CHECK(r.final_p_value >= 0.01);
+  CHECK(r.final_rms_um < 1.4 * 0.5);
 }
 
 TEST_CASE("gap: a local bump along Y in dz is localised") {
@@ -316,4 +345,121 @@ TEST_CASE("gap CLI: JSON schema, report, and bad flags or data") {
   CHECK(bad3.status == 3);
   CHECK(bad3.out.find("flat.csv:1: column 'T_a' is constant") != std::string::npos);
   CHECK_FALSE(std::filesystem::exists(never));
+}
+
+TEST_CASE("gap: a step where the data cannot tell shapes apart is unexplained, not a shape") {
+  // dx jumps by 6 µm at X = 250 mm. On 6 positions along X a quadratic PDGE basis leaves 3
+  // shape degrees of freedom, and a period or a bump uses 3: either fits, neither is named.
+  const EffectFn step = [](const Row& w) {
+    return std::array<double, 3>{w.X >= 250 ? 6.0 : 0.0, 0, 0};
+  };
+  const GapResult coarse = diagnose(synth(11, step, 0.5, 3, 6));
+  CHECK(coarse.verdict == "unexplained");
+  REQUIRE_FALSE(coarse.explanation.empty());
+  const EffectFit& first = coarse.explanation.front();
+  CHECK_FALSE(first.distinguishable);
+  CHECK(first.shape_dof_free == 3);
+  CHECK(first.shape_dof_used >= 3);
+  CHECK(coarse.verdict_reason.find("shape degrees of freedom along X") != std::string::npos);
+  // On 21 positions the shapes are told apart, and none fits a step: still not a name.
+  const GapResult fine = diagnose(synth(12, step, 0.5, 3, 21));
+  CHECK(fine.verdict == "unexplained");
+  CHECK(fine.baseline_p_value < 1e-6);
+}
+
+TEST_CASE("gap: a bump between the samples of a coarse grid is found and resolved") {
+  // 11 positions along X (50 mm apart); the bump sits between two of them.
+  const GapResult r = diagnose(synth(
+      13,
+      [](const Row& w) {
+        return std::array<double, 3>{0, 5.0 * std::exp(-0.5 * std::pow((w.X - 262) / 50, 2)), 0};
+      },
+      0.5, 3, 11));
+  CHECK(r.verdict == "pdge_shape");
+  const EffectFit* e = effect(r, "pdge_shape");
+  REQUIRE(e);
+  CHECK(e->distinguishable);
+  CHECK(e->params.at("centre") == doctest::Approx(262).epsilon(0.03));
+  CHECK(e->params.at("width") == doctest::Approx(50).epsilon(0.15));
+  CHECK(e->params.at("positions_covered") >= 3);
+}
+
+namespace {
+
+// A ballbar trace of vmc_3axis in XY (centre X 250, Y -200, Z -150 mm; radius 100 mm), 2°
+// steps, ccw then cw, `cycles` cycles; dr = exact projection of the model's deviation with
+// random errors plus `extra` (µm, in dx dy dz), plus N(0, noise²).
+std::string ballbar_synth(std::uint32_t seed, const EffectFn& extra, int cycles = 4,
+                          double noise = 0.4) {
+  Truth truth_machine(seed);
+  const BallbarMachine bm = ballbar_machine(vmc()->description());
+  BallbarFlags f;
+  f.plane = "XY";
+  f.centre = "X=250,Y=-200,Z=-150";
+  f.radius = "100";
+  const BallbarCircle circle = parse_ballbar_circle(f, bm);
+  std::ostringstream s;
+  s << "# plane: XY\n# centre: X=250, Y=-200, Z=-150\n# radius: 100 mm\n"
+    << "t_s,dir,dir_X,cycle,angle_deg,dr_um\n";
+  double t = 0;
+  for (int cy = 1; cy <= cycles; ++cy)
+    for (int feed : {1, -1})
+      for (int k = 0; k < 180; ++k) {
+        const double a = feed > 0 ? 2.0 * k : std::fmod(360 - 2.0 * k, 360.0);
+        const std::vector<double> q = ballbar_pose(bm, circle, a);  // Y, X, Z
+        const std::array<double, 3> u = ballbar_directions(bm, circle, {a}).front();
+        // X moves toward +X on the way up when the feed's tangent has a positive x part.
+        const double th = (a - feed * 1.0) * M_PI / 180;
+        const double dir_x = -feed * std::sin(th) > 0 ? 1 : -1;
+        const Row r{q[1], q[0], q[2], t, dir_x, static_cast<double>(cy), 22};
+        const std::array<double, 6> dev = truth_machine.deviation(q.data());
+        const std::array<double, 3> e = extra(r);
+        double dr = noise * truth_machine.normal();
+        for (std::size_t o = 0; o < 3; ++o) dr += u[o] * (dev[o] + e[o]);
+        s << t << "," << feed << "," << dir_x << "," << cy << "," << a << "," << dr << "\n";
+        t += 0.5;
+      }
+  return s.str();
+}
+
+}  // namespace
+
+TEST_CASE("gap: ballbar traces are dr observations; reversal on X is read from them") {
+  const MeasurementTable t = parse_measurements(ballbar_synth(21, none), "bb.csv");
+  const GapData d = gap_data(t, vmc()->description());
+  REQUIRE(d.circle);
+  CHECK(d.points.count[kRadialOutput] == 4 * 360);
+  CHECK(d.covariate.count("feed") == 1);
+  CHECK(d.covariate.count("angle_deg") == 1);
+  // A dr row of the design matrix is the radial projection of the dx, dy, dz rows at its pose.
+  PdgeBasisChoice c;
+  c.all = "poly:2";
+  const ErrorParameterisation p(vmc()->description(), c, vmc()->parameters());
+  PointData pd;
+  const PointObservation& dr = d.points.observations[37];
+  pd.poses = {d.points.poses[dr.row]};
+  for (int o = 0; o < 3; ++o) pd.observations.push_back({0, 0, o, 0.0, {}});
+  PointObservation r = dr;
+  r.row = 0;
+  pd.observations.push_back(r);
+  const Eigen::MatrixXd A = design_matrix(*vmc(), p, pd);
+  const Eigen::RowVectorXd projected =
+      dr.radial[0] * A.row(0) + dr.radial[1] * A.row(1) + dr.radial[2] * A.row(2);
+  CHECK((A.row(3) - projected).norm() <= 1e-12 * A.row(3).norm());
+  CHECK(std::hypot(dr.radial[0], dr.radial[1]) == doctest::Approx(1.0).epsilon(1e-12));
+
+  const MeasurementTable tr = parse_measurements(
+      ballbar_synth(22,
+                    [](const Row& w) {
+                      return std::array<double, 3>{2.5 * w.dir_X, 0, 0};  // B = 5 µm in dx
+                    }),
+      "bb.csv");
+  GapDiagnosis g(vmc(), p);
+  g.run(gap_data(tr, vmc()->description()), *parse_holdout("cycle:4"), "test");
+  const GapResult& res = g.result();
+  CHECK(res.verdict == "reversal");
+  const EffectFit* e = effect(res, "reversal");
+  REQUIRE(e);
+  CHECK(std::abs(e->params.at("reversal_dx")) == doctest::Approx(5.0).epsilon(0.1));
+  CHECK(res.final_rms[kRadialOutput] < 1.2 * 0.4);
 }

@@ -30,8 +30,6 @@ std::string text_of(const std::string& path) {
   return s;
 }
 
-
-
 void replace_once(std::string& s, const std::string& from, const std::string& to) {
   const auto pos = s.find(from);
   REQUIRE_MESSAGE(pos != std::string::npos, from);

@@ -11,12 +11,11 @@
 #include <random>
 
 #include "atomic_file.hpp"
+#include "bench/experiments/normal_deviates.hpp"
 #include "iso230_2.hpp"
 #include "measurement_csv.hpp"
 #include "plot.hpp"
 #include "test_support.hpp"
-
-#include "bench/experiments/normal_deviates.hpp"
 
 using namespace weilgen;
 using nlohmann::json;

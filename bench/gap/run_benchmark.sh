@@ -2,7 +2,7 @@
 # The sim-to-real gap benchmark in one command (bench/gap/README.md): writes the suite with fixed
 # seeds, runs `weilgen gap` on every scenario (2 at a time by default), scores the verdicts.
 #
-#   bench/gap/run_benchmark.sh WEILGEN [WORKDIR] [--quick] [--jobs N] [--layouts grid,line]
+#   bench/gap/run_benchmark.sh WEILGEN [WORKDIR] [--quick] [--jobs N] [--layouts grid,line,ballbar]
 #                              [--reps N] [--nones N] [--resume] [-- EXTRA GAP ARGS]
 #
 # WEILGEN is the weilgen executable (or any program with its `gap` interface, e.g.

@@ -115,7 +115,7 @@ std::vector<SuiteEntry> suite_entries(const Args& args) {
       quick ? std::vector<double>{1, 3, 10} : std::vector<double>{1, 2, 3, 5, 10};
   const int reps = static_cast<int>(number("--reps", args.get("--reps", quick ? "1" : "4")));
   const int nones = static_cast<int>(number("--nones", args.get("--nones", quick ? "4" : "20")));
-  const std::vector<std::string> layouts = split(args.get("--layouts", "grid,line"), ',');
+  const std::vector<std::string> layouts = split(args.get("--layouts", "grid,line,ballbar"), ',');
   const std::string machine = args.get("--machine", "vmc_3axis");
   const double noise_levels[2] = {0.5, 1.0};
   std::vector<SuiteEntry> out;

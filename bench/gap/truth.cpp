@@ -522,8 +522,11 @@ void Synthesiser::build_effect(Rng& rng) {
     effect_error_ = positioning_error(effect_axis_);
   } else if (effect_ == "periodic" || effect_ == "pdge_shape") {
     std::vector<int> cand = moving;
-    if (effect_ == "pdge_shape" && spec_.layout == "grid") {
-      // A local bump needs enough grid points along its axis to be local.
+    if (spec_.layout == "grid") {
+      // A local bump needs enough grid points along its axis to be local, and a period enough
+      // to be told from other shapes: on 7 positions a cubic PDGE leaves 3 shape degrees of
+      // freedom, which a period (amplitude, phase, period) or a bump (height, centre, width)
+      // uses up, so no data could tell either from a step there (docs/gap.md, "Verdict").
       std::vector<int> fine;
       for (int k : moving)
         if ((axes_[k].max - axes_[k].min) / grid_step_[k] >= 8 - 1e-9) fine.push_back(k);
