@@ -329,11 +329,17 @@ int verb_gap(const Args& args) {
     std::filesystem::create_directories(plot_dir);
     std::vector<std::string> bys;
     if (std::any_of(gd.time_s.begin(), gd.time_s.end(), [](double t) { return std::isfinite(t); }))
-      bys.push_back("t_s");  // the drift view, always
+      bys.push_back("t_s");                     // the drift view, always
+    if (gd.circle) bys.push_back("angle_deg");  // the trace view
+    auto add = [&](const std::string& by, std::size_t most) {
+      if (by != "output" && by.rfind("dir", 0) != 0 && by != "cycle" && by != "feed" &&
+          std::find(bys.begin(), bys.end(), by) == bys.end() && bys.size() < most)
+        bys.push_back(by);
+    };
+    for (const EffectFit& e : r.explanation)  // where the named effects act
+      if (e.region) add(e.region->by, 4);
     for (const GapRegion& g : r.where)
-      if (g.significant && g.by != "output" && g.by.rfind("dir", 0) != 0 && g.by != "cycle" &&
-          std::find(bys.begin(), bys.end(), g.by) == bys.end() && bys.size() < 3)
-        bys.push_back(g.by);
+      if (g.significant) add(g.by, 3);
     if (bys.empty()) bys.push_back(gd.axes[0]);
     for (const std::string& by : bys) {
       const std::string path = plot_dir + "/residual_" + by + ".png";
