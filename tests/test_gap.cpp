@@ -448,6 +448,28 @@ TEST_CASE("gap: ballbar traces are dr observations; reversal on X is read from t
   CHECK((A.row(3) - projected).norm() <= 1e-12 * A.row(3).norm());
   CHECK(std::hypot(dr.radial[0], dr.radial[1]) == doctest::Approx(1.0).epsilon(1e-12));
 
+  // Bad traces: a missing circle key, an angle missing where dr is measured.
+  std::string text = ballbar_synth(21, none, 1);
+  std::string no_radius = text;
+  no_radius.erase(no_radius.find("# radius"), no_radius.find('\n', no_radius.find("# radius")) -
+                                                  no_radius.find("# radius") + 1);
+  CHECK_THROWS_WITH(gap_data(parse_measurements(no_radius, "bb.csv"), vmc()->description()),
+                    doctest::Contains("bb.csv:3: ballbar: the header key '# radius:' is missing"));
+  const auto row7 = [&] {
+    std::size_t at = 0;
+    for (int k = 0; k < 6; ++k) at = text.find('\n', at) + 1;  // 3 keys, header, 2 rows
+    return at;
+  }();
+  std::string no_angle = text;
+  const std::size_t c4 = [&] {  // angle_deg: after the 4th comma of the row
+    std::size_t at = row7;
+    for (int k = 0; k < 4; ++k) at = no_angle.find(',', at) + 1;
+    return at;
+  }();
+  no_angle.erase(c4, no_angle.find(',', c4) - c4);
+  CHECK_THROWS_WITH(gap_data(parse_measurements(no_angle, "bb.csv"), vmc()->description()),
+                    "bb.csv:7: column 'angle_deg' is empty but dr_um is measured");
+
   const MeasurementTable tr = parse_measurements(
       ballbar_synth(22,
                     [](const Row& w) {
