@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <numeric>
+#include <optional>
 #include <set>
 #include <stdexcept>
 
@@ -376,14 +377,13 @@ struct Engine {
   std::vector<FoldFit> folds;
   double full_sse = 0;
   std::size_t full_rank = 0;
-  VectorXd full_theta;
+  FoldFit full;  // the fit on all data
 
   // The fit on all data (its rank sizes the splits; its SSE is the F tests' reference).
   void fit_full() {
-    const FoldFit f = fit_fold(A, y, all_rows(static_cast<std::size_t>(y.size())));
-    full_sse = f.res_train.squaredNorm();
-    full_rank = f.rank;
-    full_theta = f.theta;
+    full = fit_fold(A, y, all_rows(static_cast<std::size_t>(y.size())));
+    full_sse = full.res_train.squaredNorm();
+    full_rank = full.rank;
   }
   void fit_folds() {
     folds.clear();
@@ -731,12 +731,40 @@ struct Evaluated {
   double heldout_sse = INFINITY;
 };
 
+// Least-squares coefficients of columns Eperp (already projected off the model's span) for the
+// residual r; empty when the model spans them. The rank is decided on columns scaled by their
+// norm before projection (`norm`): columns (nearly) inside the span would otherwise get huge
+// coefficients from rounding.
+std::optional<VectorXd> projected_fit(const MatrixXd& Eperp, VectorXd norm, const VectorXd& r) {
+  for (Index k = 0; k < norm.size(); ++k)
+    if (!(norm[k] > 0)) norm[k] = 1;
+  const MatrixXd Es = Eperp * norm.cwiseInverse().asDiagonal();
+  Eigen::ColPivHouseholderQR<MatrixXd> qr(Es);
+  qr.setThreshold(1e-6);
+  if (qr.rank() == 0) return std::nullopt;
+  return VectorXd(norm.cwiseInverse().asDiagonal() * qr.solve(r));
+}
+
+// The columns of a θ-dependent variant for the fit `ff` on rows `train`: at the fit's θ, then
+// (Variant::theta_iterations) at the θ of the joint fit [A E] with those columns.
+MatrixXd theta_columns(const gap_detail::Candidate& c, const gap_detail::Variant& v,
+                       const FoldFit& ff, const std::vector<std::size_t>& train, std::size_t np) {
+  MatrixXd E = c.columns(v, split_theta(ff.theta, np));
+  for (int it = 0; it < v.theta_iterations; ++it) {
+    const MatrixXd Etr = rows_of(E, train);
+    const MatrixXd P = ff.U.transpose() * Etr;
+    const auto coef = projected_fit(Etr - ff.U * P, Etr.colwise().norm().transpose(), ff.res_train);
+    if (!coef) break;
+    E = c.columns(v, split_theta(VectorXd(ff.theta - ff.VS * (P * *coef)), np));
+  }
+  return E;
+}
+
 Evaluated evaluate(const gap_detail::Candidate& c, const Engine& e, std::size_t np,
                    const VectorXd& base_r, const VectorXd& base_h, double s2, double alpha,
                    double n_candidates) {
   Evaluated best;
   double best_train = INFINITY;
-  const std::vector<double> full_theta = split_theta(e.full_theta, np);
   // Training SSE over the splits and the held-out residual of one variant; false when the
   // model already spans its columns.
   auto score = [&](const gap_detail::Variant& v, double& train_sse, VectorXd& after,
@@ -747,20 +775,13 @@ Evaluated evaluate(const gap_detail::Candidate& c, const Engine& e, std::size_t 
     for (std::size_t f = 0; f < e.splits.size(); ++f) {
       const Split& s = e.splits[f];
       const FoldFit& ff = e.folds[f];
-      const MatrixXd E = v.needs_theta ? c.columns(v, split_theta(ff.theta, np)) : shared;
+      const MatrixXd E = v.needs_theta ? theta_columns(c, v, ff, s.train, np) : shared;
       const MatrixXd Etr = rows_of(E, s.train), Ete = rows_of(E, s.test);
       const MatrixXd P = ff.U.transpose() * Etr;
       const MatrixXd Eperp = Etr - ff.U * P;
-      // Columns (nearly) inside the model's span would get huge coefficients from rounding:
-      // decide the rank on columns scaled by their norm before projection.
-      VectorXd norm = Etr.colwise().norm().transpose();
-      for (Index k = 0; k < norm.size(); ++k)
-        if (!(norm[k] > 0)) norm[k] = 1;
-      const MatrixXd Es = Eperp * norm.cwiseInverse().asDiagonal();
-      Eigen::ColPivHouseholderQR<MatrixXd> qr(Es);
-      qr.setThreshold(1e-6);
-      if (qr.rank() == 0) return false;  // the model already spans these columns
-      const VectorXd coef = norm.cwiseInverse().asDiagonal() * qr.solve(ff.res_train);
+      const auto fitted = projected_fit(Eperp, Etr.colwise().norm().transpose(), ff.res_train);
+      if (!fitted) return false;  // the model already spans these columns
+      const VectorXd& coef = *fitted;
       train_sse += (ff.res_train - Eperp * coef).squaredNorm();
       const VectorXd delta = (Ete - ff.W * P) * coef;
       for (std::size_t i = 0; i < s.test.size(); ++i)
@@ -822,7 +843,10 @@ Evaluated evaluate(const gap_detail::Candidate& c, const Engine& e, std::size_t 
   }
   if (std::isfinite(best_train)) {
     best.fit.variant = best.variant.label;
-    best.columns = best.variant.needs_theta ? c.columns(best.variant, full_theta) : best_shared;
+    best.columns = best.variant.needs_theta
+                       ? theta_columns(c, best.variant, e.full,
+                                       all_rows(static_cast<std::size_t>(e.y.size())).train, np)
+                       : best_shared;
     best.fit.tested_variants = static_cast<double>(c.variants.size());
   }
   best.fit.name = c.name;

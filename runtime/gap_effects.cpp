@@ -569,6 +569,7 @@ void add_tool_offset(const EffectContext& ctx, std::vector<Candidate>& out) {
   c.name = "tool_offset";
   const std::string pname = desc.parameters[static_cast<std::size_t>(tool)].name;
   c.variants.push_back({pname, {static_cast<double>(tool)}, true});
+  c.variants.back().theta_iterations = 1;
   const GapData& d = *ctx.data;
   const double base = ctx.model->parameters()[static_cast<std::size_t>(tool)];
   c.columns = [&d, ctx, tool, base](const Variant&, const std::vector<double>& theta) {

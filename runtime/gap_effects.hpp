@@ -37,6 +37,9 @@ struct Variant {
   // output 0..5; -1 for other effects. The diagnosis checks that the data can tell the shape
   // from any other along that coordinate.
   int shape_axis = -1, shape_output = -1;
+  // needs_theta: refit θ jointly with the columns this many times before they are taken (the
+  // columns at the first-order θ are biased when that θ has absorbed part of the effect).
+  int theta_iterations = 0;
 };
 
 struct Variant::Refine {
