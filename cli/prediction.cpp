@@ -70,8 +70,7 @@ void print_prediction(std::ostream& os, const Prediction& p) {
     any = true;
     os << std::left << std::setw(8) << output_name(o) << std::right << std::setw(12)
        << format_short(p.rms_measured[o]) << std::setw(27) << format_short(p.rms_difference[o])
-       << std::setw(10) << format_short(p.max_difference[o]) << "  " << (o < 3 ? "µm" : "µrad")
-       << "\n";
+       << std::setw(10) << format_short(p.max_difference[o]) << "  " << observation_unit(o) << "\n";
   }
   if (!any) os << "(no measured deviations to compare with; --predict-out writes the values)\n";
 }

@@ -148,7 +148,7 @@ void print_report(std::ostream& os, const GapResult& r, const Model& model, cons
     else
       os << std::left << std::setw(8) << observation_name(o) << std::right << std::setw(12)
          << f3(r.baseline_rms[o]) << std::setw(9) << f3(r.baseline_max[o]) << std::setw(11)
-         << f3(r.final_rms[o]) << "  " << (o < 3 || o == kRadialOutput ? "µm" : "µrad") << "\n";
+         << f3(r.final_rms[o]) << "  " << observation_unit(o) << "\n";
   }
   os << "\n" << h2 << "Where\n\n";
   std::size_t shown = 0;

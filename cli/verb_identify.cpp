@@ -30,8 +30,6 @@ std::string fmt(double v, int precision = 3) {
   return s.str();
 }
 
-const char* output_unit(int o) { return o < 3 ? "µm" : "µrad"; }
-
 // All --data files as one set of observations (rows keep their file for messages).
 PointData merged_data(const std::vector<std::string>& files, const Description& desc,
                       const ReadOptions& ro) {
@@ -144,7 +142,7 @@ void print_result(std::ostream& os, const Model& model, const ErrorParameterisat
     if (!r.count[u]) continue;
     os << std::left << std::setw(8) << output_name(u) << std::right << std::setw(10)
        << fmt(r.rms_before[u]) << std::setw(11) << fmt(r.rms_after[u]) << std::setw(11)
-       << fmt(r.max_after[u]) << "  " << output_unit(o) << "\n";
+       << fmt(r.max_after[u]) << "  " << observation_unit(static_cast<std::size_t>(o)) << "\n";
   }
   os << "\nparameter" << std::string(16, ' ') << "value      ± s.e.  unit\n";
   for (std::size_t p = 0; p < param.size(); ++p) {

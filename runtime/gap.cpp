@@ -56,6 +56,7 @@ PointData ballbar_points(const MeasurementTable& t, const Description& desc,
   PointData p;
   p.file = t.file;
   p.poses.assign(t.rows(), {});
+  std::vector<double> angles;  // of the measured rows, for one call to ballbar_directions
   for (std::size_t r = 0; r < t.rows(); ++r) {
     if (!std::isfinite(dr[r])) continue;
     if (!std::isfinite(angle[r]))
@@ -67,12 +68,14 @@ PointData ballbar_points(const MeasurementTable& t, const Description& desc,
     ob.line = t.lines[r];
     ob.output = kRadialOutput;
     ob.value = dr[r];
-    ob.radial = ballbar_directions(machine, *circle, {angle[r]}).front();
     p.observations.push_back(ob);
-    ++p.count[kRadialOutput];
+    angles.push_back(angle[r]);
   }
   if (p.observations.empty())
     throw InputError(SourceLoc{t.file, 0, 0}, "no observations (no row has a measured dr_um)");
+  const std::vector<std::array<double, 3>> u = ballbar_directions(machine, *circle, angles);
+  for (std::size_t i = 0; i < u.size(); ++i) p.observations[i].radial = u[i];
+  p.count[kRadialOutput] = p.observations.size();
   return p;
 }
 
@@ -972,8 +975,9 @@ void decide_verdict(GapResult& R, const GapOptions& opt, const std::vector<std::
       return unexplained("the accepted effects remove " + pct(explained) +
                          " of the excess and leave a significant gap");
     if (R.final_rms_um > 2 * R.noise.sigma_um)
-      return unexplained("the accepted effects leave a significant held-out RMS of more than " +
-                         std::string("twice the noise floor"));
+      return unexplained(
+          "the accepted effects leave a significant held-out RMS of more than twice the noise "
+          "floor");
   }
   R.verdict = first.name;
   R.verdict_reason =

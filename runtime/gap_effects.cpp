@@ -15,7 +15,7 @@ namespace {
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
 using Index = Eigen::Index;
-const char* unit_of(int o) { return o < 3 || o == kRadialOutput ? "µm" : "µrad"; }
+const char* unit_of(int o) { return observation_unit(static_cast<std::size_t>(o)); }
 
 std::string num(double v, int digits = 3) {
   char b[48];
@@ -629,13 +629,7 @@ void add_setup(const EffectContext& ctx, std::vector<Candidate>& out) {
   if (d.points.count[kRadialOutput]) c.variants.push_back({"ballbar length", {-1, 0}});
   if (c.variants.empty()) return;
   c.columns = [&d](const Variant& v, const std::vector<double>&) {
-    if (v.hyper[0] < 0) {
-      const auto& obs = d.points.observations;
-      MatrixXd E = MatrixXd::Zero(static_cast<Index>(obs.size()), 1);
-      for (std::size_t i = 0; i < obs.size(); ++i)
-        if (obs[i].output == kRadialOutput) E(static_cast<Index>(i), 0) = 1;
-      return E;
-    }
+    if (v.hyper[0] < 0) return per_output(d, {kRadialOutput}, [](std::size_t) { return 1.0; });
     const std::size_t a = static_cast<std::size_t>(v.hyper[1]);
     return one_output(d, static_cast<int>(v.hyper[0]),
                       {[](double q) { return q / 1000.0; }, [](double q) { return q * q / 1e6; }},

@@ -18,6 +18,10 @@ const char* observation_name(std::size_t output) {
   return output == kRadialOutput ? "dr" : output_name(output);
 }
 
+const char* observation_unit(std::size_t output) {
+  return output < 3 || output == kRadialOutput ? "µm" : "µrad";
+}
+
 const std::array<const char*, 6> kDeviationColumns = {"dx_um",   "dy_um",   "dz_um",
                                                       "da_urad", "db_urad", "dc_urad"};
 

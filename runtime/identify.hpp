@@ -104,6 +104,8 @@ struct PointObservation {
 
 // "dx" ... "dc", "dr".
 const char* observation_name(std::size_t output);
+// "µm" for dx dy dz and dr, "µrad" for da db dc.
+const char* observation_unit(std::size_t output);
 
 // How much of deviation output o (0..5) observation `ob` sees: 1 for its own output, the radial
 // component for dr, else 0.
@@ -114,8 +116,10 @@ inline double observation_weight(const PointObservation& ob, int o) {
 }
 // The observation's value (µm, µrad) for a deviation given per output in µm and µrad.
 inline double observe(const PointObservation& ob, const std::array<double, 6>& deviation) {
-  if (ob.output != kRadialOutput) return deviation[static_cast<std::size_t>(ob.output)];
-  return ob.radial[0] * deviation[0] + ob.radial[1] * deviation[1] + ob.radial[2] * deviation[2];
+  double v = 0;
+  for (int o = 0; o < 6; ++o)
+    v += observation_weight(ob, o) * deviation[static_cast<std::size_t>(o)];
+  return v;
 }
 
 // Point measurements of a machine: the poses (independent axes, Description::axes() order, in

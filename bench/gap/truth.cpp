@@ -100,6 +100,23 @@ const std::map<std::string, std::string>& default_missing_error() {
   return m;
 }
 
+// Central-difference Jacobian (3 × errors, mm per base unit) of the tool position of `chain`
+// at `axes`, step h (mm, rad).
+Eigen::MatrixXd position_jacobian(const NumericChain& chain, const std::vector<double>& axes,
+                                  std::size_t n, double h) {
+  Eigen::MatrixXd J(3, static_cast<Eigen::Index>(n));
+  std::vector<double> e(n, 0.0);
+  for (std::size_t i = 0; i < n; ++i) {
+    e[i] = h;
+    const Eigen::Vector3d plus = chain.tool_in_workpiece(axes, e).block<3, 1>(0, 3);
+    e[i] = -h;
+    const Eigen::Vector3d minus = chain.tool_in_workpiece(axes, e).block<3, 1>(0, 3);
+    e[i] = 0;
+    J.col(static_cast<Eigen::Index>(i)) = (plus - minus) / (2 * h);
+  }
+  return J;
+}
+
 }  // namespace
 
 const std::vector<std::string>& library_effects() {
@@ -622,19 +639,9 @@ std::vector<double> Synthesiser::errors_at(const Row& row, double amplitude,
 const Eigen::MatrixXd& Synthesiser::truth_jacobian(int pose) const {
   Eigen::MatrixXd& J = truth_jacobians_[static_cast<std::size_t>(pose)];
   if (J.size() != 0) return J;
-  const std::size_t n = truth_desc_.errors.size();
-  const std::vector<double>& axes = poses_[static_cast<std::size_t>(pose)];
-  J.resize(3, static_cast<Eigen::Index>(n));
-  std::vector<double> e(n, 0.0);
-  constexpr double h = 1e-5;  // central differences: truncation and round-off ~1e-9 relative
-  for (std::size_t i = 0; i < n; ++i) {
-    e[i] = h;
-    const Eigen::Vector3d plus = truth_chain_->tool_in_workpiece(axes, e).block<3, 1>(0, 3);
-    e[i] = -h;
-    const Eigen::Vector3d minus = truth_chain_->tool_in_workpiece(axes, e).block<3, 1>(0, 3);
-    e[i] = 0;
-    J.col(static_cast<Eigen::Index>(i)) = (plus - minus) / (2 * h);
-  }
+  // h = 1e-5: truncation and round-off ~1e-9 relative.
+  J = position_jacobian(*truth_chain_, poses_[static_cast<std::size_t>(pose)],
+                        truth_desc_.errors.size(), 1e-5);
   return J;
 }
 
@@ -772,8 +779,6 @@ void Synthesiser::build_regressors() {
   // below the rank threshold below: exactly dependent columns (E_XY[1] and E_XX[1] both move dx)
   // must stay dependent, or their round-off would "absorb" signal with huge coefficients.
   std::vector<Eigen::MatrixXd> jac(poses_.size());
-  constexpr double h = 1e-4;
-  std::vector<double> e(nm, 0.0);
   for (std::size_t p = 0; p < poses_.size(); ++p) {
     // The model's axes are the truth's (same bodies); map by coordinate name to be safe.
     std::vector<double> ax(model_axes.size());
@@ -783,15 +788,7 @@ void Synthesiser::build_regressors() {
       for (std::size_t a = 0; a < axes_.size(); ++a)
         if (axes_[a].name == name) ax[k] = poses_[p][a];
     }
-    jac[p].resize(3, static_cast<Eigen::Index>(nm));
-    for (std::size_t i = 0; i < nm; ++i) {
-      e[i] = h;
-      const Eigen::Vector3d plus = model_chain_->tool_in_workpiece(ax, e).block<3, 1>(0, 3);
-      e[i] = -h;
-      const Eigen::Vector3d minus = model_chain_->tool_in_workpiece(ax, e).block<3, 1>(0, 3);
-      e[i] = 0;
-      jac[p].col(static_cast<Eigen::Index>(i)) = (plus - minus) / (2 * h);
-    }
+    jac[p] = position_jacobian(*model_chain_, ax, nm, 1e-4);
   }
   RegressorLayout lay;
   for (std::size_t i = 0; i < nm; ++i) {
