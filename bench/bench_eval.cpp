@@ -30,12 +30,12 @@
 #include <string>
 #include <vector>
 
-#include "generated/five_axis_ac.hpp"
-#include "generated/gantry_grinder.hpp"
-#include "generated/two_axis.hpp"
-#include "generated/vmc_3axis.hpp"
-#include "machine/yaml_loader.hpp"
-#include "numeric_chain.hpp"
+#include "five_axis_ac.hpp"
+#include "gantry_grinder.hpp"
+#include "two_axis.hpp"
+#include "vmc_3axis.hpp"
+#include "weilgen/machine/yaml_loader.hpp"
+#include "weilgen/model/numeric_chain.hpp"
 
 namespace {
 

@@ -9,7 +9,7 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 prefix=$work/prefix
 
-# Only the CLI is needed for the install; building `all` would also regenerate generated/.
+# Only the CLI is needed for the install.
 cmake -S "$root" -B "$build" >/dev/null
 cmake --build "$build" --target weilgen -j"$(nproc)"
 cmake --install "$build" --prefix "$prefix"

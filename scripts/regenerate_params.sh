@@ -1,7 +1,9 @@
 #!/bin/bash
 # Rewrites generated/vmc_3axis_params.hpp: the parameters identified from the synthetic point
 # measurements examples/data/vmc_3axis_points.csv (bench/experiments/make_points_data.cpp).
-# tests/test_identify.cpp fails when the committed file differs from what this writes.
+# The CTest generated_params_current fails when the committed file differs from what this writes
+# (the build writes it into <build>/generated; `cmake --build build --target update_generated`
+# rewrites every committed generated file).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BUILD_DIR=${BUILD_DIR:-build}

@@ -5,7 +5,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install_deps.sh
 bash scripts/build.sh -DWEILGEN_BUILD_BENCH=OFF
-build/weilgen generate gantry_grinder --out generated
+build/weilgen generate gantry_grinder --out build/models
 echo
 echo "Closed-form volumetric error of gantry_grinder (dx dy dz in mm, da db dc in rad):"
 build/weilgen show gantry_grinder

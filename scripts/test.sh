@@ -1,15 +1,14 @@
 #!/usr/bin/env bash
 # Set-up command (2): install what is missing, build everything and run the whole test suite:
-# the doctest suite (through CTest), the staleness check of the committed generated/ files, and
+# the doctest suite (through CTest), the golden check of the committed generated/ files, and
 # the example controller project built against an installed weilgen.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install_deps.sh
 export BUILD_DIR=${BUILD_DIR:-build}
-# Build the CLI alone first and check generated/ before the build regenerates it.
+# The build writes nothing into the source tree; the CTest generated_files_current compares the
+# committed generated/ with fresh generation.
 cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build "$BUILD_DIR" --target weilgen -j"$(nproc)"
-"$BUILD_DIR"/weilgen generate machines/*.yaml --out generated --check
 cmake --build "$BUILD_DIR" -j"$(nproc)"
 if [ -x scripts/build_example.sh ]; then
   bash scripts/build_example.sh "$BUILD_DIR"

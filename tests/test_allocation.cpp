@@ -5,8 +5,8 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "runtime/allocation.hpp"
-#include "runtime/reliability.hpp"
+#include "weilgen/uq/allocation.hpp"
+#include "weilgen/uq/reliability.hpp"
 
 using namespace weilgen;
 

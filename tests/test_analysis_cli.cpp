@@ -8,9 +8,9 @@
 #include <nlohmann/json.hpp>
 #include <set>
 
-#include "atomic_file.hpp"
-#include "distribution.hpp"
 #include "test_support.hpp"
+#include "weilgen/base/atomic_file.hpp"
+#include "weilgen/uq/distribution.hpp"
 
 using namespace weilgen;
 using nlohmann::json;

@@ -9,13 +9,14 @@
 #include <memory>
 #include <stdexcept>
 
-#include "ballbar.hpp"
-#include "builtin_models.hpp"
-#include "measurement_csv.hpp"
-#include "model.hpp"
-#include "model_loader.hpp"
-#include "numeric_chain.hpp"
 #include "test_support.hpp"
+#include "weilgen/analysis/ballbar_model.hpp"
+#include "weilgen/measure/ballbar.hpp"
+#include "weilgen/measure/measurement_csv.hpp"
+#include "weilgen/model/builtin_models.hpp"
+#include "weilgen/model/model.hpp"
+#include "weilgen/model/model_loader.hpp"
+#include "weilgen/model/numeric_chain.hpp"
 
 using namespace weilgen;
 

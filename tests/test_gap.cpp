@@ -10,11 +10,12 @@
 #include <set>
 #include <sstream>
 
-#include "builtin_models.hpp"
-#include "gap.hpp"
-#include "model_loader.hpp"
-#include "numeric_chain.hpp"
 #include "test_support.hpp"
+#include "weilgen/analysis/ballbar_model.hpp"
+#include "weilgen/analysis/gap.hpp"
+#include "weilgen/model/builtin_models.hpp"
+#include "weilgen/model/model_loader.hpp"
+#include "weilgen/model/numeric_chain.hpp"
 
 using namespace weilgen;
 

@@ -7,13 +7,13 @@
 #include <fstream>
 #include <sstream>
 
-#include "atomic_file.hpp"
-#include "emit_report.hpp"
-#include "generate.hpp"
-#include "machine/yaml_loader.hpp"
-#include "model_eval.hpp"
-#include "numeric_chain.hpp"
 #include "test_support.hpp"
+#include "weilgen/base/atomic_file.hpp"
+#include "weilgen/codegen/emit_report.hpp"
+#include "weilgen/codegen/generate.hpp"
+#include "weilgen/codegen/model_eval.hpp"
+#include "weilgen/machine/yaml_loader.hpp"
+#include "weilgen/model/numeric_chain.hpp"
 
 using namespace weilgen;
 using test::cli;
@@ -196,6 +196,25 @@ TEST_CASE("CLI: bad input exits non-zero with file:line:column and writes nothin
   CHECK(run(cli("generate two_axis --order 0")).status == 2);
   CHECK(run(cli("show two_axis --format pdf")).status == 2);
   CHECK(run(cli("frobnicate")).status == 2);
+}
+
+TEST_CASE("the banner names the machine file by its path alone, not by where weilgen was built") {
+  // A copy of a shipped machine in another directory named machines/, and one elsewhere: the
+  // label depends on the path only, so an installed or relocated binary writes the same bytes.
+  const fs::path dir = fresh_dir("banner");
+  fs::create_directories(dir / "machines");
+  const std::string text = text_of(test::machine_path("two_axis"));
+  write_file_atomically((dir / "machines" / "two_axis.yaml").string(), text);
+  write_file_atomically((dir / "two_axis.yaml").string(), text);
+  CHECK(gen::source_label((dir / "machines" / "two_axis.yaml").string()) ==
+        "machines/two_axis.yaml");
+  CHECK(gen::source_label((dir / "two_axis.yaml").string()) == "two_axis.yaml");
+  // The relocated copy generates exactly the committed header, whatever WEILGEN_MACHINES_DIR says.
+  ::setenv("WEILGEN_MACHINES_DIR", dir.string().c_str(), 1);
+  const auto files =
+      gen::generate_files(load_machine_file((dir / "machines" / "two_axis.yaml").string()), 0, "x");
+  ::unsetenv("WEILGEN_MACHINES_DIR");
+  CHECK(files[0].contents == text_of(std::string(WEILGEN_SOURCE_DIR) + "/generated/two_axis.hpp"));
 }
 
 TEST_CASE("CLI: --check reports stale files and exits 1") {

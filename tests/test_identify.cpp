@@ -10,13 +10,13 @@
 #include <random>
 #include <sstream>
 
-#include "builtin_models.hpp"
-#include "generated/vmc_3axis_params.hpp"
-#include "identify.hpp"
-#include "model_loader.hpp"
-#include "numeric_chain.hpp"
-#include "params_header.hpp"
 #include "test_support.hpp"
+#include "vmc_3axis_params.hpp"
+#include "weilgen/analysis/identify.hpp"
+#include "weilgen/model/builtin_models.hpp"
+#include "weilgen/model/model_loader.hpp"
+#include "weilgen/model/numeric_chain.hpp"
+#include "weilgen/report/params_header.hpp"
 
 using namespace weilgen;
 

@@ -10,12 +10,12 @@
 #include <nlohmann/json.hpp>
 #include <random>
 
-#include "atomic_file.hpp"
 #include "bench/experiments/normal_deviates.hpp"
-#include "iso230_2.hpp"
-#include "measurement_csv.hpp"
-#include "plot.hpp"
 #include "test_support.hpp"
+#include "weilgen/base/atomic_file.hpp"
+#include "weilgen/measure/iso230_2.hpp"
+#include "weilgen/measure/measurement_csv.hpp"
+#include "weilgen/report/plot.hpp"
 
 using namespace weilgen;
 using nlohmann::json;

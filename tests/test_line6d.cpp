@@ -11,10 +11,10 @@
 #include <string>
 #include <vector>
 
-#include "line6d.hpp"
-#include "pdge_fit.hpp"
-#include "plot.hpp"
 #include "test_support.hpp"
+#include "weilgen/measure/line6d.hpp"
+#include "weilgen/measure/pdge_fit.hpp"
+#include "weilgen/report/plot.hpp"
 
 using namespace weilgen;
 

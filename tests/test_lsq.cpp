@@ -1,9 +1,9 @@
 // The column-equilibrated SVD (runtime/lsq.hpp) that identify and the gap folds share.
 #include <doctest/doctest.h>
 
-#include "identify.hpp"
-#include "lsq.hpp"
 #include "test_support.hpp"
+#include "weilgen/analysis/identify.hpp"
+#include "weilgen/uq/lsq.hpp"
 
 using namespace weilgen;
 

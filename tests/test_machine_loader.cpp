@@ -11,10 +11,10 @@
 #include <string>
 #include <vector>
 
-#include "machine/expr.hpp"
-#include "machine/iso_names.hpp"
-#include "machine/yaml_loader.hpp"
 #include "test_support.hpp"
+#include "weilgen/base/expr.hpp"
+#include "weilgen/machine/iso_names.hpp"
+#include "weilgen/machine/yaml_loader.hpp"
 
 using namespace weilgen;
 

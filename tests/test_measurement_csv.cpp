@@ -6,8 +6,8 @@
 #include <fstream>
 #include <string>
 
-#include "measurement_csv.hpp"
 #include "test_support.hpp"
+#include "weilgen/measure/measurement_csv.hpp"
 
 using namespace weilgen;
 

@@ -6,13 +6,13 @@
 #include <fstream>
 #include <random>
 
-#include "builtin_models.hpp"
-#include "generator/generate.hpp"
-#include "machine/yaml_loader.hpp"
-#include "model_key.hpp"
-#include "model_loader.hpp"
-#include "numeric_chain.hpp"
 #include "test_support.hpp"
+#include "weilgen/codegen/generate.hpp"
+#include "weilgen/machine/model_key.hpp"
+#include "weilgen/machine/yaml_loader.hpp"
+#include "weilgen/model/builtin_models.hpp"
+#include "weilgen/model/model_loader.hpp"
+#include "weilgen/model/numeric_chain.hpp"
 
 using namespace weilgen;
 namespace fs = std::filesystem;

@@ -4,12 +4,12 @@
 #include <fstream>
 #include <sstream>
 
-#include "emit_report.hpp"
-#include "machine/yaml_loader.hpp"
-#include "model_builder.hpp"
-#include "model_eval.hpp"
-#include "numeric_chain.hpp"
 #include "test_support.hpp"
+#include "weilgen/codegen/emit_report.hpp"
+#include "weilgen/codegen/model_builder.hpp"
+#include "weilgen/codegen/model_eval.hpp"
+#include "weilgen/machine/yaml_loader.hpp"
+#include "weilgen/model/numeric_chain.hpp"
 
 using namespace weilgen;
 

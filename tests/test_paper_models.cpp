@@ -5,9 +5,9 @@
 
 #include <map>
 
-#include "machine/yaml_loader.hpp"
-#include "model_builder.hpp"
 #include "test_support.hpp"
+#include "weilgen/codegen/model_builder.hpp"
+#include "weilgen/machine/yaml_loader.hpp"
 
 using namespace weilgen;
 

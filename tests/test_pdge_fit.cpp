@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "machine/pdge_basis.hpp"
-#include "pdge_fit.hpp"
+#include "weilgen/machine/pdge_basis.hpp"
+#include "weilgen/measure/pdge_fit.hpp"
 
 using namespace weilgen;
 

@@ -8,12 +8,12 @@
 #include <map>
 #include <sstream>
 
-#include "generated/pipe_cutter.hpp"
-#include "machine/yaml_loader.hpp"
-#include "model_builder.hpp"
-#include "model_eval.hpp"
-#include "numeric_chain.hpp"
+#include "pipe_cutter.hpp"
 #include "test_support.hpp"
+#include "weilgen/codegen/model_builder.hpp"
+#include "weilgen/codegen/model_eval.hpp"
+#include "weilgen/machine/yaml_loader.hpp"
+#include "weilgen/model/numeric_chain.hpp"
 
 using namespace weilgen;
 

@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "atomic_file.hpp"
-#include "plot.hpp"
+#include "weilgen/base/atomic_file.hpp"
+#include "weilgen/report/plot.hpp"
 
 using namespace weilgen;
 namespace fs = std::filesystem;

@@ -7,8 +7,8 @@
 #include <cstring>
 #include <stdexcept>
 
-#include "runtime/parallel.hpp"
-#include "runtime/reliability.hpp"
+#include "weilgen/base/parallel.hpp"
+#include "weilgen/uq/reliability.hpp"
 
 using namespace weilgen;
 

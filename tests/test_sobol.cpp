@@ -9,9 +9,9 @@
 #include <stdexcept>
 #include <vector>
 
-#include "parallel.hpp"
-#include "sobol_indices.hpp"
-#include "sobol_sequence.hpp"
+#include "weilgen/base/parallel.hpp"
+#include "weilgen/uq/sobol_indices.hpp"
+#include "weilgen/uq/sobol_sequence.hpp"
 
 using namespace weilgen;
 

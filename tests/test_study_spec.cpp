@@ -10,11 +10,11 @@
 #include <string>
 #include <vector>
 
-#include "atomic_file.hpp"
-#include "machine/yaml_loader.hpp"
-#include "study_spec.hpp"
 #include "test_support.hpp"
-#include "tolerance_file.hpp"
+#include "weilgen/analysis/study_spec.hpp"
+#include "weilgen/analysis/tolerance_file.hpp"
+#include "weilgen/base/atomic_file.hpp"
+#include "weilgen/machine/yaml_loader.hpp"
 
 using namespace weilgen;
 namespace fs = std::filesystem;

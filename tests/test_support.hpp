@@ -13,11 +13,11 @@
 #include <string>
 #include <vector>
 
-#include "atomic_file.hpp"
-#include "builtin_models.hpp"
-#include "machine/description.hpp"
-#include "machine/yaml_loader.hpp"
-#include "model_loader.hpp"
+#include "weilgen/base/atomic_file.hpp"
+#include "weilgen/machine/description.hpp"
+#include "weilgen/machine/yaml_loader.hpp"
+#include "weilgen/model/builtin_models.hpp"
+#include "weilgen/model/model_loader.hpp"
 
 namespace weilgen::test {
 

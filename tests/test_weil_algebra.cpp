@@ -1,7 +1,7 @@
 // The Weil algebra R[e_1..e_k]/I and matrices over it.
 #include <doctest/doctest.h>
 
-#include "weil.hpp"
+#include "weilgen/codegen/weil.hpp"
 
 using namespace weilgen::gen;
 using GiNaC::ex;

@@ -28,9 +28,8 @@
 #include <random>
 #include <string_view>
 
-#include "generated/vmc_3axis.hpp"
-
 #include "bench/experiments/normal_deviates.hpp"
+#include "vmc_3axis.hpp"
 
 namespace {
 

@@ -20,12 +20,12 @@
 #include <vector>
 
 #include "bench/experiments/normal_deviates.hpp"
-#include "machine/yaml_loader.hpp"
-#include "numeric_chain.hpp"
+#include "weilgen/machine/yaml_loader.hpp"
+#include "weilgen/model/numeric_chain.hpp"
 
 int main(int argc, char** argv) {
   using namespace weilgen;
-  const Description desc = load_machine_file(std::string(WEILGEN_MACHINES_DIR) + "/vmc_3axis.yaml");
+  const Description desc = load_machine_file(resolve_machine("vmc_3axis"));
   std::FILE* out = argc > 1 ? std::fopen(argv[1], "w") : stdout;
   if (!out) {
     std::fprintf(stderr, "cannot write %s\n", argv[1]);

@@ -31,16 +31,16 @@
 #include <string>
 #include <vector>
 
-#include "generator/generate.hpp"
-#include "runtime/atomic_file.hpp"
-#include "runtime/builtin_models.hpp"
-#include "runtime/machine/yaml_loader.hpp"
-#include "runtime/model_loader.hpp"
-#include "runtime/parallel.hpp"
-#include "runtime/plot.hpp"
-#include "runtime/sobol_indices.hpp"
-#include "runtime/study_spec.hpp"
-#include "runtime/version.hpp"
+#include "weilgen/analysis/study_spec.hpp"
+#include "weilgen/base/atomic_file.hpp"
+#include "weilgen/base/parallel.hpp"
+#include "weilgen/base/version.hpp"
+#include "weilgen/codegen/generate.hpp"
+#include "weilgen/machine/yaml_loader.hpp"
+#include "weilgen/model/builtin_models.hpp"
+#include "weilgen/model/model_loader.hpp"
+#include "weilgen/report/plot.hpp"
+#include "weilgen/uq/sobol_indices.hpp"
 
 using namespace weilgen;
 

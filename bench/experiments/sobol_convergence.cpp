@@ -16,8 +16,8 @@
 #include <string>
 #include <vector>
 
-#include "runtime/parallel.hpp"
-#include "runtime/sobol_indices.hpp"
+#include "weilgen/base/parallel.hpp"
+#include "weilgen/uq/sobol_indices.hpp"
 
 using namespace weilgen;
 

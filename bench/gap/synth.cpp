@@ -15,10 +15,10 @@
 #include <thread>
 #include <vector>
 
-#include "machine/yaml_loader.hpp"
-#include "measurement_csv.hpp"
-#include "numeric_chain.hpp"
 #include "truth.hpp"
+#include "weilgen/machine/yaml_loader.hpp"
+#include "weilgen/measure/measurement_csv.hpp"
+#include "weilgen/model/numeric_chain.hpp"
 
 namespace fs = std::filesystem;
 using nlohmann::json;

@@ -8,7 +8,7 @@
 #include <set>
 #include <stdexcept>
 
-#include "machine/yaml_loader.hpp"
+#include "weilgen/machine/yaml_loader.hpp"
 
 namespace weilgen::gapbench {
 

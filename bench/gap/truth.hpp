@@ -15,8 +15,8 @@
 #include <string>
 #include <vector>
 
-#include "machine/description.hpp"
-#include "numeric_chain.hpp"
+#include "weilgen/machine/description.hpp"
+#include "weilgen/model/numeric_chain.hpp"
 
 namespace weilgen::gapbench {
 

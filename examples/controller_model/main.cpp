@@ -55,8 +55,8 @@ int main() {
 
   std::printf("%s, order %d and %d, errors at one sigma\n", m1::kMachineName, m1::kOrder,
               m2::kOrder);
-  std::printf("%-26s %10s %10s %10s %10s %10s %10s %12s\n", "pose (mm)", "dx um", "dy um",
-              "dz um", "da urad", "db urad", "dc urad", "o2-o1 nm");
+  std::printf("%-26s %10s %10s %10s %10s %10s %10s %12s\n", "pose (mm)", "dx um", "dy um", "dz um",
+              "da urad", "db urad", "dc urad", "o2-o1 nm");
   int failures = 0;
   for (const auto& f : fractions) {
     std::array<double, m1::kNumAxes> axes{};
@@ -72,7 +72,8 @@ int main() {
     double second_order = 0.0;  // largest |order 2 - order 1| over dx, dy, dz, in mm
     for (std::size_t o = 0; o < 3; ++o) {
       double linear = 0.0;
-      for (std::size_t j = 0; j < m1::kNumErrors; ++j) linear += coeff[o * m1::kNumErrors + j] * errors[j];
+      for (std::size_t j = 0; j < m1::kNumErrors; ++j)
+        linear += coeff[o * m1::kNumErrors + j] * errors[j];
       if (std::fabs(linear - pos[o]) > 1e-12) {
         std::printf("coefficients disagree with Deviation in output %zu: %g vs %g mm\n", o, linear,
                     pos[o]);

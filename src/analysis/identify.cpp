@@ -1,0 +1,420 @@
+#include "weilgen/analysis/identify.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <stdexcept>
+
+#include "weilgen/base/text.hpp"
+#include "weilgen/base/units.hpp"
+#include "weilgen/machine/derived.hpp"
+#include "weilgen/uq/lsq.hpp"
+
+namespace weilgen {
+
+const char* observation_name(std::size_t output) {
+  return output == kRadialOutput ? "dr" : output_name(output);
+}
+
+const char* observation_unit(std::size_t output) {
+  return output < 3 || output == kRadialOutput ? "µm" : "µrad";
+}
+
+const std::array<const char*, 6> kDeviationColumns = {"dx_um",   "dy_um",   "dz_um",
+                                                      "da_urad", "db_urad", "dc_urad"};
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+int error_of_name(const Description& d, const std::string& name, const std::string& what) {
+  const int k = d.error_index(name);
+  if (k < 0)
+    throw std::invalid_argument(what + ": unknown error '" + name + "' (machine " + d.name +
+                                " has " + join(error_names(d)) + ")");
+  return k;
+}
+
+}  // namespace
+
+PdgeBasisChoice parse_pdge_flags(const Description& desc, const std::vector<std::string>& flags,
+                                 PdgeBasisChoice base) {
+  for (const std::string& flag : flags) {
+    const auto eq = flag.find('=');
+    const std::string what = "--pdge \"" + flag + "\"";
+    try {
+      if (eq == std::string::npos) {
+        parse_basis(trim(flag));
+        base.all = trim(flag);
+      } else {
+        const std::string name = trim(flag.substr(0, eq)), spec = trim(flag.substr(eq + 1));
+        const int k = error_of_name(desc, name, what);
+        parse_basis(spec);
+        base.per_error.emplace_back(desc.errors[static_cast<std::size_t>(k)].name, spec);
+      }
+    } catch (const std::invalid_argument& e) {
+      const std::string m = e.what();
+      throw std::invalid_argument(m.rfind("--pdge", 0) == 0 ? m : what + ": " + m);
+    }
+  }
+  return base;
+}
+
+ErrorParameterisation::ErrorParameterisation(const Description& desc, const PdgeBasisChoice& choice,
+                                             std::vector<double> parameters)
+    : desc_(&desc), param_values_(std::move(parameters)) {
+  if (param_values_.empty())
+    for (const Parameter& p : desc.parameters) param_values_.push_back(p.value);
+  const std::vector<int> axes = desc.axes();
+  const std::size_t ne = desc.errors.size();
+  bases_.resize(ne);
+  first_.resize(ne);
+  axis_index_.assign(ne, -1);
+  coordinate_.resize(ne);
+  to_base_.resize(ne);
+  for (std::size_t k = 0; k < ne; ++k) {
+    const ErrorDef& e = desc.errors[k];
+    to_base_[k] = e.to_base;
+    first_[k] = params_.size();
+    const Joint& j = desc.bodies[static_cast<std::size_t>(e.body)].joint;
+    if (e.dependence == Dependence::PIGE || j.type == JointType::Fixed) {
+      params_.push_back({static_cast<int>(k), 0, e.name, e.unit});
+      continue;
+    }
+    // Precedence: per-error flag, run-wide flag, the error's basis, the machine's, fallback.
+    std::string spec = choice.fallback;
+    SourceLoc where;
+    if (!desc.pdge_basis.empty()) spec = desc.pdge_basis, where = desc.pdge_basis_loc;
+    if (!e.basis.empty()) spec = e.basis, where = e.basis_loc;
+    if (choice.all) spec = *choice.all, where = {};
+    for (const auto& [name, s] : choice.per_error)
+      if (name == e.name) spec = s, where = {};
+    if (!(j.max > j.min)) {
+      throw InputError(j.loc, "joint " + j.coordinate + ": " + e.name +
+                                  " is position dependent but the joint has no travel range "
+                                  "(range: [min, max]) to place its basis on");
+    }
+    try {
+      bases_[k] = parse_basis(spec).on(j.min, j.max);
+    } catch (const std::invalid_argument& ex) {
+      if (where.line > 0) throw InputError(where, ex.what());
+      throw std::invalid_argument(e.name + ": " + ex.what());
+    }
+    coordinate_[k] = j.coordinate;
+    for (std::size_t a = 0; a < axes.size(); ++a)
+      if (axes[a] == e.body) axis_index_[k] = static_cast<int>(a);
+    const std::vector<std::string> names = bases_[k]->term_names();
+    for (std::size_t t = 0; t < names.size(); ++t)
+      params_.push_back({static_cast<int>(k), t, e.name + "[" + names[t] + "]", e.unit});
+  }
+}
+
+double ErrorParameterisation::position_of(std::size_t k, const double* axes) const {
+  if (axis_index_[k] >= 0) return axes[axis_index_[k]];
+  // A linked coordinate: evaluate the links from the independent axes and the parameters.
+  std::map<std::string, double> values;
+  for (std::size_t p = 0; p < desc_->parameters.size(); ++p)
+    values[desc_->parameters[p].name] = param_values_[p];
+  const std::vector<int> ax = desc_->axes();
+  for (std::size_t a = 0; a < ax.size(); ++a)
+    values[desc_->bodies[static_cast<std::size_t>(ax[a])].joint.coordinate] = axes[a];
+  resolve_links(*desc_, values);
+  return values.at(coordinate_[k]);
+}
+
+void ErrorParameterisation::derivatives(const double* axes, double* jac) const {
+  for (std::size_t k = 0; k < bases_.size(); ++k) {
+    double* out = jac + first_[k];
+    if (!bases_[k]) {
+      out[0] = to_base_[k];
+      continue;
+    }
+    bases_[k]->evaluate(position_of(k, axes), out);
+    for (std::size_t t = 0; t < bases_[k]->size(); ++t) out[t] *= to_base_[k];
+  }
+}
+
+void ErrorParameterisation::errors_at(const double* axes, const double* theta,
+                                      double* errors) const {
+  std::vector<double> jac(params_.size());
+  derivatives(axes, jac.data());
+  std::fill(errors, errors + bases_.size(), 0.0);
+  for (std::size_t p = 0; p < params_.size(); ++p) errors[params_[p].error] += jac[p] * theta[p];
+}
+
+PointData point_data(const MeasurementTable& table, const Description& desc) {
+  PointData out;
+  out.file = table.file;
+  std::vector<const std::vector<double>*> dev(6, nullptr);
+  bool any = false;
+  for (int o = 0; o < 6; ++o)
+    if (table.has(kDeviationColumns[o])) dev[o] = &table.column(kDeviationColumns[o]), any = true;
+  if (!any)
+    throw InputError(SourceLoc{table.file, table.header_line, 0},
+                     "no deviation column (dx_um, dy_um, dz_um, da_urad, db_urad, dc_urad; "
+                     "columns: " +
+                         join(table.columns) + ")");
+  std::vector<std::string> names;
+  std::vector<const std::vector<double>*> coord;
+  for (int b : desc.axes()) {
+    names.push_back(desc.bodies[static_cast<std::size_t>(b)].joint.coordinate);
+    coord.push_back(&table.column(names.back()));
+  }
+  out.poses.assign(table.rows(), std::vector<double>(names.size(), kNaN));
+  for (std::size_t r = 0; r < table.rows(); ++r) {
+    bool measured = false;
+    for (int o = 0; o < 6; ++o) measured = measured || (dev[o] && std::isfinite((*dev[o])[r]));
+    if (!measured) continue;
+    for (std::size_t a = 0; a < names.size(); ++a) {
+      const double v = (*coord[a])[r];
+      if (!std::isfinite(v))
+        throw InputError(SourceLoc{table.file, table.lines[r], 0},
+                         "column '" + names[a] +
+                             "' is empty but a deviation is measured (every "
+                             "observation needs the machine's coordinates)");
+      out.poses[r][a] = v;
+    }
+    for (int o = 0; o < 6; ++o) {
+      if (!dev[o] || !std::isfinite((*dev[o])[r])) continue;
+      out.observations.push_back({r, table.lines[r], o, (*dev[o])[r]});
+      ++out.count[static_cast<std::size_t>(o)];
+    }
+  }
+  if (out.observations.empty())
+    throw InputError(SourceLoc{table.file, 0, 0},
+                     "no observations (no row has a measured deviation)");
+  return out;
+}
+
+std::string NullCombination::str(const std::vector<IdentParameter>& params) const {
+  std::string s;
+  for (const auto& [p, c] : terms) {
+    const double a = std::abs(c);
+    s += s.empty() ? (c < 0 ? "-" : "") : (c < 0 ? " - " : " + ");
+    if (std::abs(a - 1) > 1e-9) s += format_short(a) + "·";
+    s += params[p].label;
+  }
+  return s;
+}
+
+namespace {
+
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+
+// The equilibrated SVD (lsq.hpp) with its minimum-norm solution.
+struct SvdSolve {
+  EquilibratedSvd svd;
+  VectorXd x;
+  SvdSolve(const MatrixXd& A, const VectorXd& y, double tol)
+      : svd(A, tol, /*full_v=*/true), x(svd.solve(y)) {}
+};
+
+// Readable null-space basis: reduced row echelon form of Nᵀ (each combination has a leading
+// parameter the others do not contain), in θ units, leading coefficient 1.
+std::vector<NullCombination> null_combinations(const EquilibratedSvd& s,
+                                               const std::vector<std::size_t>& cols) {
+  const Eigen::Index n = s.V().rows(), k = n - static_cast<Eigen::Index>(s.rank());
+  std::vector<NullCombination> out;
+  if (k <= 0) return out;
+  // Rows: null vectors in θ units (z / scale).
+  MatrixXd N = s.V().rightCols(k).transpose();
+  for (Eigen::Index p = 0; p < n; ++p) N.col(p) /= s.scale()[p];
+  Eigen::Index row = 0;
+  for (Eigen::Index c = 0; c < n && row < k; ++c) {
+    Eigen::Index piv = row;
+    N.col(c).segment(row, k - row).cwiseAbs().maxCoeff(&piv);
+    piv += row;
+    if (std::abs(N(piv, c)) < 1e-9 * N.cwiseAbs().maxCoeff()) continue;
+    N.row(row).swap(N.row(piv));
+    N.row(row) /= N(row, c);
+    for (Eigen::Index r = 0; r < k; ++r)
+      if (r != row) N.row(r) -= N(r, c) * N.row(row);
+    ++row;
+  }
+  for (Eigen::Index r = 0; r < k; ++r) {
+    NullCombination nc;
+    const double big = N.row(r).cwiseAbs().maxCoeff();
+    for (Eigen::Index p = 0; p < n; ++p)
+      if (std::abs(N(r, p)) > 1e-9 * big)
+        nc.terms.emplace_back(cols[static_cast<std::size_t>(p)], N(r, p));
+    if (!nc.terms.empty()) out.push_back(std::move(nc));
+  }
+  return out;
+}
+
+}  // namespace
+
+MatrixXd design_matrix(const Model& model, const ErrorParameterisation& param,
+                       const PointData& data) {
+  const std::size_t m = data.observations.size(), np = param.size(), ne = model.num_errors();
+  ModelData md(model);
+  std::vector<double> jac(np);
+  MatrixXd A(static_cast<Eigen::Index>(m), static_cast<Eigen::Index>(np));
+  std::size_t last_row = SIZE_MAX;
+  for (std::size_t i = 0; i < m; ++i) {
+    const PointObservation& ob = data.observations[i];
+    const double* pose = data.poses[ob.row].data();
+    if (ob.row != last_row) {
+      model.coefficients(md, pose, md.coeff.data());
+      param.derivatives(pose, jac.data());
+      last_row = ob.row;
+    }
+    for (std::size_t p = 0; p < np; ++p) {
+      const auto err = static_cast<std::size_t>(param.parameters()[p].error);
+      double v = 0;
+      for (int o = 0; o < 6; ++o) {
+        const double w = observation_weight(ob, o);
+        if (w != 0)
+          v += w * kObservationScale[static_cast<std::size_t>(o)] *
+               md.coeff[static_cast<std::size_t>(o) * ne + err];
+      }
+      A(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(p)) = v * jac[p];
+    }
+  }
+  return A;
+}
+
+Identification::Identification(const Model& model, const ErrorParameterisation& param,
+                               IdentifyOptions options)
+    : model_(model), param_(param), options_(std::move(options)) {}
+
+void Identification::run(const PointData& data) {
+  const Description& desc = model_.description();
+  const std::size_t np = param_.size(), m = data.observations.size();
+  IdentifyResult R;
+  R.theta.assign(np, 0.0);
+  R.standard_error.assign(np, kNaN);
+  R.identifiable.assign(np, false);
+  R.fixed.assign(np, false);
+  for (const std::string& f : options_.fixed) {
+    const int k = error_of_name(desc, f, "--fix");
+    for (std::size_t p = 0; p < np; ++p)
+      if (param_.parameters()[p].error == k) R.fixed[p] = true;
+  }
+  std::vector<std::size_t> cols;  // free parameters
+  for (std::size_t p = 0; p < np; ++p)
+    if (!R.fixed[p]) cols.push_back(p);
+  R.free_parameters = cols.size();
+  R.observations = m;
+  R.count = data.count;
+
+  ModelData md(model_);
+  VectorXd y(static_cast<Eigen::Index>(m));
+  for (std::size_t i = 0; i < m; ++i) y[static_cast<Eigen::Index>(i)] = data.observations[i].value;
+
+  // Linear model at zero error, without the fixed parameters.
+  const MatrixXd full = design_matrix(model_, param_, data);
+  MatrixXd A(static_cast<Eigen::Index>(m), static_cast<Eigen::Index>(cols.size()));
+  for (std::size_t q = 0; q < cols.size(); ++q)
+    A.col(static_cast<Eigen::Index>(q)) = full.col(static_cast<Eigen::Index>(cols[q]));
+  SvdSolve S(A, y, options_.rank_tolerance);
+  for (std::size_t q = 0; q < cols.size(); ++q)
+    R.theta[cols[q]] = S.x[static_cast<Eigen::Index>(q)];
+
+  // Residuals of the full model (exact at order 1; the Gauss-Newton objective above).
+  auto residual = [&](const std::vector<double>& theta) {
+    VectorXd r(static_cast<Eigen::Index>(m));
+    std::size_t row = SIZE_MAX;
+    std::array<double, 6> f{};
+    for (std::size_t i = 0; i < m; ++i) {
+      const PointObservation& ob = data.observations[i];
+      if (ob.row != row) {
+        f = predict_deviation(model_, md, param_, theta, data.poses[ob.row].data());
+        row = ob.row;
+      }
+      r[static_cast<Eigen::Index>(i)] = ob.value - f[static_cast<std::size_t>(ob.output)];
+    }
+    return r;
+  };
+  VectorXd r = model_.order() > 1 ? residual(R.theta) : VectorXd(y - A * S.x);
+  if (model_.order() > 1) {
+    // Gauss-Newton; central differences are exact for the quadratic terms of an order-2 model.
+    for (int it = 0; it < options_.max_gauss_newton; ++it) {
+      MatrixXd J(static_cast<Eigen::Index>(m), static_cast<Eigen::Index>(cols.size()));
+      for (std::size_t q = 0; q < cols.size(); ++q) {
+        std::vector<double> tp = R.theta, tm = R.theta;
+        const double h = std::max(1.0, 1e-3 * std::abs(R.theta[cols[q]]));
+        tp[cols[q]] += h;
+        tm[cols[q]] -= h;
+        J.col(static_cast<Eigen::Index>(q)) = (residual(tm) - residual(tp)) / (2 * h);
+      }
+      // Directions the first-order data cannot see become weakly visible through products of
+      // errors; a looser rank cut keeps the step out of them, and halving keeps it descending.
+      S = SvdSolve(J, r, std::max(options_.rank_tolerance, 1e-6));
+      const double before = r.squaredNorm();
+      std::vector<double> trial = R.theta;
+      double step = 0, size = 0, t = 1;
+      for (int halving = 0; halving < 20; ++halving, t /= 2) {
+        trial = R.theta;
+        for (std::size_t q = 0; q < cols.size(); ++q)
+          trial[cols[q]] += t * S.x[static_cast<Eigen::Index>(q)];
+        const VectorXd rt = residual(trial);
+        if (rt.squaredNorm() <= before) {
+          r = rt;
+          break;
+        }
+      }
+      for (std::size_t q = 0; q < cols.size(); ++q) {
+        const double dq = trial[cols[q]] - R.theta[cols[q]];
+        step += dq * dq;
+        size += trial[cols[q]] * trial[cols[q]];
+      }
+      R.theta = trial;
+      R.gauss_newton_iterations = it + 1;
+      if (step <= 1e-20 * std::max(size, 1.0)) break;
+    }
+  }
+
+  const EquilibratedSvd& sv = S.svd;
+  R.rank = sv.rank();
+  R.singular_values.assign(sv.sigma().data(), sv.sigma().data() + sv.sigma().size());
+  R.condition =
+      sv.rank() ? sv.sigma()[0] / sv.sigma()[static_cast<Eigen::Index>(sv.rank() - 1)] : kNaN;
+  const double sse = r.squaredNorm();
+  const double dof = static_cast<double>(m) - static_cast<double>(sv.rank());
+  R.residual_sigma = dof > 0 ? std::sqrt(sse / dof) : kNaN;
+  const Eigen::Index nf = static_cast<Eigen::Index>(cols.size());
+  for (Eigen::Index q = 0; q < nf; ++q) {
+    double null_weight = 0, var = 0;
+    for (Eigen::Index i = static_cast<Eigen::Index>(sv.rank()); i < nf; ++i)
+      null_weight += sv.V()(q, i) * sv.V()(q, i);
+    for (Eigen::Index i = 0; i < static_cast<Eigen::Index>(sv.rank()); ++i)
+      var += sv.V()(q, i) * sv.V()(q, i) / (sv.sigma()[i] * sv.sigma()[i]);
+    const std::size_t p = cols[static_cast<std::size_t>(q)];
+    R.identifiable[p] = null_weight < 1e-12;
+    if (R.identifiable[p]) R.standard_error[p] = R.residual_sigma * std::sqrt(var) / sv.scale()[q];
+  }
+  R.unidentifiable = null_combinations(sv, cols);
+
+  std::array<double, 6> ss_before{}, ss_after{};
+  R.max_after.fill(0);
+  for (std::size_t i = 0; i < m; ++i) {
+    const auto o = static_cast<std::size_t>(data.observations[i].output);
+    const double ri = r[static_cast<Eigen::Index>(i)];
+    ss_before[o] += data.observations[i].value * data.observations[i].value;
+    ss_after[o] += ri * ri;
+    R.max_after[o] = std::max(R.max_after[o], std::abs(ri));
+  }
+  for (std::size_t o = 0; o < 6; ++o) {
+    const double n = static_cast<double>(R.count[o]);
+    R.rms_before[o] = n > 0 ? std::sqrt(ss_before[o] / n) : kNaN;
+    R.rms_after[o] = n > 0 ? std::sqrt(ss_after[o] / n) : kNaN;
+    if (n == 0) R.max_after[o] = kNaN;
+  }
+  result_ = std::move(R);
+}
+
+std::array<double, 6> predict_deviation(const Model& model, ModelData& data,
+                                        const ErrorParameterisation& param,
+                                        const std::vector<double>& theta, const double* axes) {
+  param.errors_at(axes, theta.data(), data.errors.data());
+  std::array<double, 6> out{};
+  model.deviation(data, axes, data.errors.data(), out.data());
+  for (std::size_t o = 0; o < 6; ++o) out[o] *= kObservationScale[o];
+  return out;
+}
+
+}  // namespace weilgen

@@ -1,0 +1,197 @@
+// Identification of a machine model's error parameters from point measurements (issue 5 §4,
+// docs/identify.md). Every error of the model becomes one or more parameters:
+//   PIGE (or an error on a body without a joint)   one constant, in the error's declared unit;
+//   PDGE                                           the coefficients of a basis (machine/
+//                                                  pdge_basis.hpp) in the position of its own
+//                                                  joint, on that joint's travel.
+// At algebra order 1 the deviation is linear in the parameters, d = A θ, with A built from the
+// generated coefficient matrix; it is solved by a column-equilibrated SVD, which also gives the
+// rank, the minimum-norm solution and the parameter combinations the data cannot separate (the
+// null space). Models of order ≥ 2 are refined by Gauss-Newton from that start (central
+// differences of the deviation, exact for the quadratic terms).
+//
+// Algorithm objects (ErrorParameterisation, Identification) are separate from the result
+// (IdentifyResult), which carries its own uncertainty: standard errors from the residual
+// variance, identifiability flags and the residual RMS per output.
+#pragma once
+
+#include <Eigen/Dense>
+#include <array>
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "weilgen/analysis/study_spec.hpp"
+#include "weilgen/machine/pdge_basis.hpp"
+#include "weilgen/measure/measurement_csv.hpp"
+#include "weilgen/model/model.hpp"
+
+namespace weilgen {
+
+// Which basis each PDGE uses. Precedence: a per-error override, then the run-wide override,
+// then the error's `basis:` in the machine file, then the machine's `pdge_basis:`, then
+// `fallback`.
+struct PdgeBasisChoice {
+  std::string fallback = "poly:3";
+  std::optional<std::string> all;                              // --pdge poly:3
+  std::vector<std::pair<std::string, std::string>> per_error;  // --pdge E_YY=fourier:3
+};
+
+// Parses --pdge values: "poly:3" (all PDGEs) or "E_YY=fourier:3" (an error or alias name).
+// Throws std::invalid_argument naming the flag.
+PdgeBasisChoice parse_pdge_flags(const Description& desc, const std::vector<std::string>& flags,
+                                 PdgeBasisChoice base = {});
+
+// One identified parameter: a basis coefficient of one error (or the error itself).
+struct IdentParameter {
+  int error = -1;        // index into Description::errors
+  std::size_t term = 0;  // basis term index (0 for constants)
+  std::string label;     // "E_XX[u^2]", "E_C0Y"
+  std::string unit;      // the error's declared unit (µm, µrad, ...)
+};
+
+// How parameters θ (each in its error's declared unit) give error values at a pose.
+class ErrorParameterisation {
+ public:
+  // `parameters`: the machine parameters (Description::parameters order, mm/deg) used for linked
+  // coordinates; empty = the file's defaults.
+  ErrorParameterisation(const Description& desc, const PdgeBasisChoice& choice,
+                        std::vector<double> parameters = {});
+
+  std::size_t size() const { return params_.size(); }
+  const std::vector<IdentParameter>& parameters() const { return params_; }
+  // The basis of error k, or nullopt when the error is a single constant.
+  const std::optional<Basis>& basis_of(std::size_t k) const { return bases_[k]; }
+  // The position (joint unit) that error k's basis is evaluated at, for a pose of the
+  // independent axes (Description::axes() order) and the machine parameters.
+  double position_of(std::size_t k, const double* axes) const;
+  // Fills d errors / d θ for the pose: for each parameter p, errors[params[p].error] gets
+  // jac[p] per unit of θ_p, in base units (mm or rad). jac has size().
+  void derivatives(const double* axes, double* jac) const;
+  // Error values in base units (mm, rad), Description::errors order.
+  void errors_at(const double* axes, const double* theta, double* errors) const;
+  // The joint coordinate each error's basis runs along ("X"), or "" for constants.
+  const std::string& coordinate_of(std::size_t k) const { return coordinate_[k]; }
+
+ private:
+  const Description* desc_;
+  std::vector<IdentParameter> params_;
+  std::vector<std::optional<Basis>> bases_;
+  std::vector<std::size_t> first_;  // first parameter of each error
+  std::vector<int> axis_index_;     // index into axes of the error's coordinate, -1 if linked
+  std::vector<std::string> coordinate_;
+  std::vector<double> param_values_;  // machine parameters for linked coordinates
+  std::vector<double> to_base_;       // declared unit → base unit, per error
+};
+
+// What an observation measures: the deviation outputs 0..5 (dx dy dz da db dc) or, 6, a ballbar's
+// change of ball distance dr (the deviation's component along the ball-to-ball direction).
+inline constexpr std::size_t kObservationKinds = 7;
+inline constexpr int kRadialOutput = 6;
+
+// One measured value: output o (0..5 = dx dy dz da db dc, 6 = dr) at a pose, in µm or µrad.
+struct PointObservation {
+  std::size_t row = 0;  // row in the table
+  int line = 0;         // source line
+  int output = 0;
+  double value = 0;  // µm (dx..dz, dr) or µrad (da..dc)
+  // dr only: the unit vector from the table ball to the tool ball (workpiece frame), so that
+  // dr = radial · (dx, dy, dz) to first order.
+  std::array<double, 3> radial{};
+};
+
+// "dx" ... "dc", "dr".
+const char* observation_name(std::size_t output);
+// "µm" for dx dy dz and dr, "µrad" for da db dc.
+const char* observation_unit(std::size_t output);
+
+// How much of deviation output o (0..5) observation `ob` sees: 1 for its own output, the radial
+// component for dr, else 0.
+inline double observation_weight(const PointObservation& ob, int o) {
+  if (ob.output == o) return 1;
+  if (ob.output == kRadialOutput && o < 3) return ob.radial[static_cast<std::size_t>(o)];
+  return 0;
+}
+// The observation's value (µm, µrad) for a deviation given per output in µm and µrad.
+inline double observe(const PointObservation& ob, const std::array<double, 6>& deviation) {
+  double v = 0;
+  for (int o = 0; o < 6; ++o)
+    v += observation_weight(ob, o) * deviation[static_cast<std::size_t>(o)];
+  return v;
+}
+
+// Point measurements of a machine: the poses (independent axes, Description::axes() order, in
+// their units) and one observation per measured deviation cell.
+struct PointData {
+  std::string file;
+  std::vector<std::vector<double>> poses;  // per table row
+  std::vector<PointObservation> observations;
+  std::array<std::size_t, kObservationKinds> count{};  // observations per output (and dr)
+};
+
+// From the model's outputs (mm, rad) to the measured µm and µrad, per output 0..5.
+inline constexpr std::array<double, 6> kObservationScale = {1e3, 1e3, 1e3, 1e6, 1e6, 1e6};
+
+// Output names and units as in the measurement format: dx_um ... dc_urad.
+extern const std::array<const char*, 6> kDeviationColumns;
+
+// Reads the poses and deviations of `table` for the machine. Every independent coordinate must
+// be a column (InputError "file: missing column 'Z' ..."), coordinate cells finite (file:line
+// naming the column), and at least one deviation cell measured.
+PointData point_data(const MeasurementTable& table, const Description& desc);
+
+// The first-order design matrix: row i is observation i, column p parameter p, in µm (µrad) per
+// unit of θ_p: scale_o · C[o][error_p](pose) · ∂error_p/∂θ_p(pose).
+Eigen::MatrixXd design_matrix(const Model& model, const ErrorParameterisation& param,
+                              const PointData& data);
+
+struct IdentifyOptions {
+  double rank_tolerance = 1e-9;    // singular values below tol · σ_max (equilibrated) are null
+  int max_gauss_newton = 8;        // iterations at order >= 2
+  std::vector<std::string> fixed;  // errors held at zero (names or aliases)
+};
+
+// A parameter combination the data cannot determine: adding t·Σ coeff_p e_p (θ units) changes
+// no prediction at the measured poses. Normalised so that the leading coefficient is 1.
+struct NullCombination {
+  std::vector<std::pair<std::size_t, double>> terms;                 // (parameter, coefficient)
+  std::string str(const std::vector<IdentParameter>& params) const;  // "E_XX[1] - E_XY[1]"
+};
+
+struct IdentifyResult {
+  std::vector<double> theta;           // parameter values (declared units); min-norm
+  std::vector<double> standard_error;  // NaN where not identifiable or no residual dof
+  std::vector<bool> identifiable;
+  std::vector<bool> fixed;
+  std::size_t rank = 0, observations = 0, free_parameters = 0;
+  double condition = 0;                 // σ_max / σ_min over the kept singular values
+  std::vector<double> singular_values;  // equilibrated, descending
+  std::vector<NullCombination> unidentifiable;
+  double residual_sigma = 0;  // √(SSE / (m − rank)), µm/µrad mixed as measured
+  std::array<double, 6> rms_before{}, rms_after{}, max_after{};  // per output (NaN if none)
+  std::array<std::size_t, kObservationKinds> count{};
+  int gauss_newton_iterations = 0;
+};
+
+class Identification {
+ public:
+  Identification(const Model& model, const ErrorParameterisation& param,
+                 IdentifyOptions options = {});
+  void run(const PointData& data);
+  const IdentifyResult& result() const { return result_; }
+
+ private:
+  const Model& model_;
+  const ErrorParameterisation& param_;
+  IdentifyOptions options_;
+  IdentifyResult result_;
+};
+
+// Predicted deviations (dx..dz µm, da..dc µrad) at a pose from identified parameters.
+std::array<double, 6> predict_deviation(const Model& model, ModelData& data,
+                                        const ErrorParameterisation& param,
+                                        const std::vector<double>& theta, const double* axes);
+
+}  // namespace weilgen

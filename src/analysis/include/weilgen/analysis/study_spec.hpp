@@ -1,0 +1,95 @@
+// The study inputs: where to evaluate a machine (poses), what tolerances apply to its outputs, and
+// how its errors are distributed. Parsed from command-line flags (--at, --grid, --tolerance,
+// --set) and tolerance files (tolerance_file.hpp); the grammar is in docs/study-inputs.md.
+//
+// Every parse error throws std::invalid_argument (flags) or InputError (files, "file:line:col:")
+// with one line naming the flag or file, the offending text and what was expected, e.g.
+//   --grid: "X=0:1000:0": count must be >= 1
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "weilgen/base/units.hpp"
+#include "weilgen/machine/description.hpp"
+#include "weilgen/uq/distribution.hpp"
+
+namespace weilgen {
+
+// ---- Poses -----------------------------------------------------------------------------------
+
+// --at "X=0,Y=1500,Z=600" (repeatable, one pose each) and --grid "X=0:1000:5,Y=0,Z=600:1400:5"
+// (each axis a value or start:stop:count, count >= 1 evenly spaced values from start to stop,
+// count 1 = start; at most one --grid). Axis names are the machine's coordinates; values are in
+// the axis unit (the joint's `unit`: mm or deg for the shipped machines) unless a unit is written
+// ("Y=1.5m", "A=0.5rad"); each value must lie within the axis range when the machine file gives
+// one. An axis not named takes 0 when 0 is within its range, else it must be given.
+// The grid is the Cartesian product in the order the axes are written, the LAST written axis
+// varying fastest; grid poses come first, then the --at poses. No poses at all is an error.
+struct PoseSet {
+  std::vector<std::string> axes;           // Description::axes() coordinate names, in that order
+  std::vector<std::string> units;          // each axis's unit (Joint::unit: "mm", "deg", ...)
+  std::vector<std::vector<double>> poses;  // each: values for all axes (axis units), axes order
+  // Indices (into axes) of the grid axes with more than one value, in written order, and the
+  // values of each. poses[0 .. grid size) are the grid, in row-major order over grid_axes.
+  std::vector<std::size_t> grid_axes;
+  std::vector<std::vector<double>> grid_values;
+  std::size_t grid_size() const;  // number of grid poses (0 without --grid)
+};
+PoseSet parse_poses(const Description& desc, const std::vector<std::string>& at,
+                    const std::vector<std::string>& grid);
+
+// Most poses a grid may have (the product of its counts).
+constexpr std::size_t kMaxGridPoses = 10'000'000;
+
+// ---- Outputs and tolerances -------------------------------------------------------------------
+
+// dx, dy, dz (mm), da, db, dc (rad), and dp = ||(dx, dy, dz)|| (mm, nonnegative).
+enum class OutputId { Dx, Dy, Dz, Da, Db, Dc, Dp };
+constexpr int kNumOutputs = 7;
+const std::vector<OutputId>& all_outputs();  // Dx ... Dp
+const char* output_name(OutputId id);        // "dx"
+// Outputs 0..5 (dx ... dc) by index, for per-output arrays of measurements.
+inline const char* output_name(std::size_t index) {
+  return output_name(static_cast<OutputId>(index));
+}
+const char* output_unit(OutputId id);  // "mm" or "rad"
+bool output_is_angle(OutputId id);     // da, db, dc
+// "dx" ... "dp" (case-insensitive); throws std::invalid_argument listing the outputs.
+OutputId parse_output(const std::string& name);
+
+// --tolerance "dx=0.03mm" (repeatable, or comma-separated "dx=0.03mm,dy=30um"); value > 0, default
+// unit mm for positions (dx, dy, dz, dp) and rad for orientations (da, db, dc); a length unit on an
+// orientation or an angle unit on a position is an error, as is an output given twice.
+struct OutputTolerance {
+  OutputId output;
+  double value;      // base units (mm or rad)
+  std::string text;  // the value as written ("0.03mm")
+};
+std::vector<OutputTolerance> parse_tolerances(const std::vector<std::string>& flags);
+
+// ---- Error distributions ----------------------------------------------------------------------
+
+// The distribution of every error in BASE units (mm, rad), in Description::errors order: the
+// machine file's (ErrorDef::distribution * to_base), then the tolerance files in order, then the
+// --set flags in order, each overriding what came before:
+//   --set "E_XX=sigma:5um" | "E_XX=normal:0,0.005mm" | "E_XX=uniform:-0.01,0.01mm"
+//       | "E_XX=truncnormal:0,0.005,-0.01,0.01mm" | "E_XX=const:2um"
+// NAME is an error name, an alias (a sign -1 alias negates: the distribution is the alias's) or
+// "group:<group>" (every error of the group). A number without a unit takes the unit written after
+// the last number, else the error's declared unit. An error left without a distribution is an
+// error ("E_XX has no distribution: give one in the machine file, a tolerance file or --set").
+std::vector<InputDistribution> error_distributions(const Description& desc,
+                                                   const std::vector<std::string>& tolerance_files,
+                                                   const std::vector<std::string>& set_flags);
+
+// One --set flag applied to `dists` (Description::errors order, base units; empty = none yet).
+void apply_set_flag(const Description& desc, const std::string& flag,
+                    std::vector<std::optional<InputDistribution>>& dists);
+
+// The machine file's distribution of error i in base units (nullopt when it has none).
+std::optional<InputDistribution> machine_distribution(const ErrorDef& err);
+
+}  // namespace weilgen

@@ -1,0 +1,159 @@
+#include "weilgen/base/units.hpp"
+
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <stdexcept>
+#include <vector>
+
+#include "weilgen/base/expr.hpp"
+#include "weilgen/base/text.hpp"
+
+namespace weilgen {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+struct NamedUnit {
+  const char* name;
+  UnitFactor factor;
+};
+
+// "µ" as the micro sign (U+00B5) and as the Greek small mu (U+03BC), in UTF-8.
+const char* const kMicroSign = "\xC2\xB5";
+const char* const kGreekMu = "\xCE\xBC";
+
+const std::vector<NamedUnit>& units() {
+  static const std::vector<NamedUnit> u = {
+      {"mm", {1, false}},     {"um", {1e-3, false}},      {"nm", {1e-6, false}},
+      {"m", {1e3, false}},    {"rad", {1, true}},         {"mrad", {1e-3, true}},
+      {"urad", {1e-6, true}}, {"deg", {kPi / 180, true}}, {"arcsec", {kPi / 648000, true}},
+      {"mm/m", {1e-3, true}}, {"um/m", {1e-6, true}},
+  };
+  return u;
+}
+
+// µm, μm -> um; µrad -> urad; µm/m -> um/m.
+std::string ascii_micro(const std::string& unit) {
+  for (const char* mu : {kMicroSign, kGreekMu}) {
+    const std::string m(mu);
+    if (unit.compare(0, m.size(), m) == 0) return "u" + unit.substr(m.size());
+  }
+  return unit;
+}
+
+bool unit_char(char c) {
+  const auto u = static_cast<unsigned char>(c);
+  return std::isalpha(u) || c == '/' || u >= 0x80;
+}
+
+[[noreturn]] void fail(const std::string& what, const std::string& why) {
+  throw std::invalid_argument(what.empty() ? why : what + ": " + why);
+}
+
+}  // namespace
+
+std::string trim(const std::string& s) {
+  const char* ws = " \t\r\n";
+  const size_t b = s.find_first_not_of(ws);
+  if (b == std::string::npos) return "";
+  return s.substr(b, s.find_last_not_of(ws) - b + 1);
+}
+
+std::vector<std::string> split(const std::string& s, char sep) {
+  std::vector<std::string> out;
+  size_t start = 0;
+  while (true) {
+    const size_t end = s.find(sep, start);
+    out.push_back(s.substr(start, end == std::string::npos ? std::string::npos : end - start));
+    if (end == std::string::npos) return out;
+    start = end + 1;
+  }
+}
+
+std::string format_number(double v) {
+  if (v == 0) return "0";  // also -0
+  char buf[40];
+  for (int digits : {15, 16, 17}) {
+    std::snprintf(buf, sizeof buf, "%.*g", digits, v);
+    if (std::strtod(buf, nullptr) == v) break;
+  }
+  return buf;
+}
+
+std::string known_units() {
+  return "lengths: mm, um, µm, nm, m; angles: rad, mrad, urad, µrad, deg, arcsec; slopes: mm/m, "
+         "um/m";
+}
+
+UnitFactor parse_unit(const std::string& unit) {
+  const std::string ascii = ascii_micro(unit);
+  for (const NamedUnit& u : units()) {
+    if (ascii == u.name) return u.factor;
+  }
+  throw std::invalid_argument("unknown unit \"" + unit + "\" (" + known_units() + ")");
+}
+
+Quantity parse_quantity_unit(const std::string& text, const std::string& default_unit,
+                             const std::string& what) {
+  const std::string t = trim(text);
+  if (t.empty()) fail(what, "empty value (expected a number with an optional unit, e.g. 0.03mm)");
+  std::string bare = lower(t);
+  bare.erase(0, bare.find_first_not_of("+- \t"));
+  if (bare.compare(0, 3, "nan") == 0) fail(what, "\"" + t + "\" is not a number (NaN)");
+  if (bare.compare(0, 3, "inf") == 0) fail(what, "\"" + t + "\" is not a finite number");
+
+  // The unit is the trailing run of letters, '/' and µ; an expression ending in a name
+  // ("2*pi") has none.
+  size_t cut = t.size();
+  while (cut > 0 && unit_char(t[cut - 1])) --cut;
+  std::string number_text = trim(t.substr(0, cut));
+  std::string unit_text = t.substr(cut);
+  Quantity q;
+  if (!unit_text.empty()) {
+    try {
+      q.unit = parse_unit(unit_text);
+      q.unit_name = unit_text;
+      q.unit_given = true;
+    } catch (const std::invalid_argument& ex) {
+      // Not a unit: either the whole text is an expression ("2*pi") or the unit is wrong.
+      bool expression = false;
+      try {
+        expression = parse_expr(t).params().empty();
+      } catch (const std::invalid_argument&) {
+      }
+      if (!expression) fail(what, std::string(ex.what()) + " in \"" + t + "\"");
+      number_text = t;
+      unit_text.clear();
+    }
+  }
+  if (!q.unit_given) {
+    if (default_unit.empty()) {
+      fail(what, "\"" + t + "\" needs a unit (" + known_units() + ")");
+    }
+    q.unit = parse_unit(default_unit);
+    q.unit_name = default_unit;
+  }
+  if (number_text.empty()) fail(what, "\"" + t + "\" has no number before the unit");
+  Expr e;
+  try {
+    e = parse_expr(number_text);
+  } catch (const std::invalid_argument& ex) {
+    fail(what, "\"" + t + "\" is not a number or expression: " + ex.what());
+  }
+  if (!e.params().empty()) {
+    fail(what, "\"" + t + "\" is not a number: unknown name \"" + e.params().front() +
+                   "\" (expected a number or an expression such as 0.05/6, then a unit)");
+  }
+  q.number = e.eval({});
+  if (!std::isfinite(q.number)) fail(what, "\"" + t + "\" is not a finite number");
+  return q;
+}
+
+double parse_quantity(const std::string& text, const std::string& default_unit,
+                      const std::string& what) {
+  return parse_quantity_unit(text, default_unit, what).value();
+}
+
+}  // namespace weilgen

@@ -1,0 +1,98 @@
+#include <boost/program_options.hpp>
+#include <iostream>
+
+#include "verbs.hpp"
+#include "weilgen/base/atomic_file.hpp"
+#include "weilgen/codegen/generate.hpp"
+#include "weilgen/machine/yaml_loader.hpp"
+
+namespace po = boost::program_options;
+
+namespace weilgen::cli {
+
+int usage_error(const std::string& verb, const std::string& message) {
+  std::cerr << "weilgen " << verb << ": " << message << " (try weilgen " << verb << " --help)\n";
+  return 2;
+}
+
+template <typename Positional>
+std::optional<int> parse_args(const std::string& verb, const Args& args,
+                              const po::options_description& visible, const char* positional,
+                              int max_positional, po::variables_map& vm) {
+  po::options_description hidden;
+  hidden.add_options()(positional, po::value<Positional>(), "");
+  po::options_description all;
+  all.add(visible).add(hidden);
+  po::positional_options_description pos;
+  pos.add(positional, max_positional);
+  try {
+    po::store(po::command_line_parser(args).options(all).positional(pos).run(), vm);
+    po::notify(vm);
+  } catch (const po::error& e) {
+    return usage_error(verb, e.what());
+  }
+  if (vm.count("help")) {
+    std::cout << visible << "\n";
+    return 0;
+  }
+  return std::nullopt;
+}
+
+template std::optional<int> parse_args<std::string>(const std::string&, const Args&,
+                                                    const po::options_description&, const char*,
+                                                    int, po::variables_map&);
+template std::optional<int> parse_args<std::vector<std::string>>(const std::string&, const Args&,
+                                                                 const po::options_description&,
+                                                                 const char*, int,
+                                                                 po::variables_map&);
+
+int verb_generate(const Args& args) {
+  po::options_description opts(
+      "weilgen generate <machine>... [options]\n\n"
+      "Builds each machine's error model over its Weil algebra and writes <out>/<name>.hpp\n"
+      "(standalone C++ header) and <out>/<name>.md (closed-form report). Files are written\n"
+      "atomically and only when every machine generated without error.\n\nOptions");
+  int order = 0;
+  std::string out = "generated";
+  opts.add_options()("help,h", "show this help")(
+      "order", po::value<int>(&order),
+      "truncation order r >= 1, overriding the file's algebra.order; the outputs are then\n"
+      "named <name>_o<r>")("out", po::value<std::string>(&out)->default_value("generated"),
+                           "output directory")(
+      "check",
+      "write nothing; exit 1 and list the stale files when the files in --out differ\n"
+      "from what would be generated");
+  po::variables_map vm;
+  if (auto stop = parse_args<std::vector<std::string>>("generate", args, opts, "machine", -1, vm))
+    return *stop;
+  if (!vm.count("machine")) return usage_error("generate", "no machine given");
+  if (vm.count("order") && order < 1) return usage_error("generate", "--order must be >= 1");
+
+  std::vector<gen::GeneratedFile> files;
+  for (const auto& m : vm["machine"].as<std::vector<std::string>>()) {
+    const Description d = load_machine_file(resolve_machine(m));
+    auto f = gen::generate_files(d, order, out);
+    files.insert(files.end(), f.begin(), f.end());
+  }
+  if (vm.count("check")) {
+    const auto stale = gen::stale_files(files);
+    for (const auto& s : stale) std::cout << s << "\n";
+    if (!stale.empty()) {
+      std::cout << stale.size()
+                << " generated file(s) out of date: run `weilgen generate` and "
+                   "commit the result\n";
+      return 1;
+    }
+    std::cout << files.size() << " generated file(s) up to date\n";
+    return 0;
+  }
+  for (const auto& f : files) {
+    std::string old;
+    if (read_file(f.path, old) && old == f.contents) continue;  // keep mtime: no rebuilds
+    write_file_atomically(f.path, f.contents);
+    std::cout << "wrote " << f.path << "\n";
+  }
+  return 0;
+}
+
+}  // namespace weilgen::cli

@@ -1,0 +1,181 @@
+#include "weilgen/codegen/cse.hpp"
+
+#include <algorithm>
+#include <unordered_map>
+
+namespace weilgen::gen {
+
+using GiNaC::ex;
+
+namespace {
+bool is_atom(const ex& e) {
+  return GiNaC::is_a<GiNaC::symbol>(e) || GiNaC::is_a<GiNaC::numeric>(e) ||
+         GiNaC::is_a<GiNaC::constant>(e);
+}
+// A product's numeric factor is not worth a temporary of its own: c·(rest) shares `rest`.
+ex strip_coefficient(const ex& e) {
+  if (!GiNaC::is_a<GiNaC::mul>(e)) return e;
+  ex rest = 1;
+  for (std::size_t i = 0; i < e.nops(); ++i)
+    if (!GiNaC::is_a<GiNaC::numeric>(e.op(i))) rest *= e.op(i);
+  return rest;
+}
+}  // namespace
+
+const std::string& CanonicalText::of(const ex& e) {
+  auto it = memo_.find(e);
+  if (it != memo_.end()) return it->second;
+  std::string s;
+  if (is_atom(e)) {
+    std::ostringstream os;
+    os << e;
+    s = os.str();
+  } else if (GiNaC::is_a<GiNaC::mul>(e)) {
+    // Sign-canonical: a sum factor is taken with the sign whose text is smaller and the sign is
+    // moved to the numeric coefficient, so that c·(a − b) and (−c)·(b − a) read the same.
+    GiNaC::numeric coeff = 1;
+    std::vector<std::string> parts;
+    for (std::size_t i = 0; i < e.nops(); ++i) {
+      const ex& op = e.op(i);
+      if (GiNaC::is_a<GiNaC::numeric>(op)) {
+        coeff *= GiNaC::ex_to<GiNaC::numeric>(op);
+      } else if (GiNaC::is_a<GiNaC::add>(op)) {
+        const Signed r = canonical_sign(op);
+        if (r.negated) coeff = -coeff;
+        parts.push_back(of(r.value));
+      } else {
+        parts.push_back(of(op));
+      }
+    }
+    std::sort(parts.begin(), parts.end());
+    std::ostringstream os;
+    os << "mul(" << coeff;
+    for (const auto& p : parts) os << "," << p;
+    os << ")";
+    s = os.str();
+  } else {
+    std::vector<std::string> parts;
+    for (std::size_t i = 0; i < e.nops(); ++i) parts.push_back(of(e.op(i)));
+    if (GiNaC::is_a<GiNaC::add>(e) || GiNaC::is_a<GiNaC::mul>(e))
+      std::sort(parts.begin(), parts.end());
+    if (GiNaC::is_a<GiNaC::add>(e)) {
+      s = "add(";
+    } else if (GiNaC::is_a<GiNaC::mul>(e)) {
+      s = "mul(";
+    } else if (GiNaC::is_a<GiNaC::power>(e)) {
+      s = "pow(";
+    } else if (GiNaC::is_a<GiNaC::function>(e)) {
+      s = GiNaC::ex_to<GiNaC::function>(e).get_name() + "(";
+    } else {
+      s = "node(";
+    }
+    for (std::size_t i = 0; i < parts.size(); ++i) s += (i ? "," : "") + parts[i];
+    s += ")";
+  }
+  return memo_.emplace(e, std::move(s)).first->second;
+}
+
+CanonicalText::Signed CanonicalText::canonical_sign(const ex& sum) {
+  const ex neg = (-sum).expand();
+  if (of(neg) < of(sum)) return {neg, true};
+  return {sum, false};
+}
+
+std::string CanonicalText::unsigned_text(const ex& e) {
+  if (!GiNaC::is_a<GiNaC::mul>(e)) return of(e);
+  const std::string& t = of(e);  // "mul(<coeff>,<factors...>)"
+  const auto comma = t.find(',');
+  return comma == std::string::npos ? t : "mul(" + t.substr(comma + 1);
+}
+
+std::vector<ex> CanonicalText::sorted_ops(const ex& e) {
+  std::vector<ex> ops;
+  for (std::size_t i = 0; i < e.nops(); ++i) ops.push_back(e.op(i));
+  if (GiNaC::is_a<GiNaC::mul>(e)) {
+    std::stable_sort(ops.begin(), ops.end(),
+                     [&](const ex& a, const ex& b) { return of(a) < of(b); });
+  } else if (GiNaC::is_a<GiNaC::add>(e)) {
+    // By the term without its numeric factor: the order must not change when GiNaC flips the
+    // sign of the whole sum.
+    std::vector<std::pair<std::string, ex>> keyed;
+    for (const ex& op : ops) keyed.emplace_back(unsigned_text(op), op);
+    std::stable_sort(keyed.begin(), keyed.end(),
+                     [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (std::size_t i = 0; i < ops.size(); ++i) ops[i] = keyed[i].second;
+  }
+  return ops;
+}
+
+namespace {
+struct Eliminator {
+  CanonicalText canon;
+  std::unordered_map<std::string, int> count;
+  std::unordered_map<std::string, ex> replaced;
+  CseResult result;
+  std::string prefix;
+
+  void tally(const ex& node) {
+    if (is_atom(node)) return;
+    const ex core = strip_coefficient(node);
+    if (!core.is_equal(node)) {
+      tally(core);
+      return;
+    }
+    if (count[canon.of(node)]++ > 0) return;
+    for (const ex& op : canon.sorted_ops(node)) tally(op);
+  }
+
+  ex rewrite(const ex& node) {
+    if (is_atom(node)) return node;
+    const ex core = strip_coefficient(node);
+    if (!core.is_equal(node)) return rewrite(core) * (node / core).expand();
+    const std::string& key = canon.of(node);
+    if (auto it = replaced.find(key); it != replaced.end()) return it->second;
+    ex rebuilt;
+    if (GiNaC::is_a<GiNaC::add>(node)) {
+      GiNaC::exvector v;
+      for (const ex& op : canon.sorted_ops(node)) v.push_back(rewrite(op));
+      rebuilt = GiNaC::add(v);
+    } else if (GiNaC::is_a<GiNaC::mul>(node)) {
+      GiNaC::exvector v;
+      for (const ex& op : canon.sorted_ops(node)) v.push_back(rewrite(op));
+      rebuilt = GiNaC::mul(v);
+    } else if (GiNaC::is_a<GiNaC::power>(node)) {
+      rebuilt = GiNaC::pow(rewrite(node.op(0)), rewrite(node.op(1)));
+    } else {
+      struct Rewriter : GiNaC::map_function {
+        Eliminator* self;
+        explicit Rewriter(Eliminator* s) : self(s) {}
+        ex operator()(const ex& e) override { return self->rewrite(e); }
+      } rewriter(this);
+      rebuilt = node.map(rewriter);
+    }
+    if (count[key] >= 2) {
+      GiNaC::symbol t(prefix + std::to_string(result.temps.size()));
+      // A sum's sign is GiNaC's (hash-order) choice: store the canonical sign in the temporary.
+      ex value = rebuilt, use = t;
+      if (GiNaC::is_a<GiNaC::add>(rebuilt)) {
+        const CanonicalText::Signed r = canon.canonical_sign(rebuilt);
+        value = r.value;
+        if (r.negated) use = -t;
+      }
+      result.temps.push_back({t, value});
+      replaced.emplace(key, use);
+      return use;
+    }
+    replaced.emplace(key, rebuilt);
+    return rebuilt;
+  }
+};
+}  // namespace
+
+CseResult eliminate_common_subexpressions(const std::vector<ex>& outputs,
+                                          const std::string& prefix) {
+  Eliminator el;
+  el.prefix = prefix;
+  for (const ex& e : outputs) el.tally(e);
+  for (const ex& e : outputs) el.result.outputs.push_back(el.rewrite(e));
+  return std::move(el.result);
+}
+
+}  // namespace weilgen::gen

@@ -1,0 +1,497 @@
+#include "weilgen/codegen/emit_cpp.hpp"
+
+#include <optional>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#include "weilgen/base/version.hpp"
+#include "weilgen/codegen/cse.hpp"
+#include "weilgen/codegen/emit_compensation.hpp"
+#include "weilgen/codegen/printer.hpp"
+#include "weilgen/machine/model_key.hpp"
+
+namespace weilgen::gen {
+
+using GiNaC::ex;
+
+namespace {
+
+std::string quoted(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out + "\"";
+}
+
+const char* dist_kind(Distribution::Kind k) {
+  switch (k) {
+    case Distribution::Kind::Normal:
+      return "DistributionKind::kNormal";
+    case Distribution::Kind::Uniform:
+      return "DistributionKind::kUniform";
+    case Distribution::Kind::TruncatedNormal:
+      return "DistributionKind::kTruncatedNormal";
+    case Distribution::Kind::None:
+      break;
+  }
+  return "DistributionKind::kNone";
+}
+
+const char* placement_name(ErrorPlacement p) {
+  switch (p) {
+    case ErrorPlacement::After:
+      return "after";
+    case ErrorPlacement::Before:
+      return "before";
+    case ErrorPlacement::Axis:
+      return "axis";
+  }
+  return "";
+}
+
+// Symbol name → C++ identifier, and the statement that defines each input from the arguments.
+struct InputTable {
+  std::map<std::string, std::string> code_name;
+  std::map<std::string, std::string> definition;  // by code name
+  std::vector<std::string> order;                 // code names in declaration order
+  // Inputs computed from others (reciprocals of divisors): code name -> the code names it uses.
+  std::map<std::string, std::set<std::string>> depends;
+  std::map<std::string, OpCount> cost;  // operations of a computed input's definition
+};
+
+void collect_symbols(const ex& e, std::set<std::string>& out);
+
+InputTable inputs_of(const SymbolicModel& m) {
+  InputTable t;
+  std::set<std::string> taken;
+  auto add = [&](const std::string& sym, const std::string& code, const std::string& def) {
+    if (!taken.insert(code).second)
+      throw std::runtime_error("name clash in generated code: '" + code +
+                               "' is both a coordinate, an error or a parameter name");
+    t.code_name[sym] = code;
+    t.definition[code] = def;
+    t.order.push_back(code);
+  };
+  for (std::size_t i = 0; i < m.axes.size(); ++i) {
+    const auto& a = m.axes[i];
+    const Joint& j = m.desc.bodies[a.body].joint;
+    add(a.coordinate.get_name(), j.coordinate, "axes[" + std::to_string(i) + "]");
+    if (a.revolute) {
+      const std::string arg = j.coordinate + " * Scalar(" + format_double(j.to_base) + ")";
+      add(a.cos.get_name(), "cos_" + j.coordinate, "cos(" + arg + ")");
+      add(a.sin.get_name(), "sin_" + j.coordinate, "sin(" + arg + ")");
+    }
+  }
+  for (std::size_t i = 0; i < m.errors.size(); ++i)
+    add(m.errors[i].get_name(), m.errors[i].get_name(), "errors[" + std::to_string(i) + "]");
+  for (std::size_t i = 0; i < m.params.size(); ++i)
+    add(m.params[i].get_name(), m.params[i].get_name(), "params[" + std::to_string(i) + "]");
+  // Reciprocals of derived divisors, once per call (model_builder.hpp, Reciprocal).
+  for (const Reciprocal& r : m.reciprocals) {
+    ExprPrinter pr(ExprPrinter::Style::Cpp, t.code_name);
+    const std::string code = r.symbol.get_name();
+    add(code, code, "Scalar(1) / (" + pr.print(r.divisor) + ")");
+    std::set<std::string> syms;
+    collect_symbols(r.divisor, syms);
+    for (const auto& sym : syms) t.depends[code].insert(t.code_name.at(sym));
+    OpCount c = pr.ops();
+    ++c.divs;
+    t.cost[code] = c;
+  }
+  return t;
+}
+
+void collect_symbols(const ex& e, std::set<std::string>& out) {
+  if (GiNaC::is_a<GiNaC::symbol>(e)) {
+    out.insert(GiNaC::ex_to<GiNaC::symbol>(e).get_name());
+    return;
+  }
+  for (std::size_t i = 0; i < e.nops(); ++i) collect_symbols(e.op(i), out);
+}
+
+struct OutputGroup {
+  std::string pointer;  // argument name
+  std::vector<ex> values;
+};
+
+// Named coefficient polynomials of a Deviation-style function: every coefficient that is a sum
+// or a product of several symbols gets a placeholder `_coefN` (shared by all outputs and
+// monomials), and the error monomials with the same placeholder are grouped,
+// _coef3·(E_AA + E_AY − E_A0A), instead of repeating the product per error. Signs and numeric
+// factors are chosen canonically: GiNaC would otherwise pick the sign of a sum inside a product
+// by its hash order, which varies between runs.
+struct Coefficients {
+  std::vector<std::pair<GiNaC::symbol, ex>> defs;
+  std::map<std::string, GiNaC::symbol> by_text;
+  CanonicalText canon;
+
+  // c = factor · placeholder, or nullopt when c is a number or a single symbol (used inline).
+  std::optional<std::pair<ex, GiNaC::symbol>> split(const ex& c) {
+    ex factor = 1, rest = c;
+    if (GiNaC::is_a<GiNaC::mul>(c)) {
+      rest = 1;
+      for (std::size_t i = 0; i < c.nops(); ++i) {
+        const ex op = c.op(i);
+        if (GiNaC::is_a<GiNaC::numeric>(op)) {
+          factor *= op;
+        } else if (GiNaC::is_a<GiNaC::add>(op)) {
+          // Sums in canonical sign: GiNaC's choice varies between runs.
+          const CanonicalText::Signed r = canon.canonical_sign(op);
+          if (r.negated) factor = -factor;
+          rest *= r.value;
+        } else {
+          rest *= op;
+        }
+      }
+      if (!GiNaC::is_a<GiNaC::mul>(rest) && !GiNaC::is_a<GiNaC::power>(rest)) return std::nullopt;
+    } else if (!GiNaC::is_a<GiNaC::add>(c)) {
+      return std::nullopt;
+    } else {
+      const CanonicalText::Signed r = canon.canonical_sign(c);
+      rest = r.value;
+      if (r.negated) factor = -1;
+    }
+    const std::string& key = canon.of(rest);
+    auto it = by_text.find(key);
+    if (it == by_text.end()) {
+      GiNaC::symbol sym("_coef" + std::to_string(defs.size()));
+      defs.emplace_back(sym, rest);
+      it = by_text.emplace(key, sym).first;
+    }
+    return std::make_pair(factor, it->second);
+  }
+
+  // Σ c_m · monomial_m of one output, grouped by placeholder.
+  ex output(const Poly& p, const std::vector<GiNaC::symbol>& errors) {
+    GiNaC::exvector direct;
+    std::map<std::string, std::pair<GiNaC::symbol, GiNaC::exvector>> grouped;
+    for (const auto& [mono, c] : p.terms()) {
+      ex monomial = 1;
+      for (auto i : mono) monomial *= errors[i];
+      if (auto s = split(c)) {
+        auto& g = grouped[s->second.get_name()];
+        g.first = s->second;
+        g.second.push_back(s->first * monomial);
+      } else {
+        direct.push_back(c * monomial);
+      }
+    }
+    for (auto& [name, g] : grouped) direct.push_back(g.first * GiNaC::add(g.second));
+    return GiNaC::add(direct);
+  }
+};
+
+struct FunctionCode {
+  std::string body;
+  OpCount ops;
+  std::size_t temps = 0;
+};
+
+// Body of a generated function: used inputs, one CSE pass over all groups, guarded outputs.
+FunctionCode function_body(const InputTable& inputs, const std::vector<OutputGroup>& groups,
+                           const Coefficients* coefficients = nullptr) {
+  std::vector<ex> all;
+  const std::size_t ncoef = coefficients ? coefficients->defs.size() : 0;
+  for (std::size_t k = 0; k < ncoef; ++k) all.push_back(coefficients->defs[k].second);
+  for (const auto& g : groups) all.insert(all.end(), g.values.begin(), g.values.end());
+  const CseResult cse = eliminate_common_subexpressions(all);
+
+  std::set<std::string> used;
+  for (const auto& t : cse.temps) collect_symbols(t.value, used);
+  for (const auto& o : cse.outputs) collect_symbols(o, used);
+
+  ExprPrinter printer(ExprPrinter::Style::Cpp, inputs.code_name);
+  std::ostringstream os;
+  std::set<std::string> used_code;
+  for (const auto& s : used)
+    if (auto it = inputs.code_name.find(s); it != inputs.code_name.end())
+      used_code.insert(it->second);
+  // cos/sin of a coordinate need the coordinate itself; each costs a call and a multiply.
+  const auto is_trig = [](const std::string& code) {
+    return code.rfind("cos_", 0) == 0 || code.rfind("sin_", 0) == 0;
+  };
+  OpCount trig;
+  // Computed inputs (reverse declaration order: they may use earlier ones) pull in what they use.
+  for (auto it = inputs.order.rbegin(); it != inputs.order.rend(); ++it) {
+    if (!used_code.count(*it) || !inputs.depends.count(*it)) continue;
+    used_code.insert(inputs.depends.at(*it).begin(), inputs.depends.at(*it).end());
+    trig += inputs.cost.at(*it);
+  }
+  for (const auto& code : inputs.order)
+    if (used_code.count(code) && is_trig(code)) {
+      used_code.insert(code.substr(4));
+      ++trig.functions;
+      ++trig.muls;
+    }
+  os << "  // Inputs\n";
+  for (const auto& code : inputs.order)
+    if (used_code.count(code))
+      os << "  const Scalar " << code << " = " << inputs.definition.at(code) << ";\n";
+  os << "\n  // Intermediate terms (" << cse.temps.size() << ")\n";
+  for (const auto& t : cse.temps)
+    os << "  const Scalar " << t.symbol.get_name() << " = " << printer.print(t.value) << ";\n";
+  if (ncoef > 0) os << "\n  // Coefficients of the error monomials (" << ncoef << ")\n";
+  for (std::size_t k = 0; k < ncoef; ++k)
+    os << "  const Scalar " << coefficients->defs[k].first.get_name() << " = "
+       << printer.print(cse.outputs[k]) << ";\n";
+  os << "\n  // Outputs\n";
+  std::size_t k = ncoef;
+  for (const auto& g : groups) {
+    os << "  if (" << g.pointer << " != nullptr) {\n";
+    os << "    auto& _" << g.pointer << " = *" << g.pointer << ";\n";
+    for (std::size_t i = 0; i < g.values.size(); ++i, ++k) {
+      os << "    _" << g.pointer << "[" << i << "] = " << printer.print(cse.outputs[k]) << ";\n";
+    }
+    os << "  }\n";
+  }
+  FunctionCode fc{os.str(), printer.ops(), cse.temps.size()};
+  fc.ops += trig;
+  return fc;
+}
+
+std::string doc_list(const std::vector<std::string>& names) {
+  std::string s;
+  for (std::size_t i = 0; i < names.size(); ++i) s += (i ? ", " : "") + names[i];
+  return s;
+}
+
+}  // namespace
+
+std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_label) {
+  const Description& d = m.desc;
+  const InputTable inputs = inputs_of(m);
+  const std::size_t ne = m.errors.size();
+  const std::vector<Monomial> higher = m.higher_monomials();
+
+  // Deviation: the full algebra element of each output.
+  Coefficients coefs;
+  std::vector<ex> pos, rot;
+  for (int o = 0; o < 6; ++o) (o < 3 ? pos : rot).push_back(coefs.output(m.outputs[o], m.errors));
+  const FunctionCode dev = function_body(inputs, {{"position", pos}, {"orientation", rot}}, &coefs);
+
+  // Coefficients: ∂output/∂error at zero error, row-major [output][error].
+  std::vector<ex> cpos, crot;
+  for (int o = 0; o < 6; ++o)
+    for (std::size_t i = 0; i < ne; ++i)
+      (o < 3 ? cpos : crot).push_back(m.coefficient(o, {static_cast<std::uint16_t>(i)}));
+  const FunctionCode coef =
+      function_body(inputs, {{"position_coeff", cpos}, {"orientation_coeff", crot}});
+
+  FunctionCode high;
+  if (!higher.empty()) {
+    std::vector<ex> h;
+    for (int o = 0; o < 6; ++o)
+      for (const auto& mono : higher) h.push_back(m.coefficient(o, mono));
+    high = function_body(inputs, {{"terms", h}});
+  }
+
+  // Nominal kinematics: the pose at zero errors and its Jacobian in the axes' units (a revolute
+  // column per deg is the per-rad derivative times to_base).
+  std::vector<ex> npos, nrot;
+  for (int i = 0; i < 3; ++i) {
+    npos.push_back(m.nominal[i][3]);
+    for (int j = 0; j < 3; ++j) nrot.push_back(m.nominal[i][j]);
+  }
+  const FunctionCode pose = function_body(inputs, {{"position", npos}, {"rotation", nrot}});
+  // A unit factor is a named constant, `_to_baseN * (...)`, not multiplied into every term.
+  InputTable jinputs = inputs;
+  std::map<double, GiNaC::symbol> unit_factor;
+  std::vector<ex> jac(m.nominal_jacobian.size());
+  const std::size_t na = m.axes.size();
+  for (std::size_t k = 0; k < jac.size(); ++k) {
+    const double to_base = d.bodies[m.axes[k % na].body].joint.to_base;
+    jac[k] = m.nominal_jacobian[k];
+    if (to_base == 1.0 || jac[k].is_zero()) continue;
+    auto it = unit_factor.find(to_base);
+    if (it == unit_factor.end()) {
+      const std::string code = "_to_base" + std::to_string(unit_factor.size());
+      it = unit_factor.emplace(to_base, GiNaC::symbol(code)).first;
+      jinputs.code_name[code] = code;
+      jinputs.definition[code] = "Scalar(" + format_double(to_base) + ")";
+      jinputs.order.push_back(code);
+    }
+    jac[k] = it->second * jac[k];
+  }
+  const FunctionCode jacobian = function_body(jinputs, {{"jacobian", jac}});
+
+  std::vector<std::string> axis_names, error_names, param_names;
+  for (const auto& a : m.axes) axis_names.push_back(d.bodies[a.body].joint.coordinate);
+  for (const auto& e : d.errors) error_names.push_back(e.name);
+  for (const auto& p : d.parameters) param_names.push_back(p.name);
+
+  std::ostringstream os;
+  os << "// GENERATED by weilgen " << kVersion << " from " << source_label
+     << ". Do not edit: edit the machine file and run `weilgen generate`.\n";
+  os << "// Machine: " << d.name << (d.title.empty() ? "" : " — " + d.title) << "\n";
+  os << "// Algebra: R[e_1..e_" << ne << "] / I, I = <all monomials of degree " << m.order + 1
+     << ">";
+  if (!m.relations.empty()) os << " + <" << m.relations.size() << " relation monomials>";
+  os << " (order " << m.order << (m.order == 1 ? ", dual numbers" : "") << ")\n";
+  os << "// Units: axes as in kAxes (mm, deg), errors in base units (mm, rad), parameters in "
+        "mm/deg;\n"
+     << "//        position outputs dx, dy, dz in mm, orientation outputs da, db, dc in rad.\n";
+  os << "// Operation counts (after common-subexpression elimination):\n";
+  os << "//   Deviation:    " << dev.ops.str() << ", " << dev.temps << " temporaries\n";
+  os << "//   Coefficients: " << coef.ops.str() << ", " << coef.temps << " temporaries\n";
+  if (!higher.empty())
+    os << "//   HigherOrder:  " << high.ops.str() << ", " << high.temps << " temporaries\n";
+  os << "//   NominalPose:  " << pose.ops.str() << ", " << pose.temps << " temporaries\n";
+  os << "//   NominalJacobian: " << jacobian.ops.str() << ", " << jacobian.temps
+     << " temporaries\n";
+  os << "//   Compensate:   per iteration errors_at + Deviation + NominalPose + "
+     << (m.axes_turn_output() ? 6 : 3) << "x" << na
+     << " least-squares step; once per call NominalJacobian + NominalPose + Cholesky\n";
+  os << "#pragma once\n\n#include <array>\n#include <cmath>\n#include <cstddef>\n\n";
+  os << "namespace weilgen_models {\nnamespace " << d.name << " {\n\n";
+
+  os << "inline constexpr const char* kMachineName = " << quoted(d.name) << ";\n";
+  os << "inline constexpr int kOrder = " << m.order << ";\n";
+  os << "// Machine-file text, order and weilgen version: identifies the model "
+        "(runtime/model_key.hpp).\n";
+  os << "inline constexpr const char* kModelKey = " << quoted(model_key(d.source_hash, m.order))
+     << ";\n";
+  os << "inline constexpr std::size_t kNumAxes = " << m.axes.size() << ";\n";
+  os << "inline constexpr std::size_t kNumErrors = " << ne << ";\n";
+  os << "inline constexpr std::size_t kNumParams = " << d.parameters.size() << ";\n";
+  os << "inline constexpr std::size_t kNumOutputs = 6;\n";
+  os << "inline constexpr std::size_t kNumHigherTerms = " << higher.size() << ";\n";
+  os << "inline constexpr std::size_t kMaxHigherDegree = "
+     << (higher.empty() ? 0 : higher.back().size()) << ";\n\n";
+
+  os << "enum class DistributionKind { kNone, kNormal, kUniform, kTruncatedNormal };\n\n";
+  os << "struct AxisInfo {\n  const char* name;\n  const char* unit;\n  bool revolute;\n"
+        "  double min;\n  double max;\n  double to_base;  // unit -> mm or rad\n};\n\n";
+  os << "struct ErrorInfo {\n  const char* name;\n  const char* iso;      // ISO 230-1 name or "
+        "\"\"\n"
+        "  const char* aliases;  // space-separated; a leading '-' marks a negated alias\n"
+        "  const char* group;\n  const char* unit;     // unit of the distribution values\n"
+        "  double to_base;       // unit -> mm or rad (the unit of Deviation's errors)\n"
+        "  bool position_dependent;  // PDGE (true) or PIGE (false)\n"
+        "  const char* body;\n  const char* placement;  // after | before | axis\n"
+        "  bool rotation;\n  DistributionKind distribution;\n"
+        "  double a, b;    // normal: mean, sigma; uniform: lo, hi (in unit)\n"
+        "  double lo, hi;  // truncated normal bounds (in unit)\n};\n\n";
+  os << "struct ParamInfo {\n  const char* name;\n  const char* unit;\n  double "
+        "default_value;\n};\n\n";
+
+  os << "inline constexpr std::array<AxisInfo, kNumAxes> kAxes = {{\n";
+  for (const auto& a : m.axes) {
+    const Joint& j = d.bodies[a.body].joint;
+    os << "    {" << quoted(j.coordinate) << ", " << quoted(j.unit) << ", "
+       << (a.revolute ? "true" : "false") << ", " << format_double(j.min) << ", "
+       << format_double(j.max) << ", " << format_double(j.to_base) << "},\n";
+  }
+  os << "}};\n\n";
+  os << "inline constexpr std::array<ErrorInfo, kNumErrors> kErrors = {{\n";
+  for (const auto& e : d.errors) {
+    std::string aliases;
+    for (const auto& al : e.aliases)
+      aliases += (aliases.empty() ? "" : " ") + std::string(al.sign < 0 ? "-" : "") + al.name;
+    os << "    {" << quoted(e.name) << ", " << quoted(e.iso) << ", " << quoted(aliases) << ", "
+       << quoted(e.group) << ", " << quoted(e.unit) << ", " << format_double(e.to_base) << ", "
+       << (e.dependence == Dependence::PDGE ? "true" : "false") << ", "
+       << quoted(d.bodies[e.body].name) << ", " << quoted(placement_name(e.placement)) << ", "
+       << (e.effect == ErrorEffect::Rotation ? "true" : "false") << ", "
+       << dist_kind(e.distribution.kind) << ", " << format_double(e.distribution.a) << ", "
+       << format_double(e.distribution.b) << ", " << format_double(e.distribution.lo) << ", "
+       << format_double(e.distribution.hi) << "},\n";
+  }
+  os << "}};\n\n";
+  os << "inline constexpr std::array<ParamInfo, kNumParams> kParams = {{\n";
+  const auto defaults = d.parameter_defaults();
+  for (const auto& p : d.parameters)
+    os << "    {" << quoted(p.name) << ", " << quoted(p.unit) << ", "
+       << format_double(defaults.at(p.name)) << "},\n";
+  os << "}};\n\n";
+  os << "inline constexpr std::array<const char*, kNumOutputs> kOutputs = {{\"dx\", \"dy\", "
+        "\"dz\", "
+        "\"da\", \"db\", \"dc\"}};\n";
+  os << "inline constexpr std::array<const char*, kNumOutputs> kOutputUnits = {{\"mm\", \"mm\", "
+        "\"mm\", \"rad\", \"rad\", \"rad\"}};\n\n";
+  os << "// Monomials of degree >= 2 with a non-zero coefficient: error indices, padded with -1.\n";
+  const std::size_t width = higher.empty() ? 1 : higher.back().size();
+  os << "inline constexpr std::array<std::array<int, " << width
+     << ">, kNumHigherTerms> kHigherTerms = {{\n";
+  for (const auto& mono : higher) {
+    os << "    {{";
+    for (std::size_t i = 0; i < width; ++i)
+      os << (i ? ", " : "") << (i < mono.size() ? std::to_string(mono[i]) : "-1");
+    os << "}},  // " << m.monomial_name(mono) << "\n";
+  }
+  os << "}};\n\n";
+
+  const std::string in_doc = "//   axes:   " + doc_list(axis_names) +
+                             "\n//   errors: " + doc_list(error_names) +
+                             "\n//   params: " + doc_list(param_names) + "\n";
+  os << (d.output ? "// Deviation of the output point (" +
+                        (d.output->description.empty() ? std::string("the output transform")
+                                                       : d.output->description) +
+                        "):\n"
+                  : std::string("// Deviation of the tool point relative to the workpiece, in the "
+                                "workpiece frame:\n"))
+     << "// position = (dx, dy, dz) in mm, orientation = (da, db, dc) in rad. Null outputs are\n"
+        "// skipped. Exact in the algebra of order kOrder.\n"
+     << in_doc;
+  os << "template <typename Scalar>\nvoid Deviation([[maybe_unused]] const std::array<Scalar, "
+        "kNumAxes>& axes,\n"
+        "               [[maybe_unused]] const std::array<Scalar, kNumErrors>& errors,\n"
+        "               [[maybe_unused]] const std::array<Scalar, kNumParams>& params,\n"
+        "               std::array<Scalar, 3>* const position,\n"
+        "               std::array<Scalar, 3>* const orientation = nullptr) {\n"
+        "  using std::cos;\n  using std::sin;\n  using std::sqrt;\n"
+     << dev.body << "}\n\n";
+  os << "// First-order coefficients d(output)/d(error) at zero error, row-major [output][error]:\n"
+        "// position_coeff rows dx, dy, dz (mm per base unit of the error), orientation_coeff "
+        "rows\n"
+        "// da, db, dc (rad per base unit).\n";
+  os << "template <typename Scalar>\nvoid Coefficients([[maybe_unused]] const std::array<Scalar, "
+        "kNumAxes>& axes,\n"
+        "                  [[maybe_unused]] const std::array<Scalar, kNumParams>& params,\n"
+        "                  std::array<Scalar, 3 * kNumErrors>* const position_coeff,\n"
+        "                  std::array<Scalar, 3 * kNumErrors>* const orientation_coeff = nullptr) "
+        "{\n"
+        "  using std::cos;\n  using std::sin;\n  using std::sqrt;\n"
+     << coef.body << "}\n";
+  if (!higher.empty()) {
+    os << "\n// Coefficients of the monomials kHigherTerms in each output, row-major\n"
+          "// [output][term]: output = Coefficients·errors + Σ terms[o][k]·Π "
+          "errors[kHigherTerms[k]].\n";
+    os << "template <typename Scalar>\nvoid HigherOrder([[maybe_unused]] const std::array<Scalar, "
+          "kNumAxes>& axes,\n"
+          "                 [[maybe_unused]] const std::array<Scalar, kNumParams>& params,\n"
+          "                 std::array<Scalar, kNumOutputs * kNumHigherTerms>* const terms) {\n"
+          "  using std::cos;\n  using std::sin;\n  using std::sqrt;\n"
+       << high.body << "}\n";
+  }
+  os << "\n// Nominal pose (every error zero) of "
+     << (d.output ? "the output transform" : "the tool frame in the workpiece frame")
+     << ":\n// position of the " << (d.output ? "output" : "tool")
+     << " point in mm, rotation row-major (R[i][j] at 3i+j). Null outputs are skipped.\n";
+  os << "template <typename Scalar>\nvoid NominalPose([[maybe_unused]] const std::array<Scalar, "
+        "kNumAxes>& axes,\n"
+        "                 [[maybe_unused]] const std::array<Scalar, kNumParams>& params,\n"
+        "                 std::array<Scalar, 3>* const position,\n"
+        "                 std::array<Scalar, 9>* const rotation = nullptr) {\n"
+        "  using std::cos;\n  using std::sin;\n  using std::sqrt;\n"
+     << pose.body << "}\n";
+  os << "\n// Jacobian of the nominal pose with respect to the axes, row-major [output][axis]: "
+        "rows "
+        "dx, dy, dz\n"
+        "// (mm per axis unit: mm/mm, mm/deg) and da, db, dc (rad per axis unit), the rotation "
+        "rate\n"
+        "// vee(dR/dq R^T) as in Deviation's orientation. Columns in kAxes order.\n";
+  os << "template <typename Scalar>\nvoid NominalJacobian([[maybe_unused]] const "
+        "std::array<Scalar, kNumAxes>& axes,\n"
+        "                     [[maybe_unused]] const std::array<Scalar, kNumParams>& params,\n"
+        "                     std::array<Scalar, 6 * kNumAxes>* const jacobian) {\n"
+        "  using std::cos;\n  using std::sin;\n  using std::sqrt;\n"
+     << jacobian.body << "}\n\n";
+  os << compensation_code(m.axes_turn_output());
+  os << "\n}  // namespace " << d.name << "\n}  // namespace weilgen_models\n";
+  return os.str();
+}
+
+}  // namespace weilgen::gen

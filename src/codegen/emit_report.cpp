@@ -1,0 +1,315 @@
+#include "weilgen/codegen/emit_report.hpp"
+
+#include <sstream>
+
+#include "weilgen/base/version.hpp"
+#include "weilgen/codegen/printer.hpp"
+
+namespace weilgen::gen {
+
+using GiNaC::ex;
+
+namespace {
+
+std::string latex_name(const std::string& n) {
+  // E_XX -> E_{XX}; other underscores escaped.
+  const auto u = n.find('_');
+  if (u == std::string::npos) return n;
+  std::string head = n.substr(0, u), tail = n.substr(u + 1);
+  std::string esc;
+  for (char c : tail) esc += (c == '_') ? std::string("\\_") : std::string(1, c);
+  return head + "_{" + esc + "}";
+}
+
+// Display name and sign of error i in the chosen notation.
+std::pair<std::string, int> display(const SymbolicModel& m, std::size_t i, Notation n,
+                                    FormStyle style) {
+  const ErrorDef& e = m.desc.errors[i];
+  if (n == Notation::Alias && !e.aliases.empty()) {
+    const Alias& a = e.aliases.front();
+    return {a.name, a.sign};
+  }
+  return {style == FormStyle::Latex ? latex_name(e.name) : e.name, 1};
+}
+
+std::string join_term(const std::string& acc, ex coeff, const std::string& name, ExprPrinter& pr,
+                      FormStyle style) {
+  const std::string times = style == FormStyle::Latex ? "\\," : "·";
+  bool negative = false;
+  std::string c;
+  if (GiNaC::is_a<GiNaC::add>(coeff)) {
+    // -(a + b)·E reads better than (-a - b)·E: factor out the sign of a mostly negative sum.
+    std::size_t negatives = 0;
+    for (std::size_t i = 0; i < coeff.nops(); ++i) negatives += pr.print(coeff.op(i))[0] == '-';
+    if (2 * negatives > coeff.nops()) {
+      negative = true;
+      coeff = (-coeff).expand();
+    }
+    c = (style == FormStyle::Latex ? "\\left(" : "(") + pr.print(coeff) +
+        (style == FormStyle::Latex ? "\\right)" : ")");
+  } else {
+    c = pr.print(coeff);
+    if (!c.empty() && c[0] == '-') {
+      negative = true;
+      c.erase(0, 1);
+    }
+  }
+  std::string t = (c == "1") ? name : c + times + name;
+  if (acc.empty()) return negative ? "-" + t : t;
+  return acc + (negative ? " - " : " + ") + t;
+}
+
+std::map<std::string, std::string> symbol_names(const SymbolicModel& m, FormStyle style) {
+  std::map<std::string, std::string> names;
+  if (style != FormStyle::Latex) return names;
+  for (const auto& a : m.axes) {
+    if (!a.revolute) continue;
+    names[a.cos.get_name()] = "\\cos " + a.coordinate.get_name();
+    names[a.sin.get_name()] = "\\sin " + a.coordinate.get_name();
+  }
+  for (const auto& p : m.params) names[p.get_name()] = latex_name(p.get_name());
+  return names;
+}
+
+// Common factors pulled out for reading: cos(c)·z - cos(c)·L -> cos(c)·(z - L).
+ex readable(const ex& c) { return GiNaC::collect_common_factors(c); }
+
+}  // namespace
+
+std::string closed_form(const SymbolicModel& m, int o, FormStyle style, Notation notation) {
+  ExprPrinter pr(style == FormStyle::Latex ? ExprPrinter::Style::Latex : ExprPrinter::Style::Text,
+                 symbol_names(m, style));
+  std::string s;
+  for (std::size_t i = 0; i < m.errors.size(); ++i) {
+    const ex c = m.with_divisors(m.coefficient(o, {static_cast<std::uint16_t>(i)}));
+    if (c.is_zero()) continue;
+    const auto [name, sign] = display(m, i, notation, style);
+    s = join_term(s, readable((c * sign).expand()), name, pr, style);
+  }
+  for (const auto& mono : m.higher_monomials()) {
+    const ex c = m.with_divisors(m.coefficient(o, mono));
+    if (c.is_zero()) continue;
+    std::string name;
+    int sign = 1;
+    for (auto i : mono) {
+      const auto [n, sg] = display(m, i, notation, style);
+      name += (name.empty() ? "" : (style == FormStyle::Latex ? "\\," : "·")) + n;
+      sign *= sg;
+    }
+    s = join_term(s, readable((c * sign).expand()), name, pr, style);
+  }
+  const std::string lhs = style == FormStyle::Latex
+                              ? std::string("\\delta_{") + (kOutputNames[o] + 1) + "}"
+                              : kOutputNames[o];
+  return lhs + " = " + (s.empty() ? "0" : s);
+}
+
+nlohmann::json closed_forms_json(const SymbolicModel& m, Notation notation) {
+  nlohmann::json j;
+  j["machine"] = m.desc.name;
+  j["order"] = m.order;
+  j["notation"] = notation == Notation::Iso ? "iso" : "alias";
+  ExprPrinter pr(ExprPrinter::Style::Text);
+  for (int o = 0; o < kNumOutputs; ++o) {
+    nlohmann::json out;
+    out["unit"] = kOutputUnits[o];
+    out["closed_form"] = closed_form(m, o, FormStyle::Text, notation);
+    out["latex"] = closed_form(m, o, FormStyle::Latex, notation);
+    nlohmann::json lin = nlohmann::json::object();
+    for (std::size_t i = 0; i < m.errors.size(); ++i) {
+      const ex c = m.with_divisors(m.coefficient(o, {static_cast<std::uint16_t>(i)}));
+      if (c.is_zero()) continue;
+      const auto [name, sign] = display(m, i, notation, FormStyle::Text);
+      lin[name] = pr.print((c * sign).expand());
+    }
+    out["linear"] = lin;
+    nlohmann::json hi = nlohmann::json::array();
+    for (const auto& mono : m.higher_monomials()) {
+      const ex c = m.with_divisors(m.coefficient(o, mono));
+      if (c.is_zero()) continue;
+      nlohmann::json names = nlohmann::json::array();
+      int sign = 1;
+      for (auto i : mono) {
+        const auto [n, sg] = display(m, i, notation, FormStyle::Text);
+        names.push_back(n);
+        sign *= sg;
+      }
+      hi.push_back({{"monomial", names}, {"coefficient", pr.print((c * sign).expand())}});
+    }
+    out["higher"] = hi;
+    j["outputs"][kOutputNames[o]] = out;
+  }
+  return j;
+}
+
+std::string emit_report_markdown(const SymbolicModel& m, const std::string& source_label) {
+  const Description& d = m.desc;
+  std::ostringstream os;
+  os << "<!-- GENERATED by weilgen " << kVersion << " from " << source_label
+     << ". Do not edit: edit the machine file and run `weilgen generate`. -->\n\n";
+  os << "# " << d.name << (d.title.empty() ? "" : " — " + d.title) << "\n\n";
+  os << "Closed-form error model generated from `" << source_label << "`.\n\n";
+  os << "- Algebra: R[e_1..e_" << d.errors.size() << "] / I, I = ⟨all monomials of degree "
+     << m.order + 1 << "⟩";
+  if (!m.relations.empty()) {
+    os << " + ⟨";
+    for (std::size_t k = 0; k < m.relations.size(); ++k)
+      os << (k ? ", " : "") << m.monomial_name(m.relations[k]);
+    os << "⟩";
+  }
+  os << " (order " << m.order << (m.order == 1 ? ": dual numbers" : "") << ").\n";
+  if (d.output) {
+    os << "- Outputs: deviation of the output transform's point"
+       << (d.output->description.empty() ? "" : " (" + d.output->description + ")")
+       << ": dx, dy, dz in mm; da, db, dc in rad (see \"Derived quantities\"). Errors in base "
+          "units (mm, rad).\n";
+  } else {
+    os << "- Outputs: tool point relative to the workpiece, in the workpiece frame: dx, dy, dz in "
+          "mm; da, db, dc in rad. Errors in base units (mm, rad).\n";
+  }
+  os << "- Coordinates print in lower case (`X` → `x`); revolute coordinates appear as "
+        "`cos(c)`, `sin(c)` of the angle.\n\n";
+
+  os << "## Closed forms\n\n```text\n";
+  for (int o = 0; o < kNumOutputs; ++o)
+    os << closed_form(m, o, FormStyle::Text, Notation::Iso) << "\n";
+  os << "```\n\n";
+  bool has_alias = false;
+  for (const auto& e : d.errors) has_alias |= !e.aliases.empty();
+  if (has_alias) {
+    os << "### In the source's notation (first alias of each error)\n\n```text\n";
+    for (int o = 0; o < kNumOutputs; ++o)
+      os << closed_form(m, o, FormStyle::Text, Notation::Alias) << "\n";
+    os << "```\n\n";
+  }
+
+  os << "## First-order coefficients ∂output/∂error\n\n| error | dx | dy | dz | da | db | dc |\n"
+        "| --- | --- | --- | --- | --- | --- | --- |\n";
+  ExprPrinter pr(ExprPrinter::Style::Text);
+  for (std::size_t i = 0; i < d.errors.size(); ++i) {
+    os << "| " << d.errors[i].name;
+    for (int o = 0; o < kNumOutputs; ++o) {
+      const ex c = m.with_divisors(m.coefficient(o, {static_cast<std::uint16_t>(i)}));
+      os << " | " << (c.is_zero() ? "·" : pr.print(c));
+    }
+    os << " |\n";
+  }
+
+  os << "\n## Nominal kinematics (NominalPose, NominalJacobian, Compensate)\n\n"
+     << "Nominal pose at zero errors: position of the " << (d.output ? "output" : "tool")
+     << " point in mm.\n\n```text\n";
+  for (int i = 0; i < 3; ++i)
+    os << kOutputNames[i][1] << "0 = " << pr.print(m.with_divisors(m.nominal[i][3])) << "\n";
+  os << "```\n\nJacobian of the nominal pose per mm (prismatic) or per rad (revolute); the "
+        "header's `NominalJacobian` is per axis unit (a column per deg is this times π/180). "
+        "Orientation rows are the rotation rate vee(∂R/∂q·Rᵀ).\n\n"
+        "| axis | dx | dy | dz | da | db | dc |\n| --- | --- | --- | --- | --- | --- | --- |\n";
+  const std::size_t na = m.axes.size();
+  std::vector<std::string> idle;
+  for (std::size_t k = 0; k < na; ++k) {
+    const std::string& name = d.bodies[m.axes[k].body].joint.coordinate;
+    os << "| " << name;
+    bool moves = false;
+    for (int o = 0; o < kNumOutputs; ++o) {
+      const ex c = m.with_divisors(m.nominal_jacobian[o * na + k]);
+      moves |= !c.is_zero();
+      os << " | " << (c.is_zero() ? "·" : pr.print(c));
+    }
+    os << " |\n";
+    if (!moves) idle.push_back(name);
+  }
+  os << "\n`Compensate` (docs/compensation.md) solves in least squares over the position rows"
+     << (m.axes_turn_output()
+             ? std::string(" and the orientation rows: the tilt of the tool axis (z) "
+                           "weighted by kCompensationLengthMm, the spin about it by "
+                           "kCompensationSpinWeight of that")
+             : std::string(" (no axis turns the ") + (d.output ? "output frame" : "tool") +
+                   ": orientation is not compensated)")
+     << ".";
+  if (!idle.empty()) {
+    os << " The nominal pose does not depend on ";
+    for (std::size_t i = 0; i < idle.size(); ++i)
+      os << (i == 0 ? "" : i + 1 == idle.size() ? " and " : ", ") << idle[i];
+    os << ": the least-squares problem is singular and `Compensate` returns -1.";
+  }
+  os << "\n";
+
+  os << "\n## Errors\n\n| name | aliases | body | group | placement | PIGE/PDGE | unit | "
+        "distribution |\n| --- | --- | --- | --- | --- | --- | --- | --- |\n";
+  for (const auto& e : d.errors) {
+    std::string al;
+    for (const auto& a : e.aliases)
+      al += (al.empty() ? "" : ", ") + std::string(a.sign < 0 ? "−" : "") + a.name;
+    const char* pl = e.placement == ErrorPlacement::After
+                         ? "after"
+                         : (e.placement == ErrorPlacement::Before ? "before" : "axis");
+    os << "| " << e.name << " | " << al << " | " << d.bodies[e.body].name << " | " << e.group
+       << " | " << pl << " | " << (e.dependence == Dependence::PDGE ? "PDGE" : "PIGE") << " | "
+       << e.unit << " | " << e.distribution.str() << " |\n";
+  }
+  os << "\n## Axes\n\n| coordinate | body | type | axis | twist ξ = (ω, v) | unit | range |\n"
+        "| --- | --- | --- | --- | --- | --- | --- |\n";
+  for (std::size_t b = 0; b < d.bodies.size(); ++b) {
+    const Joint& j = d.bodies[b].joint;
+    if (j.type == JointType::Fixed) continue;
+    const bool revolute = j.type == JointType::Revolute;
+    std::string axis = "[" + format_double(j.axis[0]) + ", " + format_double(j.axis[1]) + ", " +
+                       format_double(j.axis[2]) + "]";
+    if (revolute &&
+        !(j.through[0].is_number() && j.through[0].number == 0 && j.through[1].is_number() &&
+          j.through[1].number == 0 && j.through[2].is_number() && j.through[2].number == 0)) {
+      axis += " through [" + j.through[0].str() + ", " + j.through[1].str() + ", " +
+              j.through[2].str() + "]";
+    }
+    os << "| " << j.coordinate << " | " << d.bodies[b].name << " | "
+       << (revolute ? "revolute" : "prismatic") << " | " << axis << " | "
+       << (j.twist.empty() ? "·" : j.twist) << " | " << j.unit << " | "
+       << (j.link ? "linked: " + j.coordinate + " = " + j.link->str()
+                  : format_double(j.min) + " … " + format_double(j.max))
+       << " |\n";
+  }
+  if (!d.points.empty() || !d.derived.empty() || d.output) {
+    os << "\n## Derived quantities\n\n";
+    if (!d.points.empty()) {
+      os << "Chain points (deviation P(e) − P(0) in the base frame, mm; `name.x` …):\n\n"
+            "| point | body | point in the body (mm) |\n| --- | --- | --- |\n";
+      for (const ChainPoint& p : d.points)
+        os << "| " << p.name << " | " << d.bodies[p.at.body].name << " | [" << p.at.point[0].str()
+           << ", " << p.at.point[1].str() << ", " << p.at.point[2].str() << "] |\n";
+      os << "\n";
+    }
+    if (!d.derived.empty()) {
+      os << "Derived quantities, in evaluation order:\n\n```text\n";
+      for (const Derived& q : d.derived)
+        os << q.name << " = " << q.value.str()
+           << (q.description.empty() ? "" : "    # " + q.description) << "\n";
+      os << "```\n\n";
+    }
+    if (d.output) {
+      os << "Output transform P = ";
+      for (const TransformStep& st : d.output->steps) {
+        if (st.kind == TransformStep::Kind::Translate) {
+          os << "Trans(" << st.translation[0].str() << ", " << st.translation[1].str() << ", "
+             << st.translation[2].str() << ") · ";
+        } else {
+          os << "exp(ξ^·" << st.amount.str() << ") [ξ = (" << format_double(st.omega[0]) << ", "
+             << format_double(st.omega[1]) << ", " << format_double(st.omega[2]) << ", "
+             << st.v[0].str() << ", " << st.v[1].str() << ", " << st.v[2].str() << ")] · ";
+        }
+      }
+      os << "Trans(" << d.output->point[0].str() << ", " << d.output->point[1].str() << ", "
+         << d.output->point[2].str() << ")\n";
+    }
+  }
+  if (!d.parameters.empty()) {
+    os << "\n## Parameters\n\n| name | default | unit | description |\n| --- | --- | --- | --- |\n";
+    const auto defaults = d.parameter_defaults();
+    for (const auto& p : d.parameters)
+      os << "| " << p.name << " | " << format_double(defaults.at(p.name)) << " | " << p.unit
+         << " | " << p.description << " |\n";
+  }
+  if (!d.notes.empty()) os << "\n## Notes\n\n" << d.notes << (d.notes.back() == '\n' ? "" : "\n");
+  return os.str();
+}
+
+}  // namespace weilgen::gen

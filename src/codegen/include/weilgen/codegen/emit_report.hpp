@@ -1,0 +1,19 @@
+// Human-readable closed forms: the Markdown report (generated/<machine>.md) and `weilgen show`.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "weilgen/codegen/model_builder.hpp"
+
+namespace weilgen::gen {
+
+enum class Notation { Iso, Alias };  // error names as in ISO 230-1 or as the file's first alias
+enum class FormStyle { Text, Latex };
+
+// "dx = -E_XX - z·E_BX + y·E_CX + ..." grouped by error in declaration order, then higher terms.
+std::string closed_form(const SymbolicModel& m, int output, FormStyle style, Notation notation);
+nlohmann::json closed_forms_json(const SymbolicModel& m, Notation notation);
+std::string emit_report_markdown(const SymbolicModel& m, const std::string& source_label);
+
+}  // namespace weilgen::gen

@@ -1,0 +1,44 @@
+// Prints GiNaC expressions as C++ (templated Scalar), readable text or LaTeX, with operands in
+// canonical order (so output does not depend on GiNaC's hash order) and operation counts.
+#pragma once
+
+#include <ginac/ginac.h>
+
+#include <map>
+#include <string>
+
+#include "weilgen/codegen/cse.hpp"
+
+namespace weilgen::gen {
+
+// Shortest decimal text that reads back as the same double ("0.1", "1e-06", "2.0").
+std::string format_double(double v);
+
+struct OpCount {
+  long adds = 0, muls = 0, divs = 0, functions = 0;
+  long total() const { return adds + muls + divs + functions; }
+  OpCount& operator+=(const OpCount& o);
+  std::string str() const;  // "123 (adds 60, muls 60, divs 0, functions 3)"
+};
+
+class ExprPrinter {
+ public:
+  enum class Style { Cpp, Text, Latex };
+  // `names` maps symbol names to the text printed for them (others print as their name).
+  ExprPrinter(Style style, std::map<std::string, std::string> names = {});
+  std::string print(const GiNaC::ex& e);
+  const OpCount& ops() const { return ops_; }
+  void reset_ops() { ops_ = {}; }
+
+ private:
+  std::string term(const GiNaC::ex& e, bool& negative);  // one summand, sign split off
+  std::string factor(const GiNaC::ex& e);                // operand of a product
+  std::string number(const GiNaC::numeric& n);
+  std::string symbol(const GiNaC::ex& e);
+  Style style_;
+  std::map<std::string, std::string> names_;
+  CanonicalText canon_;
+  OpCount ops_;
+};
+
+}  // namespace weilgen::gen

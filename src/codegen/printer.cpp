@@ -1,0 +1,226 @@
+#include "weilgen/codegen/printer.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <stdexcept>
+
+namespace weilgen::gen {
+
+using GiNaC::ex;
+
+OpCount& OpCount::operator+=(const OpCount& o) {
+  adds += o.adds;
+  muls += o.muls;
+  divs += o.divs;
+  functions += o.functions;
+  return *this;
+}
+
+std::string OpCount::str() const {
+  return std::to_string(total()) + " (adds " + std::to_string(adds) + ", muls " +
+         std::to_string(muls) + ", divs " + std::to_string(divs) + ", functions " +
+         std::to_string(functions) + ")";
+}
+
+ExprPrinter::ExprPrinter(Style style, std::map<std::string, std::string> names)
+    : style_(style), names_(std::move(names)) {}
+
+namespace {
+bool has_symbol(const ex& e) {
+  if (GiNaC::is_a<GiNaC::symbol>(e)) return true;
+  for (std::size_t i = 0; i < e.nops(); ++i)
+    if (has_symbol(e.op(i))) return true;
+  return false;
+}
+}  // namespace
+
+std::string format_double(double v) {
+  char buf[40];
+  for (int p = 1; p <= 17; ++p) {
+    std::snprintf(buf, sizeof buf, "%.*g", p, v);
+    if (std::strtod(buf, nullptr) == v) break;
+  }
+  std::string s(buf);
+  if (s.find_first_of(".en") == std::string::npos) s += ".0";
+  return s;
+}
+
+namespace {
+std::string text(const GiNaC::numeric& n) {
+  std::ostringstream os;
+  os << n;
+  return os.str();
+}
+}  // namespace
+
+std::string ExprPrinter::number(const GiNaC::numeric& n) {
+  if (style_ == Style::Cpp) {
+    if (n.is_integer()) return "Scalar(" + text(n) + ")";
+    return "Scalar(" + format_double(n.to_double()) + ")";
+  }
+  if (n.is_integer()) return text(n);
+  if (n.is_rational() && n.denom() < 1000) {
+    if (style_ == Style::Latex) return "\\frac{" + text(n.numer()) + "}{" + text(n.denom()) + "}";
+    return text(n.numer()) + "/" + text(n.denom());
+  }
+  return format_double(n.to_double());
+}
+
+std::string ExprPrinter::symbol(const ex& e) {
+  std::string n = GiNaC::ex_to<GiNaC::symbol>(e).get_name();
+  auto it = names_.find(n);
+  return it == names_.end() ? n : it->second;
+}
+
+std::string ExprPrinter::print(const ex& e) {
+  if (GiNaC::is_a<GiNaC::add>(e)) {
+    // Canonical order, positive terms first: "(tool_length - z)" rather than "(-z + tool_length)".
+    std::vector<std::pair<bool, std::string>> terms;  // (negative, text without the sign)
+    for (const ex& op : canon_.sorted_ops(e)) {
+      bool neg = false;
+      std::string t = term(op, neg);
+      terms.emplace_back(neg, std::move(t));
+    }
+    std::stable_partition(terms.begin(), terms.end(), [](const auto& t) { return !t.first; });
+    std::string s = terms.front().first ? "-" + terms.front().second : terms.front().second;
+    for (std::size_t i = 1; i < terms.size(); ++i) {
+      s += terms[i].first ? " - " : " + ";
+      s += terms[i].second;
+      ++ops_.adds;
+    }
+    return s;
+  }
+  bool neg = false;
+  std::string t = term(e, neg);
+  return neg ? "-" + t : t;
+}
+
+std::string ExprPrinter::term(const ex& e, bool& negative) {
+  negative = false;
+  if (GiNaC::is_a<GiNaC::numeric>(e)) {
+    GiNaC::numeric n = GiNaC::ex_to<GiNaC::numeric>(e);
+    if (n.is_negative()) {
+      negative = true;
+      n = -n;
+    }
+    return number(n);
+  }
+  const bool divisor = GiNaC::is_a<GiNaC::power>(e) && GiNaC::is_a<GiNaC::numeric>(e.op(1)) &&
+                       GiNaC::ex_to<GiNaC::numeric>(e.op(1)).is_negative();
+  if (!GiNaC::is_a<GiNaC::mul>(e) && !divisor) return factor(e);
+  GiNaC::numeric coeff = 1;
+  std::vector<std::string> num, den;
+  for (const ex& op : divisor ? std::vector<ex>{e} : canon_.sorted_ops(e)) {
+    if (GiNaC::is_a<GiNaC::numeric>(op)) {
+      coeff *= GiNaC::ex_to<GiNaC::numeric>(op);
+    } else if (GiNaC::is_a<GiNaC::power>(op) && GiNaC::is_a<GiNaC::numeric>(op.op(1)) &&
+               GiNaC::ex_to<GiNaC::numeric>(op.op(1)).is_negative()) {
+      ex base = op.op(0);
+      if (GiNaC::is_a<GiNaC::add>(base)) {  // the divisor's sign as CanonicalText chooses it
+        const CanonicalText::Signed r = canon_.canonical_sign(base);
+        if (r.negated && GiNaC::ex_to<GiNaC::numeric>(op.op(1)).is_odd()) coeff = -coeff;
+        base = r.value;
+      }
+      den.push_back(factor(GiNaC::pow(base, -op.op(1))));
+    } else if (GiNaC::is_a<GiNaC::add>(op)) {
+      const CanonicalText::Signed r = canon_.canonical_sign(op);
+      if (r.negated) coeff = -coeff;
+      num.push_back(factor(r.value));
+    } else {
+      num.push_back(factor(op));
+    }
+  }
+  if (coeff.is_negative()) {
+    negative = true;
+    coeff = -coeff;
+  }
+  const std::string times = style_ == Style::Cpp ? " * " : (style_ == Style::Text ? "·" : " ");
+  std::string s;
+  if (!coeff.is_equal(1) || num.empty()) {
+    s = number(coeff);
+    if (!num.empty()) ++ops_.muls;
+  }
+  for (std::size_t i = 0; i < num.size(); ++i) {
+    if (!s.empty()) s += times;
+    if (i > 0) ++ops_.muls;
+    s += num[i];
+  }
+  if (!den.empty()) {
+    std::string d;
+    for (std::size_t i = 0; i < den.size(); ++i) {
+      d += (i ? times : "") + den[i];
+      if (i > 0) ++ops_.muls;
+    }
+    ++ops_.divs;
+    if (style_ == Style::Latex) return "\\frac{" + s + "}{" + d + "}";
+    s += " / " + (den.size() > 1 ? "(" + d + ")" : d);
+  }
+  return s;
+}
+
+std::string ExprPrinter::factor(const ex& e) {
+  if (GiNaC::is_a<GiNaC::symbol>(e)) return symbol(e);
+  if (!has_symbol(e)) {  // constants such as cos(Pi/9) or sqrt(2)
+    const ex v = e.evalf();
+    if (GiNaC::is_a<GiNaC::numeric>(v)) {
+      const GiNaC::numeric n = GiNaC::ex_to<GiNaC::numeric>(v);
+      std::string s =
+          style_ == Style::Cpp
+              ? "Scalar(" + format_double(n.to_double()) + ")"
+              : (GiNaC::is_a<GiNaC::numeric>(e) ? number(n) : format_double(n.to_double()));
+      return n.is_negative() ? "(" + s + ")" : s;
+    }
+  }
+  if (GiNaC::is_a<GiNaC::add>(e)) {
+    std::string s = print(e);
+    return style_ == Style::Latex ? "\\left(" + s + "\\right)" : "(" + s + ")";
+  }
+  if (GiNaC::is_a<GiNaC::mul>(e)) {
+    bool neg = false;
+    std::string s = term(e, neg);
+    return neg ? "(-" + s + ")" : s;
+  }
+  if (GiNaC::is_a<GiNaC::power>(e)) {
+    const ex base = e.op(0), expo = e.op(1);
+    if (GiNaC::is_a<GiNaC::numeric>(expo) && GiNaC::ex_to<GiNaC::numeric>(expo).is_pos_integer()) {
+      const long n = GiNaC::ex_to<GiNaC::numeric>(expo).to_long();
+      const std::string b = factor(base);
+      if (style_ != Style::Cpp)
+        return b + (style_ == Style::Latex ? "^{" : "^") + std::to_string(n) +
+               (style_ == Style::Latex ? "}" : "");
+      std::string s = b;
+      for (long i = 1; i < n; ++i) {
+        s += " * " + b;
+        ++ops_.muls;
+      }
+      return "(" + s + ")";
+    }
+    if (GiNaC::is_a<GiNaC::numeric>(expo) && GiNaC::ex_to<GiNaC::numeric>(expo).is_integer() &&
+        GiNaC::ex_to<GiNaC::numeric>(expo).is_negative()) {
+      // A divisor (derived ratios): 1 / b^n.
+      ++ops_.divs;
+      const std::string den = factor(GiNaC::pow(base, -expo));
+      if (style_ == Style::Latex) return "\\frac{1}{" + den + "}";
+      return (style_ == Style::Cpp ? "Scalar(1) / " : "1 / ") + den;
+    }
+    if (expo.is_equal(GiNaC::numeric(1, 2))) {
+      ++ops_.functions;
+      return (style_ == Style::Cpp ? "sqrt(" : "\\sqrt{") + print(base) +
+             (style_ == Style::Cpp ? ")" : "}");
+    }
+    ++ops_.functions;
+    return "pow(" + print(base) + ", " + print(expo) + ")";
+  }
+  if (GiNaC::is_a<GiNaC::function>(e)) {
+    const std::string name = GiNaC::ex_to<GiNaC::function>(e).get_name();
+    if (name != "sin" && name != "cos" && name != "tan" && name != "exp" && name != "log")
+      throw std::runtime_error("cannot print function " + name);
+    ++ops_.functions;
+    return name + "(" + print(e.op(0)) + ")";
+  }
+  std::ostringstream os;
+  os << e;
+  return os.str();
+}
+
+}  // namespace weilgen::gen

@@ -1,0 +1,278 @@
+#include "weilgen/codegen/weil.hpp"
+
+#include <algorithm>
+
+namespace weilgen::gen {
+
+using GiNaC::ex;
+
+Monomial monomial_product(const Monomial& a, const Monomial& b) {
+  Monomial out;
+  out.reserve(a.size() + b.size());
+  std::merge(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(out));
+  return out;
+}
+
+bool divides(const Monomial& divisor, const Monomial& m) {
+  return std::includes(m.begin(), m.end(), divisor.begin(), divisor.end());
+}
+
+Algebra::Algebra(int order, std::vector<Monomial> relations, GiNaC::exmap trig_rules)
+    : order_(order), trig_rules_(std::move(trig_rules)) {
+  // Keep only minimal generators: drop those of degree > r (already vanish) and multiples.
+  for (auto& r : relations) std::sort(r.begin(), r.end());
+  std::sort(relations.begin(), relations.end(), [](const Monomial& a, const Monomial& b) {
+    return a.size() != b.size() ? a.size() < b.size() : a < b;
+  });
+  for (const auto& r : relations) {
+    if (static_cast<int>(r.size()) > order_) continue;
+    bool redundant = std::any_of(relations_.begin(), relations_.end(),
+                                 [&](const Monomial& g) { return divides(g, r); });
+    if (!redundant) relations_.push_back(r);
+  }
+}
+
+bool Algebra::vanishes(const Monomial& m) const {
+  if (static_cast<int>(m.size()) > order_) return true;
+  return std::any_of(relations_.begin(), relations_.end(),
+                     [&](const Monomial& g) { return divides(g, m); });
+}
+
+ex Algebra::normalize(const ex& c) const {
+  ex e = c.expand();
+  if (trig_rules_.empty()) return e;
+  // Repeat: one algebraic pass lowers cos^n to cos^(n-2)·(1 − sin²).
+  for (int pass = 0; pass < 8; ++pass) {
+    ex reduced = e.subs(trig_rules_, GiNaC::subs_options::algebraic).expand();
+    if (reduced.is_equal(e)) break;
+    e = reduced;
+  }
+  return e;
+}
+
+Poly::Poly(const ex& constant) { add_term({}, constant); }
+
+Poly Poly::error(std::uint16_t index) {
+  Poly p;
+  p.terms_[{index}] = 1;
+  return p;
+}
+
+void Poly::add_term(const Monomial& m, const ex& c) {
+  if (c.is_zero()) return;
+  auto it = terms_.find(m);
+  if (it == terms_.end()) {
+    terms_.emplace(m, c);
+    return;
+  }
+  it->second = (it->second + c).expand();
+  if (it->second.is_zero()) terms_.erase(it);
+}
+
+ex Poly::constant() const {
+  auto it = terms_.find(Monomial{});
+  return it == terms_.end() ? ex(0) : it->second;
+}
+
+Poly Poly::without_constant() const {
+  Poly p = *this;
+  p.terms_.erase(Monomial{});
+  return p;
+}
+
+int Poly::min_degree() const {
+  int d = 0;
+  bool first = true;
+  for (const auto& [m, c] : terms_) {
+    if (first || static_cast<int>(m.size()) < d) d = static_cast<int>(m.size());
+    first = false;
+  }
+  return d;
+}
+
+Poly Poly::operator+(const Poly& o) const {
+  Poly p = *this;
+  for (const auto& [m, c] : o.terms_) p.add_term(m, c);
+  return p;
+}
+
+Poly Poly::operator-(const Poly& o) const { return *this + (-o); }
+
+Poly Poly::operator-() const {
+  Poly p;
+  for (const auto& [m, c] : terms_) p.terms_.emplace(m, (-c).expand());
+  return p;
+}
+
+Poly Poly::scaled(const ex& c, const Algebra& alg) const {
+  Poly p;
+  for (const auto& [m, t] : terms_) p.add_term(m, alg.normalize(t * c));
+  return p;
+}
+
+Poly Poly::mul(const Poly& o, const Algebra& alg) const {
+  if (is_zero() || o.is_zero()) return {};
+  // Sum raw products per monomial, normalise each sum once.
+  std::map<Monomial, GiNaC::exvector> raw;
+  for (const auto& [ma, ca] : terms_) {
+    for (const auto& [mb, cb] : o.terms_) {
+      if (static_cast<int>(ma.size() + mb.size()) > alg.order()) continue;
+      Monomial m = monomial_product(ma, mb);
+      if (alg.vanishes(m)) continue;  // never formed: truncation inside the product
+      raw[m].push_back(ca * cb);
+    }
+  }
+  Poly p;
+  for (auto& [m, parts] : raw) {
+    ex c = alg.normalize(GiNaC::add(parts));
+    if (!c.is_zero()) p.terms_.emplace(m, c);
+  }
+  return p;
+}
+
+ex Poly::to_ex(const std::vector<GiNaC::symbol>& error_symbols) const {
+  GiNaC::exvector parts;
+  for (const auto& [m, c] : terms_) {
+    ex t = c;
+    for (auto i : m) t *= error_symbols.at(i);
+    parts.push_back(t);
+  }
+  return GiNaC::add(parts);
+}
+
+Mat4 Mat4::identity() {
+  Mat4 r;
+  for (int i = 0; i < 4; ++i) r.m[i][i] = Poly(1);
+  return r;
+}
+
+Mat4 Mat4::zero() { return {}; }
+
+Mat4 Mat4::mul(const Mat4& o, const Algebra& alg) const {
+  Mat4 r;
+  for (int i = 0; i < 4; ++i) {
+    for (int j = 0; j < 4; ++j) {
+      Poly acc;
+      for (int k = 0; k < 4; ++k) {
+        if (m[i][k].is_zero() || o.m[k][j].is_zero()) continue;
+        acc = acc + m[i][k].mul(o.m[k][j], alg);
+      }
+      r.m[i][j] = acc;
+    }
+  }
+  return r;
+}
+
+Mat4 Mat4::operator+(const Mat4& o) const {
+  Mat4 r;
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) r.m[i][j] = m[i][j] + o.m[i][j];
+  return r;
+}
+
+Mat4 Mat4::operator-(const Mat4& o) const {
+  Mat4 r;
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) r.m[i][j] = m[i][j] - o.m[i][j];
+  return r;
+}
+
+Mat4 Mat4::constant_part() const {
+  Mat4 r;
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) r.m[i][j] = Poly(m[i][j].constant());
+  return r;
+}
+
+Mat4 Mat4::nilpotent_part() const {
+  Mat4 r;
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) r.m[i][j] = m[i][j].without_constant();
+  return r;
+}
+
+Mat4 rigid_inverse(const Mat4& nominal, const Algebra& alg) {
+  Mat4 r;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) r.m[i][j] = Poly(nominal.m[j][i].constant());
+  for (int i = 0; i < 3; ++i) {
+    ex t = 0;
+    for (int k = 0; k < 3; ++k) t -= nominal.m[k][i].constant() * nominal.m[k][3].constant();
+    r.m[i][3] = Poly(alg.normalize(t));
+  }
+  r.m[3][3] = Poly(1);
+  return r;
+}
+
+Mat4 neumann_inverse(const Mat4& m, const Algebra& alg) {
+  const Mat4 m0_inv = rigid_inverse(m.constant_part(), alg);
+  const Mat4 k = m0_inv.mul(m.nilpotent_part(), alg);
+  // Horner form of Σ_{j=0}^{r} (−K)^j: X ← I − K·X, r times.
+  Mat4 x = Mat4::identity();
+  for (int j = 0; j < alg.order(); ++j) x = Mat4::identity() - k.mul(x, alg);
+  return x.mul(m0_inv, alg);
+}
+
+Mat4 translation(const ex (&v)[3]) {
+  Mat4 r = Mat4::identity();
+  for (int i = 0; i < 3; ++i) r.m[i][3] = Poly(v[i]);
+  return r;
+}
+
+Mat4 translation_by(const Poly& amount, const ex (&u)[3], const Algebra& alg) {
+  Mat4 r = Mat4::identity();
+  for (int i = 0; i < 3; ++i) r.m[i][3] = amount.scaled(u[i], alg);
+  return r;
+}
+
+namespace {
+// [u]x and [u]x² as exact 3x3 coefficient matrices.
+void cross_matrices(const ex (&u)[3], ex (&k)[3][3], ex (&k2)[3][3]) {
+  const ex kk[3][3] = {{0, -u[2], u[1]}, {u[2], 0, -u[0]}, {-u[1], u[0], 0}};
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      k[i][j] = kk[i][j];
+      ex s = 0;
+      for (int l = 0; l < 3; ++l) s += kk[i][l] * kk[l][j];
+      k2[i][j] = s.expand();
+    }
+}
+}  // namespace
+
+Mat4 rotation_cs(const ex (&u)[3], const ex& c, const ex& s, const Algebra& alg) {
+  ex k[3][3], k2[3][3];
+  cross_matrices(u, k, k2);
+  Mat4 r = Mat4::identity();
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      ex e = (i == j ? ex(1) : ex(0)) + s * k[i][j] + (1 - c) * k2[i][j];
+      r.m[i][j] = Poly(alg.normalize(e));
+    }
+  return r;
+}
+
+Mat4 rotation_small(const ex (&u)[3], const Poly& angle, const Algebra& alg) {
+  // sin a = Σ_{k odd} (−1)^((k−1)/2) a^k / k!,  1 − cos a = Σ_{k even ≥ 2} (−1)^(k/2+1) a^k / k!
+  Poly sin_a, one_minus_cos;
+  Poly power = angle;
+  GiNaC::numeric factorial = 1;
+  for (int k = 1; k <= alg.order() && !power.is_zero(); ++k) {
+    factorial *= k;
+    const ex coeff = GiNaC::numeric(1) / factorial;
+    if (k % 2 == 1) {
+      sin_a = sin_a + power.scaled(((k - 1) / 2) % 2 == 0 ? coeff : -coeff, alg);
+    } else {
+      one_minus_cos = one_minus_cos + power.scaled((k / 2) % 2 == 1 ? coeff : -coeff, alg);
+    }
+    power = power.mul(angle, alg);
+  }
+  ex k[3][3], k2[3][3];
+  cross_matrices(u, k, k2);
+  Mat4 r = Mat4::identity();
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      r.m[i][j] = r.m[i][j] + sin_a.scaled(k[i][j], alg) + one_minus_cos.scaled(k2[i][j], alg);
+  return r;
+}
+
+}  // namespace weilgen::gen

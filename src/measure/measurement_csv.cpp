@@ -1,0 +1,307 @@
+#include "weilgen/measure/measurement_csv.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+
+#include "weilgen/base/atomic_file.hpp"
+
+namespace weilgen {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+bool is_ident_char(char c) {
+  return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_';
+}
+
+bool is_identifier(const std::string& s) {
+  return !s.empty() && std::all_of(s.begin(), s.end(), is_ident_char);
+}
+
+bool is_space(char c) { return c == ' ' || c == '\t'; }
+
+// [first, last) of s without surrounding blanks.
+std::pair<std::size_t, std::size_t> trimmed_range(const std::string& s, std::size_t first,
+                                                  std::size_t last) {
+  while (first < last && is_space(s[first])) ++first;
+  while (last > first && is_space(s[last - 1])) --last;
+  return {first, last};
+}
+
+std::string join_names(const std::vector<std::string>& v) {
+  std::string s;
+  for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
+  return s;
+}
+
+// One comma-separated field: its text (trimmed) and its 1-based character column.
+struct Field {
+  std::string text;
+  int column = 0;
+};
+
+std::vector<Field> split_fields(const std::string& line) {
+  std::vector<Field> out;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = line.find(',', start);
+    const std::size_t end = comma == std::string::npos ? line.size() : comma;
+    const auto [a, b] = trimmed_range(line, start, end);
+    out.push_back({line.substr(a, b - a), static_cast<int>((a < b ? a : start) + 1)});
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return out;
+}
+
+bool is_coordinate_name(const std::string& name, const ReadOptions& o) {
+  if (!o.coordinates.empty())
+    return std::find(o.coordinates.begin(), o.coordinates.end(), name) != o.coordinates.end();
+  return name.size() == 1 && name[0] >= 'A' && name[0] <= 'Z';
+}
+
+std::string coordinate_unit(const std::string& name) {
+  return name == "A" || name == "B" || name == "C" ? "deg" : "mm";
+}
+
+// Strict number: digits, sign, '.', exponent; rejects nan, inf, hex and overflow.
+bool parse_number(const std::string& text, double& value, std::string& why) {
+  if (text.find_first_not_of("0123456789+-.eE") != std::string::npos) {
+    why = "is not a number";
+    return false;
+  }
+  char* end = nullptr;
+  value = std::strtod(text.c_str(), &end);
+  if (end != text.c_str() + text.size() || text.empty()) {
+    why = "is not a number";
+    return false;
+  }
+  if (!std::isfinite(value)) {
+    why = "is out of range";
+    return false;
+  }
+  return true;
+}
+
+const char* kKnownRoles =
+    "coordinates (single upper-case letters such as X, Y, Z, A, C, or the machine's), t_s, dir, "
+    "dir_<axis>, cycle, T_<name>, covariates (rpm, feed_mm_min, cov_<name>), deviations "
+    "(dx_um, dy_um, dz_um, da_urad, db_urad, dc_urad), ballbar angle_deg and dr_um";
+
+}  // namespace
+
+const char* to_string(ColumnRole role) {
+  switch (role) {
+    case ColumnRole::Coordinate:
+      return "coordinate";
+    case ColumnRole::Time:
+      return "time";
+    case ColumnRole::Direction:
+      return "direction";
+    case ColumnRole::Cycle:
+      return "cycle";
+    case ColumnRole::Temperature:
+      return "temperature";
+    case ColumnRole::Covariate:
+      return "covariate";
+    case ColumnRole::Deviation:
+      return "deviation";
+    case ColumnRole::Angle:
+      return "angle";
+    case ColumnRole::Radial:
+      return "radial";
+    case ColumnRole::Unknown:
+      break;
+  }
+  return "unknown";
+}
+
+ColumnInfo classify_column(const std::string& name, const ReadOptions& o) {
+  ColumnInfo c;
+  c.name = name;
+  auto set = [&](ColumnRole role, std::string unit, std::string axis = "") {
+    c.role = role;
+    c.unit = std::move(unit);
+    c.axis = std::move(axis);
+    return c;
+  };
+  if (is_coordinate_name(name, o)) return set(ColumnRole::Coordinate, coordinate_unit(name));
+  if (name == "t_s") return set(ColumnRole::Time, "s");
+  if (name == "dir") return set(ColumnRole::Direction, "");
+  if (name.rfind("dir_", 0) == 0 && is_coordinate_name(name.substr(4), o))
+    return set(ColumnRole::Direction, "", name.substr(4));
+  if (name == "cycle") return set(ColumnRole::Cycle, "");
+  if (name.size() > 2 && name.rfind("T_", 0) == 0 && is_identifier(name.substr(2)))
+    return set(ColumnRole::Temperature, "degC");
+  if (name == "dx_um" || name == "dy_um" || name == "dz_um")
+    return set(ColumnRole::Deviation, "um");
+  if (name == "da_urad" || name == "db_urad" || name == "dc_urad")
+    return set(ColumnRole::Deviation, "urad");
+  if (name == "angle_deg") return set(ColumnRole::Angle, "deg");
+  if (name == "dr_um") return set(ColumnRole::Radial, "um");
+  if (std::find(o.expected.begin(), o.expected.end(), name) != o.expected.end())
+    return set(ColumnRole::Covariate, "");
+  if (name == "rpm") return set(ColumnRole::Covariate, "1/min");
+  if (name == "feed_mm_min") return set(ColumnRole::Covariate, "mm/min");
+  if (name.size() > 4 && name.rfind("cov_", 0) == 0 && is_identifier(name.substr(4)))
+    return set(ColumnRole::Covariate, "");
+  return set(ColumnRole::Unknown, "");
+}
+
+const std::vector<double>& MeasurementTable::column(const std::string& name) const {
+  const auto it = values.find(name);
+  if (it == values.end())
+    throw InputError(SourceLoc{file, 0, 0},
+                     "missing column '" + name + "' (columns: " + join_names(columns) + ")");
+  return it->second;
+}
+
+const ColumnInfo& MeasurementTable::info_of(const std::string& name) const {
+  for (std::size_t i = 0; i < columns.size(); ++i)
+    if (columns[i] == name) return info[i];
+  column(name);  // throws
+  throw InputError(SourceLoc{file, 0, 0}, "missing column '" + name + "'");
+}
+
+std::vector<std::string> MeasurementTable::columns_with(ColumnRole role) const {
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < columns.size(); ++i)
+    if (info[i].role == role) out.push_back(columns[i]);
+  return out;
+}
+
+std::string MeasurementTable::header_key(const std::string& key,
+                                         const std::string& fallback) const {
+  const auto it = header_keys.find(key);
+  return it == header_keys.end() ? fallback : it->second;
+}
+
+MeasurementTable parse_measurements(const std::string& text, const std::string& filename,
+                                    const ReadOptions& options) {
+  MeasurementTable t;
+  t.file = filename;
+  auto fail = [&](int line, int col, const std::string& msg) -> InputError {
+    return InputError(SourceLoc{filename, line, col}, msg);
+  };
+
+  std::size_t pos = 0;
+  if (text.compare(0, 3, "\xEF\xBB\xBF") == 0) pos = 3;  // UTF-8 byte-order mark
+  int line_no = 0;
+  bool header_seen = false;
+  while (pos < text.size()) {
+    std::size_t nl = text.find('\n', pos);
+    if (nl == std::string::npos) nl = text.size();
+    std::string line = text.substr(pos, nl - pos);
+    pos = nl + 1;
+    ++line_no;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    const auto [a, b] = trimmed_range(line, 0, line.size());
+    if (a == b) continue;  // blank line
+    if (line[a] == '#') {
+      if (header_seen) continue;
+      // "# key: value" before the header.
+      const std::string body = line.substr(a + 1, b - a - 1);
+      const std::size_t colon = body.find(':');
+      if (colon == std::string::npos) continue;
+      const auto [ka, kb] = trimmed_range(body, 0, colon);
+      const std::string key = body.substr(ka, kb - ka);
+      bool ok = !key.empty();
+      for (char ch : key) ok = ok && (is_ident_char(ch) || ch == '-' || ch == '.');
+      if (!ok) continue;  // a plain comment
+      const auto [va, vb] = trimmed_range(body, colon + 1, body.size());
+      if (t.header_keys.count(key))
+        throw fail(line_no, static_cast<int>(a + 2 + ka),
+                   "header key '" + key + "' given twice (first at line " +
+                       std::to_string(t.header_key_lines[key]) + ")");
+      t.header_keys[key] = body.substr(va, vb - va);
+      t.header_key_lines[key] = line_no;
+      continue;
+    }
+    const std::vector<Field> fields = split_fields(line);
+    if (!header_seen) {
+      header_seen = true;
+      t.header_line = line_no;
+      std::vector<std::string> unknown;
+      for (std::size_t i = 0; i < fields.size(); ++i) {
+        std::string name = fields[i].text;
+        if (name.size() >= 2 && name.front() == '"' && name.back() == '"')
+          name = name.substr(1, name.size() - 2);
+        if (name.empty())
+          throw fail(line_no, fields[i].column,
+                     "empty column name (header field " + std::to_string(i + 1) + ")");
+        if (name.find('"') != std::string::npos)
+          throw fail(line_no, fields[i].column,
+                     "column name " + fields[i].text +
+                         ": quotes only around a whole name, without quotes inside");
+        const auto dup = std::find(t.columns.begin(), t.columns.end(), name);
+        if (dup != t.columns.end())
+          throw fail(line_no, fields[i].column,
+                     "duplicate column '" + name + "' (also header field " +
+                         std::to_string(dup - t.columns.begin() + 1) + ")");
+        ColumnInfo info = classify_column(name, options);
+        if (info.role == ColumnRole::Unknown) {
+          unknown.push_back("'" + name + "'");
+          if (options.allow_unknown)
+            t.warnings.push_back(filename + ":" + std::to_string(line_no) + ":" +
+                                 std::to_string(fields[i].column) + ": unknown column '" + name +
+                                 "' (kept, not interpreted)");
+        }
+        t.columns.push_back(name);
+        t.info.push_back(std::move(info));
+        t.values[name];
+      }
+      if (!unknown.empty() && !options.allow_unknown)
+        throw fail(line_no, 0,
+                   std::string(unknown.size() > 1 ? "unknown columns " : "unknown column ") +
+                       join_names(unknown) + " (known: " + kKnownRoles + ")");
+      continue;
+    }
+    // A data row.
+    if (fields.size() != t.columns.size())
+      throw fail(line_no, 0,
+                 std::to_string(fields.size()) + " field" + (fields.size() == 1 ? "" : "s") +
+                     ", the header (line " + std::to_string(t.header_line) + ") has " +
+                     std::to_string(t.columns.size()));
+    for (std::size_t i = 0; i < fields.size(); ++i) {
+      const Field& f = fields[i];
+      const std::string& name = t.columns[i];
+      double v = kNaN;
+      if (!f.text.empty()) {
+        std::string why;
+        if (!parse_number(f.text, v, why))
+          throw fail(line_no, f.column, "column '" + name + "': '" + f.text + "' " + why);
+        const ColumnRole role = t.info[i].role;
+        if (role == ColumnRole::Direction && v != 1.0 && v != -1.0)
+          throw fail(line_no, f.column, "column '" + name + "': '" + f.text + "' must be +1 or -1");
+        if (role == ColumnRole::Cycle && v != std::floor(v))
+          throw fail(line_no, f.column,
+                     "column '" + name + "': '" + f.text + "' is not an integer");
+      }
+      t.values[name].push_back(v);
+    }
+    t.lines.push_back(line_no);
+  }
+  if (!header_seen)
+    throw fail(0, 0, line_no == 0 ? "empty file" : "no header row (only comments and blank lines)");
+  if (t.lines.empty()) throw fail(t.header_line, 0, "no data rows after the header");
+  return t;
+}
+
+MeasurementTable read_measurements(const std::string& path, const ReadOptions& options) {
+  std::string text;
+  if (!read_file(path, text)) throw InputError(SourceLoc{path, 0, 0}, "cannot read file");
+  return parse_measurements(text, path, options);
+}
+
+ReadOptions machine_read_options(const Description& desc, bool allow_unknown) {
+  ReadOptions ro;
+  for (int b : desc.axes())
+    ro.coordinates.push_back(desc.bodies[static_cast<std::size_t>(b)].joint.coordinate);
+  ro.allow_unknown = allow_unknown;
+  return ro;
+}
+
+}  // namespace weilgen

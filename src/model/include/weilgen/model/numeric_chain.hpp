@@ -1,0 +1,61 @@
+// The exact numeric kinematic chain of a machine description: Eigen 4x4 products, exact
+// rotation matrices (AngleAxis), exact inverses. Written independently of the generator: it is
+// the reference the generated models are verified against (O(s^{r+1}) agreement) and the
+// "straightforward numeric chain" the benchmarks compare with.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <array>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "weilgen/machine/description.hpp"
+
+namespace weilgen {
+
+class NumericChain {
+ public:
+  // Parameters take their defaults unless `set_parameters` is called.
+  explicit NumericChain(Description desc);
+
+  // Parameter values in the order of Description::parameters (mm / deg).
+  void set_parameters(const std::vector<double>& values);
+
+  // Tool frame (at the tool point) in the workpiece frame; for a machine with an `output`
+  // transform, that transform (times Trans(point)) instead. `axes` in the joints' units, in
+  // Description::axes() order; `errors` in base units (mm, rad), in Description::errors order.
+  Eigen::Matrix4d tool_in_workpiece(const std::vector<double>& axes,
+                                    const std::vector<double>& errors) const;
+
+  // (dx, dy, dz) in mm and the rotation vector (da, db, dc) in rad of the actual tool pose
+  // relative to the nominal one, both in the workpiece frame (machines/README.md, "Outputs").
+  std::array<double, 6> deviation(const std::vector<double>& axes,
+                                  const std::vector<double>& errors) const;
+
+  const Description& description() const { return desc_; }
+  std::size_t num_axes() const { return axis_bodies_.size(); }
+  std::size_t num_errors() const { return desc_.errors.size(); }
+
+ private:
+  // q_body: each body's joint value in its unit (0 for fixed bodies).
+  Eigen::Matrix4d body_transform(int body, const std::vector<double>& q_body,
+                                 const std::vector<double>& errors) const;
+  Eigen::Matrix4d error_transform(int body, ErrorPlacement placement,
+                                  const std::vector<double>& errors) const;
+  Eigen::Matrix4d branch(const PointSpec& end, const std::vector<double>& q_body,
+                         const std::vector<double>& errors) const;
+  // Parameters, independent coordinates (from `axes`) and linked coordinates by name.
+  std::map<std::string, double> coordinate_values(const std::vector<double>& axes) const;
+  // Chain points, derived quantities (by name, into `values`) and the output transform.
+  Eigen::Matrix4d output_transform(std::map<std::string, double> values,
+                                   const std::vector<double>& q_body,
+                                   const std::vector<double>& errors) const;
+
+  Description desc_;
+  std::vector<int> axis_bodies_;
+  std::vector<int> linked_bodies_;  // bodies with a linked joint
+  std::map<std::string, double> params_;
+};
+
+}  // namespace weilgen

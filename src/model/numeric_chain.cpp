@@ -1,0 +1,172 @@
+#include "weilgen/model/numeric_chain.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "weilgen/machine/derived.hpp"
+
+namespace weilgen {
+
+namespace {
+Eigen::Vector3d vec(const Vec3& v) { return {v[0], v[1], v[2]}; }
+
+Eigen::Matrix4d translation(const Eigen::Vector3d& t) {
+  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+  m.block<3, 1>(0, 3) = t;
+  return m;
+}
+
+Eigen::Matrix4d rotation(const Eigen::Vector3d& axis, double angle_rad) {
+  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+  m.block<3, 3>(0, 0) = Eigen::AngleAxisd(angle_rad, axis.normalized()).toRotationMatrix();
+  return m;
+}
+
+Eigen::Matrix4d rigid_inverse(const Eigen::Matrix4d& m) {
+  Eigen::Matrix4d r = Eigen::Matrix4d::Identity();
+  r.block<3, 3>(0, 0) = m.block<3, 3>(0, 0).transpose();
+  r.block<3, 1>(0, 3) = -m.block<3, 3>(0, 0).transpose() * m.block<3, 1>(0, 3);
+  return r;
+}
+}  // namespace
+
+NumericChain::NumericChain(Description desc)
+    : desc_(std::move(desc)),
+      axis_bodies_(desc_.axes()),
+      linked_bodies_(desc_.linked_axes()),
+      params_(desc_.parameter_defaults()) {}
+
+void NumericChain::set_parameters(const std::vector<double>& values) {
+  if (values.size() != desc_.parameters.size())
+    throw std::invalid_argument("expected " + std::to_string(desc_.parameters.size()) +
+                                " parameter values");
+  for (std::size_t i = 0; i < values.size(); ++i) params_[desc_.parameters[i].name] = values[i];
+}
+
+Eigen::Matrix4d NumericChain::error_transform(int body, ErrorPlacement placement,
+                                              const std::vector<double>& errors) const {
+  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+  for (int ei : desc_.bodies[body].errors) {
+    const ErrorDef& e = desc_.errors[ei];
+    if (e.placement != placement) continue;
+    const double v = errors.at(ei);
+    m = m * (e.effect == ErrorEffect::Translation ? translation(v * vec(e.direction))
+                                                  : rotation(vec(e.direction), v));
+  }
+  return m;
+}
+
+Eigen::Matrix4d NumericChain::body_transform(int body, const std::vector<double>& q_body,
+                                             const std::vector<double>& errors) const {
+  const Body& b = desc_.bodies[body];
+  Eigen::Vector3d t;
+  for (int i = 0; i < 3; ++i) t[i] = b.offset.translation[i].eval(params_);
+  Eigen::Matrix4d m = translation(t);
+  for (const auto& r : b.offset.rotations)
+    m = m * rotation(vec(r.axis), r.angle_deg.eval(params_) * M_PI / 180.0);
+
+  Eigen::Matrix4d joint = Eigen::Matrix4d::Identity();
+  if (b.joint.type != JointType::Fixed) {
+    const double q = q_body[static_cast<std::size_t>(body)] * b.joint.to_base;
+    if (b.joint.type == JointType::Prismatic) {
+      joint = translation(q * vec(b.joint.axis));
+    } else {
+      Eigen::Vector3d through;
+      for (int i = 0; i < 3; ++i) through[i] = b.joint.through[i].eval(params_);
+      joint = translation(through) * rotation(vec(b.joint.axis), q) * translation(-through);
+    }
+  }
+  const Eigen::Matrix4d axis = error_transform(body, ErrorPlacement::Axis, errors);
+  return m * error_transform(body, ErrorPlacement::Before, errors) * axis * joint *
+         rigid_inverse(axis) * error_transform(body, ErrorPlacement::After, errors);
+}
+
+Eigen::Matrix4d NumericChain::branch(const PointSpec& end, const std::vector<double>& q_body,
+                                     const std::vector<double>& errors) const {
+  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+  for (int b : desc_.chain_to(end.body)) m = m * body_transform(b, q_body, errors);
+  Eigen::Vector3d p;
+  for (int i = 0; i < 3; ++i) p[i] = end.point[i].eval(params_);
+  return m * translation(p);
+}
+
+std::map<std::string, double> NumericChain::coordinate_values(
+    const std::vector<double>& axes) const {
+  std::map<std::string, double> values = params_;
+  for (std::size_t k = 0; k < axis_bodies_.size(); ++k)
+    values[desc_.bodies[static_cast<std::size_t>(axis_bodies_[k])].joint.coordinate] = axes[k];
+  resolve_links(desc_, values);
+  return values;
+}
+
+Eigen::Matrix4d NumericChain::output_transform(std::map<std::string, double> values,
+                                               const std::vector<double>& q_body,
+                                               const std::vector<double>& errors) const {
+  const std::vector<double> none(errors.size(), 0.0);
+  for (const ChainPoint& p : desc_.points) {
+    const Eigen::Vector3d d =
+        (branch(p.at, q_body, errors) - branch(p.at, q_body, none)).block<3, 1>(0, 3);
+    for (int i = 0; i < 3; ++i) values[p.name + "." + static_cast<char>('x' + i)] = d[i];
+  }
+  for (const Derived& q : desc_.derived) values[q.name] = q.value.eval(values);
+  auto vec3 = [&](const std::array<Expr, 3>& e) {
+    return Eigen::Vector3d(e[0].eval(values), e[1].eval(values), e[2].eval(values));
+  };
+  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+  for (const TransformStep& s : desc_.output->steps) {
+    if (s.kind == TransformStep::Kind::Translate) {
+      m = m * translation(vec3(s.translation));
+      continue;
+    }
+    // exp(ξ^ a) for ξ = (ω, v): a screw about the line through ω × v with pitch ω·v (|ω| = 1),
+    // or a translation by v·a (ω = 0).
+    const Eigen::Vector3d w = vec(s.omega), v = vec3(s.v);
+    const double a = s.amount.eval(values);
+    if (w.norm() == 0) {
+      m = m * translation(a * v);
+    } else {
+      const Eigen::Vector3d q = w.cross(v);
+      m = m * translation(q) * rotation(w, a) * translation(w.dot(v) * a * w - q);
+    }
+  }
+  return m * translation(vec3(desc_.output->point));
+}
+
+Eigen::Matrix4d NumericChain::tool_in_workpiece(const std::vector<double>& axes,
+                                                const std::vector<double>& errors) const {
+  if (axes.size() != axis_bodies_.size())
+    throw std::invalid_argument("expected " + std::to_string(axis_bodies_.size()) + " axis values");
+  if (errors.size() != desc_.errors.size())
+    throw std::invalid_argument("expected " + std::to_string(desc_.errors.size()) +
+                                " error values");
+  std::vector<double> q_body(desc_.bodies.size(), 0.0);
+  for (std::size_t k = 0; k < axis_bodies_.size(); ++k)
+    q_body[static_cast<std::size_t>(axis_bodies_[k])] = axes[k];
+  // Names are needed only for linked coordinates and the output transform: serial machines
+  // evaluate without building them (this chain is the numeric engine's hot path).
+  if (linked_bodies_.empty() && !desc_.output)
+    return rigid_inverse(branch(desc_.workpiece, q_body, errors)) *
+           branch(desc_.tool, q_body, errors);
+  const std::map<std::string, double> values = coordinate_values(axes);
+  for (int b : linked_bodies_)
+    q_body[static_cast<std::size_t>(b)] =
+        values.at(desc_.bodies[static_cast<std::size_t>(b)].joint.coordinate);
+  if (desc_.output) return output_transform(values, q_body, errors);
+  return rigid_inverse(branch(desc_.workpiece, q_body, errors)) *
+         branch(desc_.tool, q_body, errors);
+}
+
+std::array<double, 6> NumericChain::deviation(const std::vector<double>& axes,
+                                              const std::vector<double>& errors) const {
+  const Eigen::Matrix4d actual = tool_in_workpiece(axes, errors);
+  const Eigen::Matrix4d nominal =
+      tool_in_workpiece(axes, std::vector<double>(desc_.errors.size(), 0.0));
+  const Eigen::Vector3d dp = actual.block<3, 1>(0, 3) - nominal.block<3, 1>(0, 3);
+  const Eigen::Matrix3d dr = actual.block<3, 3>(0, 0) * nominal.block<3, 3>(0, 0).transpose();
+  const Eigen::AngleAxisd aa(dr);
+  const Eigen::Vector3d w = aa.angle() * aa.axis();
+  return {dp[0], dp[1], dp[2], w[0], w[1], w[2]};
+}
+
+}  // namespace weilgen

@@ -1,0 +1,59 @@
+#include "weilgen/uq/lsq.hpp"
+
+namespace weilgen {
+
+using Eigen::Index;
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+
+EquilibratedSvd::EquilibratedSvd(const MatrixXd& A, double rank_tolerance, bool full_v) {
+  const Index n = A.cols();
+  scale_ = A.colwise().norm().transpose();
+  zero_column_.resize(static_cast<std::size_t>(n));
+  for (Index p = 0; p < n; ++p) {
+    zero_column_[static_cast<std::size_t>(p)] = !(scale_[p] > 0);
+    if (zero_column_[static_cast<std::size_t>(p)]) scale_[p] = 1;
+  }
+  const MatrixXd As = A * scale_.cwiseInverse().asDiagonal();
+  const unsigned options =
+      Eigen::ComputeThinU | (full_v ? Eigen::ComputeFullV : Eigen::ComputeThinV);
+  Eigen::BDCSVD<MatrixXd> svd(As, options);
+  sigma_ = VectorXd::Zero(n);
+  if (svd.singularValues().allFinite() && svd.matrixU().allFinite() && svd.matrixV().allFinite()) {
+    sigma_.head(svd.singularValues().size()) = svd.singularValues();
+    U_ = svd.matrixU();
+    V_ = svd.matrixV();
+  } else {
+    // Eigen 3.4's divide-and-conquer SVD returns NaN for some strongly rank-deficient matrices
+    // (a 1010 × 75 design of rank 4, one linear axis measured: tests/test_lsq.cpp); the
+    // one-sided Jacobi SVD is slower but does not.
+    Eigen::JacobiSVD<MatrixXd> jacobi(As, options);
+    sigma_.head(jacobi.singularValues().size()) = jacobi.singularValues();
+    U_ = jacobi.matrixU();
+    V_ = jacobi.matrixV();
+  }
+  const double smax = sigma_.size() ? sigma_[0] : 0;
+  while (rank_ < static_cast<std::size_t>(std::min(n, U_.cols())) &&
+         sigma_[static_cast<Index>(rank_)] > rank_tolerance * smax && smax > 0)
+    ++rank_;
+}
+
+VectorXd EquilibratedSvd::solve(const VectorXd& y) const {
+  VectorXd z = VectorXd::Zero(V_.rows());
+  for (std::size_t i = 0; i < rank_; ++i) {
+    const auto c = static_cast<Index>(i);
+    z += V_.col(c) * (U_.col(c).dot(y) / sigma_[c]);
+  }
+  VectorXd x = z.cwiseQuotient(scale_);
+  for (std::size_t p = 0; p < zero_column_.size(); ++p)
+    if (zero_column_[p]) x[static_cast<Index>(p)] = 0;  // not rounding noise
+  return x;
+}
+
+MatrixXd EquilibratedSvd::pinv_right() const {
+  const auto r = static_cast<Index>(rank_);
+  return scale_.cwiseInverse().asDiagonal() * V_.leftCols(r) *
+         sigma_.head(r).cwiseInverse().asDiagonal();
+}
+
+}  // namespace weilgen
