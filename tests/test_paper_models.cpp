@@ -34,7 +34,7 @@ void check_output(const gen::SymbolicModel& m, int o, const Terms& printed,
   for (const auto& p : m.params) seed_setup[p] = 0;
   for (std::size_t i = 0; i < m.errors.size(); ++i) {
     const std::string& name = m.desc.errors[i].name;
-    CAPTURE(gen::kOutputNames[o]);
+    CAPTURE(output_name(static_cast<std::size_t>(o)));
     CAPTURE(name);
     const GiNaC::ex got = m.coefficient(o, {static_cast<std::uint16_t>(i)}).subs(seed_setup);
     const auto it = expected.find(name);

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "truth.hpp"
+#include "weilgen/base/text.hpp"
 #include "weilgen/machine/yaml_loader.hpp"
 #include "weilgen/measure/measurement_csv.hpp"
 #include "weilgen/model/numeric_chain.hpp"

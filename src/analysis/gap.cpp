@@ -11,6 +11,7 @@
 
 #include "weilgen/analysis/ballbar_model.hpp"
 #include "weilgen/analysis/gap_effects.hpp"
+#include "weilgen/base/format.hpp"
 #include "weilgen/base/text.hpp"
 #include "weilgen/uq/lsq.hpp"
 

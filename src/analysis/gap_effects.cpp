@@ -418,7 +418,7 @@ void add_pdge_shape(const EffectContext& ctx, std::vector<Candidate>& out) {
 std::array<double, 6> exact(const NumericChain& chain, const std::vector<double>& pose,
                             const std::vector<double>& errors) {
   std::array<double, 6> v = chain.deviation(pose, errors);
-  for (std::size_t o = 0; o < 6; ++o) v[o] *= kObservationScale[o];
+  for (std::size_t o = 0; o < 6; ++o) v[o] *= kMeasuredScale[o];
   return v;
 }
 

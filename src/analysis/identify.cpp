@@ -7,6 +7,7 @@
 #include <map>
 #include <stdexcept>
 
+#include "weilgen/base/format.hpp"
 #include "weilgen/base/text.hpp"
 #include "weilgen/base/units.hpp"
 #include "weilgen/machine/derived.hpp"
@@ -19,11 +20,8 @@ const char* observation_name(std::size_t output) {
 }
 
 const char* observation_unit(std::size_t output) {
-  return output < 3 || output == kRadialOutput ? "µm" : "µrad";
+  return output == kRadialOutput ? "µm" : measured_unit(output);
 }
-
-const std::array<const char*, 6> kDeviationColumns = {"dx_um",   "dy_um",   "dz_um",
-                                                      "da_urad", "db_urad", "dc_urad"};
 
 namespace {
 
@@ -268,7 +266,7 @@ MatrixXd design_matrix(const Model& model, const ErrorParameterisation& param,
       for (int o = 0; o < 6; ++o) {
         const double w = observation_weight(ob, o);
         if (w != 0)
-          v += w * kObservationScale[static_cast<std::size_t>(o)] *
+          v += w * kMeasuredScale[static_cast<std::size_t>(o)] *
                md.coeff[static_cast<std::size_t>(o) * ne + err];
       }
       A(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(p)) = v * jac[p];
@@ -413,7 +411,7 @@ std::array<double, 6> predict_deviation(const Model& model, ModelData& data,
   param.errors_at(axes, theta.data(), data.errors.data());
   std::array<double, 6> out{};
   model.deviation(data, axes, data.errors.data(), out.data());
-  for (std::size_t o = 0; o < 6; ++o) out[o] *= kObservationScale[o];
+  for (std::size_t o = 0; o < 6; ++o) out[o] *= kMeasuredScale[o];
   return out;
 }
 

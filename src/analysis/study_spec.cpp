@@ -7,12 +7,11 @@
 #include <stdexcept>
 
 #include "weilgen/analysis/tolerance_file.hpp"
+#include "weilgen/base/format.hpp"
 #include "weilgen/base/text.hpp"
 
 namespace weilgen {
 namespace {
-
-std::string quoted(const std::string& s) { return "\"" + s + "\""; }
 
 // "--grid: \"X=0:1000:0\"" : the prefix of every message about one flag value.
 std::string flag_context(const std::string& flag, const std::string& text) {
@@ -240,48 +239,6 @@ PoseSet parse_poses(const Description& desc, const std::vector<std::string>& at,
 }
 
 // ---- Outputs and tolerances -------------------------------------------------------------------
-
-const std::vector<OutputId>& all_outputs() {
-  static const std::vector<OutputId> all = {OutputId::Dx, OutputId::Dy, OutputId::Dz, OutputId::Da,
-                                            OutputId::Db, OutputId::Dc, OutputId::Dp};
-  return all;
-}
-
-const char* output_name(OutputId id) {
-  switch (id) {
-    case OutputId::Dx:
-      return "dx";
-    case OutputId::Dy:
-      return "dy";
-    case OutputId::Dz:
-      return "dz";
-    case OutputId::Da:
-      return "da";
-    case OutputId::Db:
-      return "db";
-    case OutputId::Dc:
-      return "dc";
-    case OutputId::Dp:
-      return "dp";
-  }
-  return "?";
-}
-
-bool output_is_angle(OutputId id) {
-  return id == OutputId::Da || id == OutputId::Db || id == OutputId::Dc;
-}
-
-const char* output_unit(OutputId id) { return output_is_angle(id) ? "rad" : "mm"; }
-
-OutputId parse_output(const std::string& name) {
-  const std::string n = lower(trim(name));
-  std::vector<std::string> names;
-  for (OutputId id : all_outputs()) {
-    if (n == output_name(id)) return id;
-    names.push_back(output_name(id));
-  }
-  throw std::invalid_argument("unknown output " + quoted(name) + " (expected " + join(names) + ")");
-}
 
 std::vector<OutputTolerance> parse_tolerances(const std::vector<std::string>& flags) {
   std::vector<OutputTolerance> out;

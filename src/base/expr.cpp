@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <utility>
 
+
 namespace weilgen {
 namespace {
 
@@ -209,8 +210,8 @@ int precedence(const Expr& e) {
   return 5;
 }
 
-// Shortest decimal form that reads back as the same double.
-std::string format_number(double v) {
+// Shortest decimal form that reads back as the same double; pi by name (expressions only).
+std::string number_text(double v) {
   if (v == kPi) return "pi";
   if (v == -kPi) return "-pi";
   char buf[64];
@@ -280,7 +281,7 @@ std::string Expr::str() const {
   const int p = precedence(*this);
   switch (kind) {
     case Kind::Number:
-      return format_number(number);
+      return number_text(number);
     case Kind::Param:
       return name;
     case Kind::Neg:

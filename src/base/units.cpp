@@ -54,34 +54,6 @@ bool unit_char(char c) {
 
 }  // namespace
 
-std::string trim(const std::string& s) {
-  const char* ws = " \t\r\n";
-  const size_t b = s.find_first_not_of(ws);
-  if (b == std::string::npos) return "";
-  return s.substr(b, s.find_last_not_of(ws) - b + 1);
-}
-
-std::vector<std::string> split(const std::string& s, char sep) {
-  std::vector<std::string> out;
-  size_t start = 0;
-  while (true) {
-    const size_t end = s.find(sep, start);
-    out.push_back(s.substr(start, end == std::string::npos ? std::string::npos : end - start));
-    if (end == std::string::npos) return out;
-    start = end + 1;
-  }
-}
-
-std::string format_number(double v) {
-  if (v == 0) return "0";  // also -0
-  char buf[40];
-  for (int digits : {15, 16, 17}) {
-    std::snprintf(buf, sizeof buf, "%.*g", digits, v);
-    if (std::strtod(buf, nullptr) == v) break;
-  }
-  return buf;
-}
-
 std::string known_units() {
   return "lengths: mm, um, µm, nm, m; angles: rad, mrad, urad, µrad, deg, arcsec; slopes: mm/m, "
          "um/m";

@@ -6,6 +6,7 @@
 
 #include "study.hpp"
 #include "weilgen/analysis/ballbar_model.hpp"
+#include "weilgen/base/format.hpp"
 #include "weilgen/base/text.hpp"
 
 namespace weilgen::cli {

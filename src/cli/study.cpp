@@ -8,7 +8,9 @@
 #include <stdexcept>
 
 #include "weilgen/base/atomic_file.hpp"
+#include "weilgen/base/format.hpp"
 #include "weilgen/base/parallel.hpp"
+#include "weilgen/base/text.hpp"
 #include "weilgen/base/units.hpp"
 #include "weilgen/codegen/generate.hpp"
 #include "weilgen/machine/model_key.hpp"

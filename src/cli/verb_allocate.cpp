@@ -10,6 +10,7 @@
 #include "reliability_sweep.hpp"
 #include "verbs.hpp"
 #include "weilgen/analysis/tolerance_file.hpp"
+#include "weilgen/base/text.hpp"
 #include "weilgen/base/units.hpp"
 #include "weilgen/base/version.hpp"
 #include "weilgen/machine/description.hpp"

@@ -10,6 +10,7 @@
 #include "study.hpp"
 #include "verbs.hpp"
 #include "weilgen/analysis/gap.hpp"
+#include "weilgen/base/format.hpp"
 #include "weilgen/base/text.hpp"
 #include "weilgen/base/units.hpp"
 #include "weilgen/base/version.hpp"

@@ -7,6 +7,7 @@
 
 #include "study.hpp"
 #include "verbs.hpp"
+#include "weilgen/base/format.hpp"
 #include "weilgen/base/units.hpp"
 #include "weilgen/base/version.hpp"
 #include "weilgen/measure/iso230_2.hpp"

@@ -8,6 +8,7 @@
 
 #include "reliability_sweep.hpp"
 #include "verbs.hpp"
+#include "weilgen/base/format.hpp"
 #include "weilgen/base/units.hpp"
 #include "weilgen/base/version.hpp"
 #include "weilgen/report/plot.hpp"

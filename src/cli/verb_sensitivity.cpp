@@ -8,6 +8,7 @@
 
 #include "study.hpp"
 #include "verbs.hpp"
+#include "weilgen/base/text.hpp"
 #include "weilgen/base/units.hpp"
 #include "weilgen/base/version.hpp"
 #include "weilgen/report/plot.hpp"

@@ -32,8 +32,8 @@ int verb_show(const Args& args) {
   if (vm.count("order") && order < 1) return usage_error("show", "--order must be >= 1");
   int only = -1;
   if (!output.empty()) {
-    for (int o = 0; o < gen::kNumOutputs; ++o)
-      if (output == gen::kOutputNames[o]) only = o;
+    for (int o = 0; o < kNumDeviationOutputs; ++o)
+      if (output == output_name(static_cast<std::size_t>(o))) only = o;
     if (only < 0) return usage_error("show", "unknown output '" + output + "' (dx dy dz da db dc)");
   }
   const Description d = load_machine_file(resolve_machine(vm["machine"].as<std::string>()));
@@ -42,14 +42,14 @@ int verb_show(const Args& args) {
   if (format == "json") {
     auto j = gen::closed_forms_json(m, n);
     if (only >= 0) {
-      auto one = j["outputs"][gen::kOutputNames[only]];
-      j["outputs"] = {{gen::kOutputNames[only], one}};
+      auto one = j["outputs"][output_name(static_cast<std::size_t>(only))];
+      j["outputs"] = {{output_name(static_cast<std::size_t>(only)), one}};
     }
     std::cout << j.dump(2) << "\n";
     return 0;
   }
   const auto style = format == "latex" ? gen::FormStyle::Latex : gen::FormStyle::Text;
-  for (int o = 0; o < gen::kNumOutputs; ++o)
+  for (int o = 0; o < kNumDeviationOutputs; ++o)
     if (only < 0 || only == o) std::cout << gen::closed_form(m, o, style, n) << "\n";
   return 0;
 }

@@ -5,6 +5,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "weilgen/base/format.hpp"
+#include "weilgen/base/text.hpp"
 #include "weilgen/base/version.hpp"
 #include "weilgen/codegen/cse.hpp"
 #include "weilgen/codegen/emit_compensation.hpp"
@@ -17,7 +19,7 @@ using GiNaC::ex;
 
 namespace {
 
-std::string quoted(const std::string& s) {
+std::string string_literal(const std::string& s) {
   std::string out = "\"";
   for (char c : s) {
     if (c == '"' || c == '\\') out += '\\';
@@ -80,7 +82,7 @@ InputTable inputs_of(const SymbolicModel& m) {
     const Joint& j = m.desc.bodies[a.body].joint;
     add(a.coordinate.get_name(), j.coordinate, "axes[" + std::to_string(i) + "]");
     if (a.revolute) {
-      const std::string arg = j.coordinate + " * Scalar(" + format_double(j.to_base) + ")";
+      const std::string arg = j.coordinate + " * Scalar(" + format_literal(j.to_base) + ")";
       add(a.cos.get_name(), "cos_" + j.coordinate, "cos(" + arg + ")");
       add(a.sin.get_name(), "sin_" + j.coordinate, "sin(" + arg + ")");
     }
@@ -310,7 +312,7 @@ std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_la
       const std::string code = "_to_base" + std::to_string(unit_factor.size());
       it = unit_factor.emplace(to_base, GiNaC::symbol(code)).first;
       jinputs.code_name[code] = code;
-      jinputs.definition[code] = "Scalar(" + format_double(to_base) + ")";
+      jinputs.definition[code] = "Scalar(" + format_literal(to_base) + ")";
       jinputs.order.push_back(code);
     }
     jac[k] = it->second * jac[k];
@@ -347,16 +349,16 @@ std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_la
   os << "#pragma once\n\n#include <array>\n#include <cmath>\n#include <cstddef>\n\n";
   os << "namespace weilgen_models {\nnamespace " << d.name << " {\n\n";
 
-  os << "inline constexpr const char* kMachineName = " << quoted(d.name) << ";\n";
+  os << "inline constexpr const char* kMachineName = " << string_literal(d.name) << ";\n";
   os << "inline constexpr int kOrder = " << m.order << ";\n";
   os << "// Machine-file text, order and weilgen version: identifies the model "
         "(runtime/model_key.hpp).\n";
-  os << "inline constexpr const char* kModelKey = " << quoted(model_key(d.source_hash, m.order))
-     << ";\n";
+  os << "inline constexpr const char* kModelKey = "
+     << string_literal(model_key(d.source_hash, m.order)) << ";\n";
   os << "inline constexpr std::size_t kNumAxes = " << m.axes.size() << ";\n";
   os << "inline constexpr std::size_t kNumErrors = " << ne << ";\n";
   os << "inline constexpr std::size_t kNumParams = " << d.parameters.size() << ";\n";
-  os << "inline constexpr std::size_t kNumOutputs = 6;\n";
+  os << "inline constexpr std::size_t kNumOutputs = " << kNumDeviationOutputs << ";\n";
   os << "inline constexpr std::size_t kNumHigherTerms = " << higher.size() << ";\n";
   os << "inline constexpr std::size_t kMaxHigherDegree = "
      << (higher.empty() ? 0 : higher.back().size()) << ";\n\n";
@@ -380,9 +382,9 @@ std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_la
   os << "inline constexpr std::array<AxisInfo, kNumAxes> kAxes = {{\n";
   for (const auto& a : m.axes) {
     const Joint& j = d.bodies[a.body].joint;
-    os << "    {" << quoted(j.coordinate) << ", " << quoted(j.unit) << ", "
-       << (a.revolute ? "true" : "false") << ", " << format_double(j.min) << ", "
-       << format_double(j.max) << ", " << format_double(j.to_base) << "},\n";
+    os << "    {" << string_literal(j.coordinate) << ", " << string_literal(j.unit) << ", "
+       << (a.revolute ? "true" : "false") << ", " << format_literal(j.min) << ", "
+       << format_literal(j.max) << ", " << format_literal(j.to_base) << "},\n";
   }
   os << "}};\n\n";
   os << "inline constexpr std::array<ErrorInfo, kNumErrors> kErrors = {{\n";
@@ -390,27 +392,32 @@ std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_la
     std::string aliases;
     for (const auto& al : e.aliases)
       aliases += (aliases.empty() ? "" : " ") + std::string(al.sign < 0 ? "-" : "") + al.name;
-    os << "    {" << quoted(e.name) << ", " << quoted(e.iso) << ", " << quoted(aliases) << ", "
-       << quoted(e.group) << ", " << quoted(e.unit) << ", " << format_double(e.to_base) << ", "
+    os << "    {" << string_literal(e.name) << ", " << string_literal(e.iso) << ", "
+       << string_literal(aliases) << ", " << string_literal(e.group) << ", "
+       << string_literal(e.unit) << ", " << format_literal(e.to_base) << ", "
        << (e.dependence == Dependence::PDGE ? "true" : "false") << ", "
-       << quoted(d.bodies[e.body].name) << ", " << quoted(placement_name(e.placement)) << ", "
+       << string_literal(d.bodies[e.body].name) << ", "
+       << string_literal(placement_name(e.placement)) << ", "
        << (e.effect == ErrorEffect::Rotation ? "true" : "false") << ", "
-       << dist_kind(e.distribution.kind) << ", " << format_double(e.distribution.a) << ", "
-       << format_double(e.distribution.b) << ", " << format_double(e.distribution.lo) << ", "
-       << format_double(e.distribution.hi) << "},\n";
+       << dist_kind(e.distribution.kind) << ", " << format_literal(e.distribution.a) << ", "
+       << format_literal(e.distribution.b) << ", " << format_literal(e.distribution.lo) << ", "
+       << format_literal(e.distribution.hi) << "},\n";
   }
   os << "}};\n\n";
   os << "inline constexpr std::array<ParamInfo, kNumParams> kParams = {{\n";
   const auto defaults = d.parameter_defaults();
   for (const auto& p : d.parameters)
-    os << "    {" << quoted(p.name) << ", " << quoted(p.unit) << ", "
-       << format_double(defaults.at(p.name)) << "},\n";
+    os << "    {" << string_literal(p.name) << ", " << string_literal(p.unit) << ", "
+       << format_literal(defaults.at(p.name)) << "},\n";
   os << "}};\n\n";
-  os << "inline constexpr std::array<const char*, kNumOutputs> kOutputs = {{\"dx\", \"dy\", "
-        "\"dz\", "
-        "\"da\", \"db\", \"dc\"}};\n";
-  os << "inline constexpr std::array<const char*, kNumOutputs> kOutputUnits = {{\"mm\", \"mm\", "
-        "\"mm\", \"rad\", \"rad\", \"rad\"}};\n\n";
+  std::string names, units;
+  for (std::size_t o = 0; o < kNumDeviationOutputs; ++o) {
+    names += std::string(o ? ", " : "") + string_literal(output_name(o));
+    units += std::string(o ? ", " : "") + string_literal(output_unit(o));
+  }
+  os << "inline constexpr std::array<const char*, kNumOutputs> kOutputs = {{" << names << "}};\n";
+  os << "inline constexpr std::array<const char*, kNumOutputs> kOutputUnits = {{" << units
+     << "}};\n\n";
   os << "// Monomials of degree >= 2 with a non-zero coefficient: error indices, padded with -1.\n";
   const std::size_t width = higher.empty() ? 1 : higher.back().size();
   os << "inline constexpr std::array<std::array<int, " << width

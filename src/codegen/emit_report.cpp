@@ -2,6 +2,7 @@
 
 #include <sstream>
 
+#include "weilgen/base/format.hpp"
 #include "weilgen/base/version.hpp"
 #include "weilgen/codegen/printer.hpp"
 
@@ -98,9 +99,10 @@ std::string closed_form(const SymbolicModel& m, int o, FormStyle style, Notation
     }
     s = join_term(s, readable((c * sign).expand()), name, pr, style);
   }
-  const std::string lhs = style == FormStyle::Latex
-                              ? std::string("\\delta_{") + (kOutputNames[o] + 1) + "}"
-                              : kOutputNames[o];
+  const std::string lhs =
+      style == FormStyle::Latex
+          ? std::string("\\delta_{") + (output_name(static_cast<std::size_t>(o)) + 1) + "}"
+          : output_name(static_cast<std::size_t>(o));
   return lhs + " = " + (s.empty() ? "0" : s);
 }
 
@@ -110,9 +112,9 @@ nlohmann::json closed_forms_json(const SymbolicModel& m, Notation notation) {
   j["order"] = m.order;
   j["notation"] = notation == Notation::Iso ? "iso" : "alias";
   ExprPrinter pr(ExprPrinter::Style::Text);
-  for (int o = 0; o < kNumOutputs; ++o) {
+  for (int o = 0; o < kNumDeviationOutputs; ++o) {
     nlohmann::json out;
-    out["unit"] = kOutputUnits[o];
+    out["unit"] = output_unit(static_cast<std::size_t>(o));
     out["closed_form"] = closed_form(m, o, FormStyle::Text, notation);
     out["latex"] = closed_form(m, o, FormStyle::Latex, notation);
     nlohmann::json lin = nlohmann::json::object();
@@ -137,7 +139,7 @@ nlohmann::json closed_forms_json(const SymbolicModel& m, Notation notation) {
       hi.push_back({{"monomial", names}, {"coefficient", pr.print((c * sign).expand())}});
     }
     out["higher"] = hi;
-    j["outputs"][kOutputNames[o]] = out;
+    j["outputs"][output_name(static_cast<std::size_t>(o))] = out;
   }
   return j;
 }
@@ -171,14 +173,14 @@ std::string emit_report_markdown(const SymbolicModel& m, const std::string& sour
         "`cos(c)`, `sin(c)` of the angle.\n\n";
 
   os << "## Closed forms\n\n```text\n";
-  for (int o = 0; o < kNumOutputs; ++o)
+  for (int o = 0; o < kNumDeviationOutputs; ++o)
     os << closed_form(m, o, FormStyle::Text, Notation::Iso) << "\n";
   os << "```\n\n";
   bool has_alias = false;
   for (const auto& e : d.errors) has_alias |= !e.aliases.empty();
   if (has_alias) {
     os << "### In the source's notation (first alias of each error)\n\n```text\n";
-    for (int o = 0; o < kNumOutputs; ++o)
+    for (int o = 0; o < kNumDeviationOutputs; ++o)
       os << closed_form(m, o, FormStyle::Text, Notation::Alias) << "\n";
     os << "```\n\n";
   }
@@ -188,7 +190,7 @@ std::string emit_report_markdown(const SymbolicModel& m, const std::string& sour
   ExprPrinter pr(ExprPrinter::Style::Text);
   for (std::size_t i = 0; i < d.errors.size(); ++i) {
     os << "| " << d.errors[i].name;
-    for (int o = 0; o < kNumOutputs; ++o) {
+    for (int o = 0; o < kNumDeviationOutputs; ++o) {
       const ex c = m.with_divisors(m.coefficient(o, {static_cast<std::uint16_t>(i)}));
       os << " | " << (c.is_zero() ? "·" : pr.print(c));
     }
@@ -199,7 +201,8 @@ std::string emit_report_markdown(const SymbolicModel& m, const std::string& sour
      << "Nominal pose at zero errors: position of the " << (d.output ? "output" : "tool")
      << " point in mm.\n\n```text\n";
   for (int i = 0; i < 3; ++i)
-    os << kOutputNames[i][1] << "0 = " << pr.print(m.with_divisors(m.nominal[i][3])) << "\n";
+    os << output_name(static_cast<std::size_t>(i))[1]
+       << "0 = " << pr.print(m.with_divisors(m.nominal[i][3])) << "\n";
   os << "```\n\nJacobian of the nominal pose per mm (prismatic) or per rad (revolute); the "
         "header's `NominalJacobian` is per axis unit (a column per deg is this times π/180). "
         "Orientation rows are the rotation rate vee(∂R/∂q·Rᵀ).\n\n"
@@ -210,7 +213,7 @@ std::string emit_report_markdown(const SymbolicModel& m, const std::string& sour
     const std::string& name = d.bodies[m.axes[k].body].joint.coordinate;
     os << "| " << name;
     bool moves = false;
-    for (int o = 0; o < kNumOutputs; ++o) {
+    for (int o = 0; o < kNumDeviationOutputs; ++o) {
       const ex c = m.with_divisors(m.nominal_jacobian[o * na + k]);
       moves |= !c.is_zero();
       os << " | " << (c.is_zero() ? "·" : pr.print(c));
@@ -253,8 +256,8 @@ std::string emit_report_markdown(const SymbolicModel& m, const std::string& sour
     const Joint& j = d.bodies[b].joint;
     if (j.type == JointType::Fixed) continue;
     const bool revolute = j.type == JointType::Revolute;
-    std::string axis = "[" + format_double(j.axis[0]) + ", " + format_double(j.axis[1]) + ", " +
-                       format_double(j.axis[2]) + "]";
+    std::string axis = "[" + format_literal(j.axis[0]) + ", " + format_literal(j.axis[1]) + ", " +
+                       format_literal(j.axis[2]) + "]";
     if (revolute &&
         !(j.through[0].is_number() && j.through[0].number == 0 && j.through[1].is_number() &&
           j.through[1].number == 0 && j.through[2].is_number() && j.through[2].number == 0)) {
@@ -265,7 +268,7 @@ std::string emit_report_markdown(const SymbolicModel& m, const std::string& sour
        << (revolute ? "revolute" : "prismatic") << " | " << axis << " | "
        << (j.twist.empty() ? "·" : j.twist) << " | " << j.unit << " | "
        << (j.link ? "linked: " + j.coordinate + " = " + j.link->str()
-                  : format_double(j.min) + " … " + format_double(j.max))
+                  : format_literal(j.min) + " … " + format_literal(j.max))
        << " |\n";
   }
   if (!d.points.empty() || !d.derived.empty() || d.output) {
@@ -292,8 +295,8 @@ std::string emit_report_markdown(const SymbolicModel& m, const std::string& sour
           os << "Trans(" << st.translation[0].str() << ", " << st.translation[1].str() << ", "
              << st.translation[2].str() << ") · ";
         } else {
-          os << "exp(ξ^·" << st.amount.str() << ") [ξ = (" << format_double(st.omega[0]) << ", "
-             << format_double(st.omega[1]) << ", " << format_double(st.omega[2]) << ", "
+          os << "exp(ξ^·" << st.amount.str() << ") [ξ = (" << format_literal(st.omega[0]) << ", "
+             << format_literal(st.omega[1]) << ", " << format_literal(st.omega[2]) << ", "
              << st.v[0].str() << ", " << st.v[1].str() << ", " << st.v[2].str() << ")] · ";
         }
       }
@@ -305,7 +308,7 @@ std::string emit_report_markdown(const SymbolicModel& m, const std::string& sour
     os << "\n## Parameters\n\n| name | default | unit | description |\n| --- | --- | --- | --- |\n";
     const auto defaults = d.parameter_defaults();
     for (const auto& p : d.parameters)
-      os << "| " << p.name << " | " << format_double(defaults.at(p.name)) << " | " << p.unit
+      os << "| " << p.name << " | " << format_literal(defaults.at(p.name)) << " | " << p.unit
          << " | " << p.description << " |\n";
   }
   if (!d.notes.empty()) os << "\n## Notes\n\n" << d.notes << (d.notes.back() == '\n' ? "" : "\n");

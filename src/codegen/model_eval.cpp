@@ -27,7 +27,7 @@ std::array<double, 6> evaluate_model(const SymbolicModel& m, const std::vector<d
   for (const Reciprocal& r : m.reciprocals)
     values[r.symbol] = GiNaC::pow(r.divisor.subs(values), -1);
   std::array<double, 6> out{};
-  for (int o = 0; o < kNumOutputs; ++o) {
+  for (int o = 0; o < kNumDeviationOutputs; ++o) {
     const GiNaC::ex v = m.outputs[o].to_ex(m.errors).subs(values).evalf();
     if (!GiNaC::is_a<GiNaC::numeric>(v))
       throw std::runtime_error("evaluate_model: output did not evaluate to a number");

@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "weilgen/base/format.hpp"
+
 namespace weilgen::gen {
 
 using GiNaC::ex;
@@ -34,17 +36,6 @@ bool has_symbol(const ex& e) {
 }
 }  // namespace
 
-std::string format_double(double v) {
-  char buf[40];
-  for (int p = 1; p <= 17; ++p) {
-    std::snprintf(buf, sizeof buf, "%.*g", p, v);
-    if (std::strtod(buf, nullptr) == v) break;
-  }
-  std::string s(buf);
-  if (s.find_first_of(".en") == std::string::npos) s += ".0";
-  return s;
-}
-
 namespace {
 std::string text(const GiNaC::numeric& n) {
   std::ostringstream os;
@@ -56,14 +47,14 @@ std::string text(const GiNaC::numeric& n) {
 std::string ExprPrinter::number(const GiNaC::numeric& n) {
   if (style_ == Style::Cpp) {
     if (n.is_integer()) return "Scalar(" + text(n) + ")";
-    return "Scalar(" + format_double(n.to_double()) + ")";
+    return "Scalar(" + format_literal(n.to_double()) + ")";
   }
   if (n.is_integer()) return text(n);
   if (n.is_rational() && n.denom() < 1000) {
     if (style_ == Style::Latex) return "\\frac{" + text(n.numer()) + "}{" + text(n.denom()) + "}";
     return text(n.numer()) + "/" + text(n.denom());
   }
-  return format_double(n.to_double());
+  return format_literal(n.to_double());
 }
 
 std::string ExprPrinter::symbol(const ex& e) {
@@ -166,8 +157,8 @@ std::string ExprPrinter::factor(const ex& e) {
       const GiNaC::numeric n = GiNaC::ex_to<GiNaC::numeric>(v);
       std::string s =
           style_ == Style::Cpp
-              ? "Scalar(" + format_double(n.to_double()) + ")"
-              : (GiNaC::is_a<GiNaC::numeric>(e) ? number(n) : format_double(n.to_double()));
+              ? "Scalar(" + format_literal(n.to_double()) + ")"
+              : (GiNaC::is_a<GiNaC::numeric>(e) ? number(n) : format_literal(n.to_double()));
       return n.is_negative() ? "(" + s + ")" : s;
     }
   }

@@ -7,6 +7,7 @@
 #include <set>
 #include <stdexcept>
 
+#include "weilgen/base/format.hpp"
 #include "weilgen/base/text.hpp"
 
 namespace weilgen {

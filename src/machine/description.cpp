@@ -16,20 +16,6 @@ bool is_zero(const Expr& e) { return e.is_number() && e.number == 0.0; }
 
 }  // namespace
 
-std::string SourceLoc::str() const {
-  std::string s = file;
-  if (line > 0) {
-    s += ":" + std::to_string(line);
-    if (column > 0) s += ":" + std::to_string(column);
-  }
-  return s;
-}
-
-InputError::InputError(const SourceLoc& loc, const std::string& message)
-    : std::runtime_error(loc.str().empty() ? message : loc.str() + ": " + message),
-      loc_(loc),
-      message_(message) {}
-
 bool Offset::is_identity() const {
   const bool no_rotation =
       std::all_of(rotations.begin(), rotations.end(),

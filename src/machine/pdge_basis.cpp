@@ -20,13 +20,6 @@ std::string num(double v) {
   return buf;
 }
 
-std::string trim_copy(const std::string& s) {
-  std::size_t i = 0, j = s.size();
-  while (i < j && std::isspace(static_cast<unsigned char>(s[i]))) ++i;
-  while (j > i && std::isspace(static_cast<unsigned char>(s[j - 1]))) --j;
-  return s.substr(i, j - i);
-}
-
 // Power-series coefficients (in u) of the first n + 1 Legendre or Chebyshev polynomials:
 // m[k][j] = coefficient of u^j in P_k (or T_k).
 std::vector<std::vector<double>> monomial_table(BasisKind kind, int n) {
@@ -249,7 +242,7 @@ BasisSpec parse_basis(const std::string& text, bool allow_auto) {
   std::size_t start = 0;
   while (true) {
     const std::size_t colon = text.find(':', start);
-    parts.push_back(trim_copy(text.substr(start, colon - start)));
+    parts.push_back(trim(text.substr(start, colon - start)));
     if (colon == std::string::npos) break;
     start = colon + 1;
   }
@@ -303,7 +296,7 @@ BasisSpec parse_basis(const std::string& text, bool allow_auto) {
       spec.period_search = true;
     } else {
       if (p.size() > 2 && p.compare(p.size() - 2, 2, "mm") == 0)
-        p = trim_copy(p.substr(0, p.size() - 2));
+        p = trim(p.substr(0, p.size() - 2));
       char* end = nullptr;
       const double v = std::strtod(p.c_str(), &end);
       if (p.empty() || end != p.c_str() + p.size() || !std::isfinite(v) || v <= 0) {

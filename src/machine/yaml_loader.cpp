@@ -15,6 +15,7 @@
 #include <sstream>
 #include <utility>
 
+#include "weilgen/base/format.hpp"
 #include "weilgen/base/text.hpp"
 #include "weilgen/machine/derived.hpp"
 #include "weilgen/machine/iso_names.hpp"

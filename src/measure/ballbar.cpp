@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "weilgen/base/format.hpp"
 #include "weilgen/base/text.hpp"
 #include "weilgen/base/units.hpp"
 
@@ -26,8 +27,6 @@ double wrap_deg(double a) {
   if (w < 0) w += 360.0;
   return w >= 360.0 ? 0.0 : w;
 }
-
-std::string quoted(const std::string& s) { return "\"" + s + "\""; }
 
 // ---- Settings: one header key or flag ---------------------------------------------------------
 

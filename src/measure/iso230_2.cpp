@@ -8,6 +8,8 @@
 #include <map>
 #include <stdexcept>
 
+#include "weilgen/base/format.hpp"
+#include "weilgen/base/text.hpp"
 #include "weilgen/base/units.hpp"
 
 namespace weilgen {
@@ -19,12 +21,6 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 std::string mm(double v) { return format_number(v) + " mm"; }
 
 std::string dir_name(int d) { return d == kUp ? "+1" : "-1"; }
-
-std::string join(const std::vector<std::string>& v) {
-  std::string s;
-  for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
-  return s;
-}
 
 std::string list_cycles(const std::vector<long>& c, std::size_t max_items = 8) {
   std::vector<std::string> s;

@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <tuple>
 
+#include "weilgen/base/format.hpp"
 #include "weilgen/base/units.hpp"
 #include "weilgen/measure/iso230_2.hpp"
 

@@ -14,13 +14,6 @@ constexpr LaserChannel kChannels[kLaserChannels] = {
     LaserChannel::Linear, LaserChannel::StraightnessH, LaserChannel::StraightnessV,
     LaserChannel::Yaw,    LaserChannel::Pitch,         LaserChannel::Roll};
 
-std::string trim_copy(const std::string& s) {
-  std::size_t i = 0, j = s.size();
-  while (i < j && std::isspace(static_cast<unsigned char>(s[i]))) ++i;
-  while (j > i && std::isspace(static_cast<unsigned char>(s[j - 1]))) --j;
-  return s.substr(i, j - i);
-}
-
 void check_axis(const std::string& axis) {
   if (axis != "X" && axis != "Y" && axis != "Z") {
     throw std::invalid_argument("axis '" + axis +
@@ -122,19 +115,19 @@ std::vector<ChannelMapping> apply_line6d_map(std::vector<ChannelMapping> mapping
   while (start <= text.size()) {
     std::size_t comma = text.find(',', start);
     if (comma == std::string::npos) comma = text.size();
-    const std::string item = trim_copy(text.substr(start, comma - start));
+    const std::string item = trim(text.substr(start, comma - start));
     start = comma + 1;
     if (item.empty()) continue;
     const std::size_t eq = item.find('=');
     const std::string quoted = "map item \"" + item + "\": ";
     if (eq == std::string::npos)
       throw std::invalid_argument(quoted + "expected CHANNEL=[-]ERROR, e.g. yaw_urad=-E_C" + axis);
-    const std::string col = trim_copy(item.substr(0, eq));
-    std::string target = trim_copy(item.substr(eq + 1));
+    const std::string col = trim(item.substr(0, eq));
+    std::string target = trim(item.substr(eq + 1));
     int sign = 1;
     if (!target.empty() && (target[0] == '-' || target[0] == '+')) {
       sign = target[0] == '-' ? -1 : 1;
-      target = trim_copy(target.substr(1));
+      target = trim(target.substr(1));
     }
     const LaserChannel* ch = channel_by_column(col);
     if (!ch) {
@@ -289,7 +282,7 @@ Line6dData convert_line6d(const std::string& axis, const std::vector<double>& po
 }
 
 bool is_line6d(const MeasurementTable& table) {
-  return lower(trim_copy(table.header_key("format"))) == "line6d";
+  return lower(trim(table.header_key("format"))) == "line6d";
 }
 
 ReadOptions line6d_read_options() {
@@ -306,7 +299,7 @@ Line6dData line6d_from_table(const MeasurementTable& table, const Line6dOptions&
     return SourceLoc{table.file, it == table.header_key_lines.end() ? 0 : it->second, 0};
   };
   const SourceLoc header{table.file, table.header_line, 0};
-  const std::string axis = trim_copy(table.header_key("axis"));
+  const std::string axis = trim(table.header_key("axis"));
   if (axis.empty()) {
     throw InputError(SourceLoc{table.file, 0, 0},
                      "line6d: the header key '# axis:' is missing (the measured axis, e.g. "

@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "weilgen/base/atomic_file.hpp"
+#include "weilgen/base/text.hpp"
 
 namespace weilgen {
 
@@ -29,12 +30,6 @@ std::pair<std::size_t, std::size_t> trimmed_range(const std::string& s, std::siz
   while (first < last && is_space(s[first])) ++first;
   while (last > first && is_space(s[last - 1])) --last;
   return {first, last};
-}
-
-std::string join_names(const std::vector<std::string>& v) {
-  std::string s;
-  for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
-  return s;
 }
 
 // One comma-separated field: its text (trimmed) and its 1-based character column.
@@ -155,7 +150,7 @@ const std::vector<double>& MeasurementTable::column(const std::string& name) con
   const auto it = values.find(name);
   if (it == values.end())
     throw InputError(SourceLoc{file, 0, 0},
-                     "missing column '" + name + "' (columns: " + join_names(columns) + ")");
+                     "missing column '" + name + "' (columns: " + join(columns) + ")");
   return it->second;
 }
 
@@ -256,7 +251,7 @@ MeasurementTable parse_measurements(const std::string& text, const std::string& 
       if (!unknown.empty() && !options.allow_unknown)
         throw fail(line_no, 0,
                    std::string(unknown.size() > 1 ? "unknown columns " : "unknown column ") +
-                       join_names(unknown) + " (known: " + kKnownRoles + ")");
+                       join(unknown) + " (known: " + kKnownRoles + ")");
       continue;
     }
     // A data row.

@@ -131,12 +131,6 @@ struct PointData {
   std::array<std::size_t, kObservationKinds> count{};  // observations per output (and dr)
 };
 
-// From the model's outputs (mm, rad) to the measured µm and µrad, per output 0..5.
-inline constexpr std::array<double, 6> kObservationScale = {1e3, 1e3, 1e3, 1e6, 1e6, 1e6};
-
-// Output names and units as in the measurement format: dx_um ... dc_urad.
-extern const std::array<const char*, 6> kDeviationColumns;
-
 // Reads the poses and deviations of `table` for the machine. Every independent coordinate must
 // be a column (InputError "file: missing column 'Z' ..."), coordinate cells finite (file:line
 // naming the column), and at least one deviation cell measured.

@@ -14,6 +14,7 @@
 
 #include "weilgen/base/units.hpp"
 #include "weilgen/machine/description.hpp"
+#include "weilgen/machine/outputs.hpp"
 #include "weilgen/uq/distribution.hpp"
 
 namespace weilgen {
@@ -45,20 +46,6 @@ PoseSet parse_poses(const Description& desc, const std::vector<std::string>& at,
 constexpr std::size_t kMaxGridPoses = 10'000'000;
 
 // ---- Outputs and tolerances -------------------------------------------------------------------
-
-// dx, dy, dz (mm), da, db, dc (rad), and dp = ||(dx, dy, dz)|| (mm, nonnegative).
-enum class OutputId { Dx, Dy, Dz, Da, Db, Dc, Dp };
-constexpr int kNumOutputs = 7;
-const std::vector<OutputId>& all_outputs();  // Dx ... Dp
-const char* output_name(OutputId id);        // "dx"
-// Outputs 0..5 (dx ... dc) by index, for per-output arrays of measurements.
-inline const char* output_name(std::size_t index) {
-  return output_name(static_cast<OutputId>(index));
-}
-const char* output_unit(OutputId id);  // "mm" or "rad"
-bool output_is_angle(OutputId id);     // da, db, dc
-// "dx" ... "dp" (case-insensitive); throws std::invalid_argument listing the outputs.
-OutputId parse_output(const std::string& name);
 
 // --tolerance "dx=0.03mm" (repeatable, or comma-separated "dx=0.03mm,dy=30um"); value > 0, default
 // unit mm for positions (dx, dy, dz, dp) and rad for orientations (da, db, dc); a length unit on an

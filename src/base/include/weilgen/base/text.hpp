@@ -1,31 +1,21 @@
-// Small text helpers shared by the machine loader and the study-input parsers' messages.
+// Text helpers: joining, case, trimming, splitting and quoting, for messages and parsers.
+// Numbers are formatted in weilgen/base/format.hpp.
 #pragma once
 
-#include <cctype>
-#include <cstdio>
 #include <string>
 #include <vector>
 
 namespace weilgen {
 
 // "a, b, c".
-inline std::string join(const std::vector<std::string>& items) {
-  std::string out;
-  for (const std::string& s : items) out += (out.empty() ? "" : ", ") + s;
-  return out;
-}
-
+std::string join(const std::vector<std::string>& items);
 // ASCII lower case.
-inline std::string lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
-
-// A number for messages: "%g" (1000, 0.05, 1e-06).
-inline std::string format_short(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
+std::string lower(std::string s);
+// Without leading and trailing blanks (space, tab, CR, LF).
+std::string trim(const std::string& s);
+// Splits at every `sep` (empty items kept).
+std::vector<std::string> split(const std::string& s, char sep);
+// "\"text\"" for messages.
+std::string quoted(const std::string& s);
 
 }  // namespace weilgen

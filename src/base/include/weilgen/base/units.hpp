@@ -43,11 +43,4 @@ Quantity parse_quantity_unit(const std::string& text, const std::string& default
 double parse_quantity(const std::string& text, const std::string& default_unit,
                       const std::string& what);
 
-// Helpers shared by the study-input parsers.
-std::string trim(const std::string& s);
-// Splits at every `sep` (empty items kept).
-std::vector<std::string> split(const std::string& s, char sep);
-// "%g"-like text that reads back as the same double (shortest of 15, 16, 17 digits).
-std::string format_number(double v);
-
 }  // namespace weilgen

@@ -9,14 +9,9 @@
 
 #include "weilgen/codegen/weil.hpp"
 #include "weilgen/machine/description.hpp"
+#include "weilgen/machine/outputs.hpp"
 
 namespace weilgen::gen {
-
-inline constexpr int kNumOutputs = 6;
-inline const std::array<const char*, kNumOutputs> kOutputNames = {"dx", "dy", "dz",
-                                                                  "da", "db", "dc"};
-inline const std::array<const char*, kNumOutputs> kOutputUnits = {"mm",  "mm",  "mm",
-                                                                  "rad", "rad", "rad"};
 
 struct AxisSymbols {
   int body = -1;
@@ -40,8 +35,9 @@ struct SymbolicModel {
   std::vector<AxisSymbols> axes;    // in Description::axes() order
   std::vector<GiNaC::symbol> errors;
   std::vector<GiNaC::symbol> params;
-  std::array<Poly, kNumOutputs> outputs;  // deviation, as algebra elements (no constant term)
-  std::vector<Reciprocal> reciprocals;    // symbols standing for 1/divisor in coefficients
+  std::array<Poly, kNumDeviationOutputs>
+      outputs;                          // deviation, as algebra elements (no constant term)
+  std::vector<Reciprocal> reciprocals;  // symbols standing for 1/divisor in coefficients
   // The nominal pose P0 (every error zero): rows 0..2 of the 4x4 transform, R0 | p0, over the
   // coordinates, their cos/sin symbols and the parameters.
   std::array<std::array<GiNaC::ex, 4>, 3> nominal;

@@ -7,12 +7,10 @@
 #include <map>
 #include <string>
 
+#include "weilgen/base/format.hpp"
 #include "weilgen/codegen/cse.hpp"
 
 namespace weilgen::gen {
-
-// Shortest decimal text that reads back as the same double ("0.1", "1e-06", "2.0").
-std::string format_double(double v);
 
 struct OpCount {
   long adds = 0, muls = 0, divs = 0, functions = 0;

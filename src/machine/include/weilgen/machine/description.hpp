@@ -16,28 +16,10 @@
 #include <string>
 #include <vector>
 
+#include "weilgen/base/error.hpp"
 #include "weilgen/base/expr.hpp"
 
 namespace weilgen {
-
-struct SourceLoc {
-  std::string file;
-  int line = 0;             // 1-based; 0 = unknown
-  int column = 0;           // 1-based; 0 = unknown
-  std::string str() const;  // "file:line:column"
-};
-
-// Bad input in a machine file. what() is "file:line:column: message".
-class InputError : public std::runtime_error {
- public:
-  InputError(const SourceLoc& loc, const std::string& message);
-  const SourceLoc& loc() const { return loc_; }
-  const std::string& message() const { return message_; }
-
- private:
-  SourceLoc loc_;
-  std::string message_;
-};
 
 using Vec3 = std::array<double, 3>;
 

@@ -1,0 +1,21 @@
+// Numbers as text, in one place. Every printed number goes through one of these.
+#pragma once
+
+#include <string>
+
+namespace weilgen {
+
+// The shortest of 15, 16 or 17 significant digits that reads back as the same double ("%g"
+// style: 0.03, 1e-05, 1500): file values, labels, JSON-equivalent text.
+std::string format_number(double v);
+// "%g" (6 significant digits): numbers inside messages.
+std::string format_short(double v);
+// Fixed-point with `decimals` digits after the point; "-" for NaN and infinities: table cells.
+std::string format_fixed(double v, int decimals);
+// `digits` significant digits (std::setprecision); "-" for NaN and infinities: table cells.
+std::string format_significant(double v, int digits);
+// A C++ double literal: the shortest decimal (1 to 17 digits) that reads back as v, with ".0"
+// appended when it would otherwise read as an integer (generated code).
+std::string format_literal(double v);
+
+}  // namespace weilgen
