@@ -39,7 +39,7 @@ AllocationProblem synthetic_problem(std::size_t* calls = nullptr) {
       rp.inputs = inputs;
       rp.linear = forms[c];
       rp.tolerance = kT;
-      const auto r = compute_reliability(rp, ReliabilityOptions{});
+      const auto r = ReliabilityAnalysis(ReliabilityOptions{}).run(rp);
       cases.push_back(AllocationCase{c < 3 ? 0u : 1u, r.reliability, r.dR_dsigma});
     }
     return cases;
@@ -82,7 +82,7 @@ TEST_CASE("allocation: the step procedure on a problem followed by hand") {
   // dy needs s1 <= 0.01108 for the minimum and s1 <= 0.0100 (step 2) for the mean >= 0.97.
   const AllocationProblem problem = synthetic_problem();
   AllocationOptions o = synthetic_options();
-  const AllocationResult res = allocate_steps(problem, o);
+  const AllocationResult res = StepAllocation(o).run(problem);
   CHECK(res.met);
   CHECK(res.note.empty());
   CHECK(res.chosen == std::vector<std::size_t>{0, 1});
@@ -118,7 +118,7 @@ TEST_CASE("allocation: the step procedure on a problem followed by hand") {
 
   // Tightening only the failing groups' choices: dy stops after step 2 at s1 = 0.010.
   o.per_group = true;
-  const AllocationResult pg = allocate_steps(problem, o);
+  const AllocationResult pg = StepAllocation(o).run(problem);
   CHECK(pg.met);
   REQUIRE(pg.steps.size() == 7);
   CHECK(pg.steps[2].tightened == std::vector<std::size_t>{0, 1});
@@ -132,7 +132,7 @@ TEST_CASE("allocation: targets met at the start, and targets out of reach") {
   AllocationOptions o = synthetic_options();
   o.min_target = 0.85;
   o.mean_target = 0.9;
-  const AllocationResult easy = allocate_steps(problem, o);
+  const AllocationResult easy = StepAllocation(o).run(problem);
   CHECK(easy.met);
   CHECK(easy.steps.size() == 1);
   CHECK(easy.chosen.empty());
@@ -142,7 +142,7 @@ TEST_CASE("allocation: targets met at the start, and targets out of reach") {
   // small they get; x3 (0.002, step 0.0005) would reach 0 at step 4.
   o = synthetic_options();
   o.chosen = {2, 3};
-  const AllocationResult stuck = allocate_steps(problem, o);
+  const AllocationResult stuck = StepAllocation(o).run(problem);
   CHECK_FALSE(stuck.met);
   CHECK(stuck.steps.size() == 4);
   CHECK(stuck.note ==
@@ -152,7 +152,7 @@ TEST_CASE("allocation: targets met at the start, and targets out of reach") {
 
   o = synthetic_options();
   o.max_steps = 3;
-  const AllocationResult short_run = allocate_steps(problem, o);
+  const AllocationResult short_run = StepAllocation(o).run(problem);
   CHECK_FALSE(short_run.met);
   CHECK(short_run.steps.size() == 4);
   CHECK(short_run.note == "the targets are not met after 3 steps");
@@ -162,13 +162,13 @@ TEST_CASE("allocation: cost-aware mode meets the targets at a lower cost") {
   std::size_t calls = 0;
   const AllocationProblem problem = synthetic_problem(&calls);
   AllocationOptions o = synthetic_options();
-  const AllocationResult steps = allocate_steps(problem, o);
+  const AllocationResult steps = StepAllocation(o).run(problem);
   REQUIRE(steps.met);
   o.per_group = true;
-  const AllocationResult pg = allocate_steps(problem, o);
+  const AllocationResult pg = StepAllocation(o).run(problem);
   o.per_group = false;
   calls = 0;
-  const AllocationResult res = allocate_cost_aware(problem, o, steps);
+  const AllocationResult res = CostAwareAllocation(o).run(problem, steps);
   CHECK(res.steps.size() == steps.steps.size());
   CHECK(res.cost_aware_met);
   CHECK(res.cost_aware_evaluations == calls);
@@ -207,7 +207,7 @@ TEST_CASE("allocation: cost-aware mode meets the targets at a lower cost") {
   // Weights: making x0 very expensive to tighten moves the burden to x2.
   AllocationOptions w = o;
   w.cost_weights = {100.0, 1.0, 1.0, 1.0};
-  const AllocationResult rw = allocate_cost_aware(problem, w, steps);
+  const AllocationResult rw = CostAwareAllocation(w).run(problem, steps);
   CHECK(rw.cost_aware_met);
   CHECK(rw.cost_aware_stddev[0] > res.cost_aware_stddev[0]);
   CHECK(rw.cost_aware_stddev[2] < res.cost_aware_stddev[2]);
@@ -217,33 +217,34 @@ TEST_CASE("allocation: bad problems throw std::invalid_argument") {
   const AllocationProblem problem = synthetic_problem();
   AllocationOptions o = synthetic_options();
   o.step.pop_back();
-  CHECK_THROWS_AS(allocate_steps(problem, o), std::invalid_argument);
+  CHECK_THROWS_AS(StepAllocation(o).run(problem), std::invalid_argument);
   o = synthetic_options();
   o.chosen = {7};
-  CHECK_THROWS_AS(allocate_steps(problem, o), std::invalid_argument);
+  CHECK_THROWS_AS(StepAllocation(o).run(problem), std::invalid_argument);
   o.chosen = {1, 1};
-  CHECK_THROWS_AS(allocate_steps(problem, o), std::invalid_argument);
+  CHECK_THROWS_AS(StepAllocation(o).run(problem), std::invalid_argument);
   o = synthetic_options();
   o.step[1] = 0;
   o.chosen = {1};
-  CHECK_THROWS_WITH_AS(allocate_steps(problem, o), doctest::Contains("x1 has no positive step"),
+  CHECK_THROWS_WITH_AS(StepAllocation(o).run(problem), doctest::Contains("x1 has no positive step"),
                        std::invalid_argument);
   o = synthetic_options();
   o.min_target = 1.5;
-  CHECK_THROWS_AS(allocate_steps(problem, o), std::invalid_argument);
+  CHECK_THROWS_AS(StepAllocation(o).run(problem), std::invalid_argument);
   AllocationProblem bad = problem;
   bad.evaluate = [](const std::vector<InputDistribution>&) {
     return std::vector<AllocationCase>{AllocationCase{0, 0.9, {0, 0, 0, 0}}};
   };
-  CHECK_THROWS_WITH_AS(allocate_steps(bad, synthetic_options()),
+  CHECK_THROWS_WITH_AS(StepAllocation(synthetic_options()).run(bad),
                        doctest::Contains("group dy has no cases"), std::invalid_argument);
   bad.evaluate = [](const std::vector<InputDistribution>&) {
     return std::vector<AllocationCase>{AllocationCase{0, 0.9, {0, 0}},
                                        AllocationCase{1, 0.9, {0, 0, 0, 0}}};
   };
-  CHECK_THROWS_AS(allocate_steps(bad, synthetic_options()), std::invalid_argument);
+  CHECK_THROWS_AS(StepAllocation(synthetic_options()).run(bad), std::invalid_argument);
   o = synthetic_options();
   o.sigma_lower = {0.0, 0.0, 0.0, 0.0};
-  CHECK_THROWS_AS(allocate_cost_aware(problem, o, allocate_steps(problem, synthetic_options())),
-                  std::invalid_argument);
+  CHECK_THROWS_AS(
+      CostAwareAllocation(o).run(problem, StepAllocation(synthetic_options()).run(problem)),
+      std::invalid_argument);
 }

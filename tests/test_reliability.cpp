@@ -115,7 +115,7 @@ TEST_CASE(
     for (double t : {0.01, 0.03, 0.06}) {
       CAPTURE(std::string(to_string(kind)));
       CAPTURE(t);
-      const auto res = compute_reliability(lc.problem(kind, t), ReliabilityOptions{});
+      const auto res = ReliabilityAnalysis(ReliabilityOptions{}).run(lc.problem(kind, t));
       CHECK(res.method == ReliabilityMethod::Exact);
       const double R = lc.closed_form(kind, t);
       CHECK(res.reliability == doctest::Approx(R).epsilon(1e-13));
@@ -155,12 +155,13 @@ TEST_CASE("reliability: FORM and IS are exact for a linear Gaussian limit state"
       const double t = 0.03;
       const auto p = callback ? lc.callback_problem(kind, t) : lc.problem(kind, t);
       const auto ex =
-          compute_reliability(lc.problem(kind, t), with_method(ReliabilityMethod::Exact));
-      const auto form = compute_reliability(p, with_method(ReliabilityMethod::Form));
-      const auto is = compute_reliability(p, with_method(ReliabilityMethod::ImportanceSampling));
+          ReliabilityAnalysis(with_method(ReliabilityMethod::Exact)).run(lc.problem(kind, t));
+      const auto form = ReliabilityAnalysis(with_method(ReliabilityMethod::Form)).run(p);
+      const auto is =
+          ReliabilityAnalysis(with_method(ReliabilityMethod::ImportanceSampling)).run(p);
       ReliabilityOptions so = with_method(ReliabilityMethod::ImportanceSampling);
       so.sensitivities = SensitivityMethod::Sampling;
-      const auto is_s = compute_reliability(p, so);
+      const auto is_s = ReliabilityAnalysis(so).run(p);
       CHECK(form.method == ReliabilityMethod::Form);
       CHECK(is.method == ReliabilityMethod::ImportanceSampling);
       const std::size_t sides = kind == LimitKind::TwoSided ? 2 : 1;
@@ -215,11 +216,12 @@ TEST_CASE("reliability: non-Gaussian inputs, FORM and IS against a long Monte Ca
     CAPTURE(std::string(to_string(kind)));
     p.limit = kind;
     p.tolerance = 0.04;
-    CHECK_THROWS_AS(compute_reliability(p, with_method(ReliabilityMethod::Exact)),
+    CHECK_THROWS_AS(ReliabilityAnalysis(with_method(ReliabilityMethod::Exact)).run(p),
                     std::invalid_argument);
-    const auto mc = compute_reliability(p, with_method(ReliabilityMethod::MonteCarlo, 1u << 22));
-    const auto is = compute_reliability(p, ReliabilityOptions{});  // Auto: IS
-    const auto form = compute_reliability(p, with_method(ReliabilityMethod::Form));
+    const auto mc =
+        ReliabilityAnalysis(with_method(ReliabilityMethod::MonteCarlo, 1u << 22)).run(p);
+    const auto is = ReliabilityAnalysis(ReliabilityOptions{}).run(p);  // Auto: IS
+    const auto form = ReliabilityAnalysis(with_method(ReliabilityMethod::Form)).run(p);
     CHECK(is.method == ReliabilityMethod::ImportanceSampling);
     const double se_mc = mc.cov * mc.failure, se_is = is.cov * is.failure;
     MESSAGE(std::string(to_string(kind))
@@ -242,7 +244,7 @@ TEST_CASE("reliability: a curved limit state where FORM is wrong and IS converge
   const double kappa = 0.15, t = 3.0;
   const double exact = curved_exact(kappa, t);
   const ReliabilityProblem p = curved_problem(kappa, t);
-  const auto form = compute_reliability(p, with_method(ReliabilityMethod::Form));
+  const auto form = ReliabilityAnalysis(with_method(ReliabilityMethod::Form)).run(p);
   REQUIRE(form.design_points.size() == 1);
   CHECK(form.design_points[0].converged);
   CHECK(form.design_points[0].beta == doctest::Approx(t).epsilon(1e-8));
@@ -254,7 +256,8 @@ TEST_CASE("reliability: a curved limit state where FORM is wrong and IS converge
   // line), so the error at N lines is about 2.24 / sqrt(N) relative.
   for (std::size_t n : {std::size_t(1) << 10, std::size_t(1) << 12, std::size_t(1) << 14,
                         std::size_t(1) << 16, std::size_t(1) << 18}) {
-    const auto is = compute_reliability(p, with_method(ReliabilityMethod::ImportanceSampling, n));
+    const auto is =
+        ReliabilityAnalysis(with_method(ReliabilityMethod::ImportanceSampling, n)).run(p);
     const double err = std::abs(is.failure - exact) / exact;
     MESSAGE("curved IS N=" << n << ": P_f " << is.failure << " relative error " << err << " CoV "
                            << is.cov << " evaluations " << is.evaluations);
@@ -269,7 +272,7 @@ TEST_CASE("reliability: a curved limit state where FORM is wrong and IS converge
   for (int seed = 1; seed <= seeds; ++seed) {
     ReliabilityOptions o = with_method(ReliabilityMethod::ImportanceSampling, 4096);
     o.seed = static_cast<std::uint64_t>(seed);
-    const auto is = compute_reliability(p, o);
+    const auto is = ReliabilityAnalysis(o).run(p);
     mean += is.failure / seeds;
     if (is.ci_lo <= 1 - exact && is.ci_hi >= 1 - exact) ++covered;
   }
@@ -281,7 +284,7 @@ TEST_CASE("reliability: a curved limit state where FORM is wrong and IS converge
   // differentiated IS estimate (consistent) and FORM's (off like FORM's P_f).
   ReliabilityOptions so = with_method(ReliabilityMethod::ImportanceSampling, 1u << 16);
   so.sensitivities = SensitivityMethod::Sampling;
-  const auto is_s = compute_reliability(p, so);
+  const auto is_s = ReliabilityAnalysis(so).run(p);
   const double h = 1e-4;
   const double ref_dmu[2] = {
       -(curved_exact(kappa, t, h, 1, 0, 1) - curved_exact(kappa, t, -h, 1, 0, 1)) / (2 * h),
@@ -302,7 +305,7 @@ TEST_CASE("reliability: a curved limit state where FORM is wrong and IS converge
   CHECK(std::abs(form.dR_dmu[0] - ref_dmu[0]) > 0.2 * std::abs(ref_dmu[0]));
   CHECK(form.dR_dsigma[1] == 0);  // the design point has x2 = 0: FORM sees no effect of sigma2
   // Monte Carlo agrees too.
-  const auto mc = compute_reliability(p, with_method(ReliabilityMethod::MonteCarlo, 1u << 22));
+  const auto mc = ReliabilityAnalysis(with_method(ReliabilityMethod::MonteCarlo, 1u << 22)).run(p);
   CHECK(mc.ci_lo <= 1 - exact);
   CHECK(mc.ci_hi >= 1 - exact);
 }
@@ -324,8 +327,8 @@ TEST_CASE("reliability: radial limit (upper on a norm of zero-mean inputs)") {
     p.limit = LimitKind::Upper;
     p.tolerance = t;
     const double exact = n == 2 ? std::exp(-t * t / 2) : 2 * Phi(-t) + 2 * t * phi(t);
-    const auto form = compute_reliability(p, with_method(ReliabilityMethod::Form));
-    const auto is = compute_reliability(p, with_method(ReliabilityMethod::ImportanceSampling));
+    const auto form = ReliabilityAnalysis(with_method(ReliabilityMethod::Form)).run(p);
+    const auto is = ReliabilityAnalysis(with_method(ReliabilityMethod::ImportanceSampling)).run(p);
     MESSAGE("radial n=" << n << ": exact P_f " << exact << ", FORM " << form.failure << ", IS "
                         << is.failure << " (CoV " << is.cov << ")");
     REQUIRE(form.design_points.size() == 2);  // a design point and its mirror
@@ -342,7 +345,7 @@ TEST_CASE("reliability: radial limit (upper on a norm of zero-mean inputs)") {
     const double dP_dsigma = (n == 2 ? exact * t * t : 2 * t * t * phi(t) * t) / sigma / n;
     ReliabilityOptions so = with_method(ReliabilityMethod::ImportanceSampling);
     so.sensitivities = SensitivityMethod::Sampling;
-    const auto is_s = compute_reliability(p, so);
+    const auto is_s = ReliabilityAnalysis(so).run(p);
     for (int i = 0; i < n; ++i) {
       CAPTURE(i);
       CHECK(is_s.dR_dsigma[i] == doctest::Approx(-dP_dsigma).epsilon(0.08));
@@ -360,7 +363,7 @@ TEST_CASE("reliability: Monte Carlo interval covers the exact value and reports 
   for (std::uint64_t seed : {1u, 2u, 3u}) {
     ReliabilityOptions o = with_method(ReliabilityMethod::MonteCarlo, 200000);
     o.seed = seed;
-    const auto mc = compute_reliability(p, o);
+    const auto mc = ReliabilityAnalysis(o).run(p);
     CAPTURE(seed);
     CHECK(mc.method == ReliabilityMethod::MonteCarlo);
     CHECK(mc.ci_lo <= R);
@@ -393,11 +396,11 @@ TEST_CASE("reliability: bit-identical results for any thread count") {
       CAPTURE(std::string(to_string(m)));
       ReliabilityOptions o = with_method(m, m == ReliabilityMethod::MonteCarlo ? 50000 : 5000);
       o.threads = 1;
-      const auto ref = compute_reliability(*p, o);
+      const auto ref = ReliabilityAnalysis(o).run(*p);
       for (unsigned th : {2u, 3u, 8u}) {
         max_thread = 0;
         o.threads = th;
-        const auto r = compute_reliability(*p, o);
+        const auto r = ReliabilityAnalysis(o).run(*p);
         CAPTURE(th);
         CHECK(same_bits(r.reliability, ref.reliability));
         CHECK(same_bits(r.cov, ref.cov));
@@ -409,7 +412,7 @@ TEST_CASE("reliability: bit-identical results for any thread count") {
       }
       o.seed = 2;
       o.threads = 2;
-      CHECK(!same_bits(compute_reliability(*p, o).reliability, ref.reliability));
+      CHECK(!same_bits(ReliabilityAnalysis(o).run(*p).reliability, ref.reliability));
     }
   }
 }
@@ -423,7 +426,7 @@ TEST_CASE("reliability: constant inputs are fixed at their mean and keep a mean 
   LinearCase shifted = lc;
   shifted.c0 += 0.002;
   const double R = shifted.closed_form(LimitKind::TwoSided, 0.03);
-  const auto ex = compute_reliability(p, ReliabilityOptions{});
+  const auto ex = ReliabilityAnalysis(ReliabilityOptions{}).run(p);
   CHECK(ex.reliability == doctest::Approx(R).epsilon(1e-13));
   CHECK(ex.dR_dsigma[5] == 0);
   CHECK(ex.dR_dmu[5] == doctest::Approx(2 * ex.dR_dmu[0] / lc.c[0]).epsilon(1e-12));
@@ -433,7 +436,7 @@ TEST_CASE("reliability: constant inputs are fixed at their mean and keep a mean 
   q.response = [](unsigned, const double* x) {
     return 0.002 + x[0] - 2 * x[1] + 0.5 * x[2] + 3 * x[3] - 1.5 * x[4] + 2 * x[5];
   };
-  const auto form = compute_reliability(q, with_method(ReliabilityMethod::Form));
+  const auto form = ReliabilityAnalysis(with_method(ReliabilityMethod::Form)).run(q);
   CHECK(form.reliability == doctest::Approx(R).epsilon(1e-8));
   CHECK(form.dR_dmu[5] == doctest::Approx(ex.dR_dmu[5]).epsilon(1e-5));
   CHECK(form.design_points[0].u.size() == 6);
@@ -444,48 +447,48 @@ TEST_CASE("reliability: constant inputs are fixed at their mean and keep a mean 
   d.inputs = {InputDistribution::normal(0.01, 0), InputDistribution::uniform(0.02, 0.02)};
   d.response = [](unsigned, const double* x) { return x[0] + x[1]; };
   d.tolerance = 0.025;
-  CHECK(compute_reliability(d, ReliabilityOptions{}).reliability == 0.0);
+  CHECK(ReliabilityAnalysis(ReliabilityOptions{}).run(d).reliability == 0.0);
   d.tolerance = 0.035;
-  CHECK(compute_reliability(d, ReliabilityOptions{}).reliability == 1.0);
+  CHECK(ReliabilityAnalysis(ReliabilityOptions{}).run(d).reliability == 1.0);
   // Zero spread in the exact method.
   ReliabilityProblem z = lc.problem(LimitKind::Upper, 0.03);
   for (auto& in : z.inputs) in = in.with_mean_stddev(in.mean(), 0.0);
-  CHECK(compute_reliability(z, ReliabilityOptions{}).reliability == 1.0);
+  CHECK(ReliabilityAnalysis(ReliabilityOptions{}).run(z).reliability == 1.0);
 }
 
 TEST_CASE("reliability: bad problems throw std::invalid_argument") {
   const LinearCase lc;
   const ReliabilityOptions o;
   auto p = lc.problem(LimitKind::TwoSided, 0.0);
-  CHECK_THROWS_AS(compute_reliability(p, o), std::invalid_argument);
+  CHECK_THROWS_AS(ReliabilityAnalysis(o).run(p), std::invalid_argument);
   p.tolerance = -0.01;
-  CHECK_THROWS_AS(compute_reliability(p, o), std::invalid_argument);
+  CHECK_THROWS_AS(ReliabilityAnalysis(o).run(p), std::invalid_argument);
   p.tolerance = std::nan("");
-  CHECK_THROWS_AS(compute_reliability(p, o), std::invalid_argument);
+  CHECK_THROWS_AS(ReliabilityAnalysis(o).run(p), std::invalid_argument);
   p.tolerance = 0.03;
   ReliabilityProblem empty = p;
   empty.inputs.clear();
   empty.linear->coefficients.clear();
-  CHECK_THROWS_AS(compute_reliability(empty, o), std::invalid_argument);
+  CHECK_THROWS_AS(ReliabilityAnalysis(o).run(empty), std::invalid_argument);
   ReliabilityProblem wrong = p;
   wrong.linear->coefficients.pop_back();
-  CHECK_THROWS_AS(compute_reliability(wrong, o), std::invalid_argument);
+  CHECK_THROWS_AS(ReliabilityAnalysis(o).run(wrong), std::invalid_argument);
   ReliabilityProblem none = p;
   none.linear.reset();
-  CHECK_THROWS_AS(compute_reliability(none, o), std::invalid_argument);
+  CHECK_THROWS_AS(ReliabilityAnalysis(o).run(none), std::invalid_argument);
   // Exact on a non-Gaussian input or a non-linear response.
   ReliabilityProblem ng = p;
   ng.inputs[2] = InputDistribution::uniform(-0.01, 0.01);
-  CHECK_THROWS_WITH_AS(compute_reliability(ng, with_method(ReliabilityMethod::Exact)),
+  CHECK_THROWS_WITH_AS(ReliabilityAnalysis(with_method(ReliabilityMethod::Exact)).run(ng),
                        doctest::Contains("input 2 is uniform"), std::invalid_argument);
   CHECK_THROWS_WITH_AS(
-      compute_reliability(curved_problem(0.1, 3), with_method(ReliabilityMethod::Exact)),
+      ReliabilityAnalysis(with_method(ReliabilityMethod::Exact)).run(curved_problem(0.1, 3)),
       doctest::Contains("linear"), std::invalid_argument);
-  CHECK_THROWS_AS(compute_reliability(p, with_method(ReliabilityMethod::MonteCarlo, 0)),
+  CHECK_THROWS_AS(ReliabilityAnalysis(with_method(ReliabilityMethod::MonteCarlo, 0)).run(p),
                   std::invalid_argument);
   ReliabilityOptions bad_conf;
   bad_conf.confidence = 1.0;
-  CHECK_THROWS_AS(compute_reliability(p, bad_conf), std::invalid_argument);
+  CHECK_THROWS_AS(ReliabilityAnalysis(bad_conf).run(p), std::invalid_argument);
 }
 
 TEST_CASE("reliability: method names") {

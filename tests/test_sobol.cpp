@@ -115,8 +115,8 @@ double max_error(const SobolIndices& s, const Analytic& exact) {
 SobolResult run_scalar(const std::vector<InputDistribution>& inputs, double (*fn)(const double*),
                        const SobolOptions& options) {
   const SobolDesign design(inputs, options);
-  return estimate_sobol(
-      design, 1, [fn](unsigned, const double* x, double* y) { *y = fn(x); }, options);
+  return SobolAnalysis(options).run(design, 1,
+                                    [fn](unsigned, const double* x, double* y) { *y = fn(x); });
 }
 
 double linear_f(const double* x) { return 10 + 3 * x[0] + x[1] + 0 * x[2]; }
@@ -343,13 +343,10 @@ TEST_CASE("Sobol' indices: constant inputs are not perturbed and get exactly 0")
   CHECK(design.varying() == std::vector<std::size_t>{0, 2, 3});
   for (std::size_t j = 0; j < design.samples(); ++j)
     REQUIRE((design.a(j)[1] == 5.0 && design.b(j)[1] == 5.0));
-  const SobolResult r = estimate_sobol(
-      design, 1,
-      [](unsigned, const double* x, double* y) {
-        const double x3[3] = {x[0], x[2], x[3]};
-        *y = ishigami(x3);
-      },
-      o);
+  const SobolResult r = SobolAnalysis(o).run(design, 1, [](unsigned, const double* x, double* y) {
+    const double x3[3] = {x[0], x[2], x[3]};
+    *y = ishigami(x3);
+  });
   CHECK(r.evaluations == o.samples * 5);  // N (2 + 3): no A_B^2 evaluations
   const SobolIndices& s = r.outputs[0];
   const SobolIndices& t = ref.outputs[0];
@@ -374,14 +371,11 @@ TEST_CASE("Sobol' indices: zero-variance outputs give zeros, not NaN") {
   o.samples = 1u << 9;
   o.bootstrap = 20;
   const SobolDesign design(ishigami_inputs(), o);
-  const SobolResult r = estimate_sobol(
-      design, 3,
-      [](unsigned, const double* x, double* y) {
-        y[0] = ishigami(x);
-        y[1] = 4.2;                 // exactly constant
-        y[2] = 1e6 + 1e-12 * x[0];  // variation below the rounding of 1e6 (ulp 1.2e-10)
-      },
-      o);
+  const SobolResult r = SobolAnalysis(o).run(design, 3, [](unsigned, const double* x, double* y) {
+    y[0] = ishigami(x);
+    y[1] = 4.2;                 // exactly constant
+    y[2] = 1e6 + 1e-12 * x[0];  // variation below the rounding of 1e6 (ulp 1.2e-10)
+  });
   REQUIRE(r.outputs.size() == 3);
   CHECK(r.outputs[0].variance > 1);
   CHECK(r.outputs[1].mean == 4.2);
@@ -417,15 +411,13 @@ TEST_CASE("Sobol' indices are bit-identical for 1, 2 and 3 threads") {
       o.threads = threads;
       const SobolDesign design(ishigami_inputs(), o);
       std::vector<unsigned> seen(threads, 0);
-      results.push_back(estimate_sobol(
-          design, 2,
-          [&seen, threads](unsigned t, const double* x, double* y) {
+      results.push_back(
+          SobolAnalysis(o).run(design, 2, [&seen, threads](unsigned t, const double* x, double* y) {
             REQUIRE(t < threads);
             ++seen[t];
             y[0] = ishigami(x);
             y[1] = x[0] * x[1] + x[2];
-          },
-          o));
+          }));
     }
     for (std::size_t t = 1; t < results.size(); ++t) {
       CAPTURE(t);
@@ -455,15 +447,15 @@ TEST_CASE("Sobol' indices: resamples drawn by the design equal those drawn per e
   bare.bootstrap = 0;
   const SobolDesign plain(ishigami_inputs(), bare);  // same points, no resamples
   const VectorFunction f = [](unsigned, const double* x, double* y) { *y = ishigami(x); };
-  const SobolIndices a = estimate_sobol(cached, 1, f, o).outputs[0];
-  const SobolIndices b = estimate_sobol(plain, 1, f, o).outputs[0];
+  const SobolIndices a = SobolAnalysis(o).run(cached, 1, f).outputs[0];
+  const SobolIndices b = SobolAnalysis(o).run(plain, 1, f).outputs[0];
   CHECK(a.first == b.first);
   CHECK(a.first_lo == b.first_lo);
   CHECK(a.total_hi == b.total_hi);
   // Another bootstrap seed on the same design: same estimates, other intervals.
   SobolOptions other = o;
   other.seed = 6;
-  const SobolIndices c = estimate_sobol(cached, 1, f, other).outputs[0];
+  const SobolIndices c = SobolAnalysis(other).run(cached, 1, f).outputs[0];
   CHECK(c.first == a.first);
   CHECK(c.total == a.total);
   CHECK(c.first_lo != a.first_lo);
@@ -511,10 +503,10 @@ TEST_CASE("Sobol' design: invalid options are rejected with a clear message") {
     for (std::size_t i = 0; i < 3; ++i) REQUIRE(std::abs(d.a(j)[i]) < kPi);
   // A throwing function: the exception reaches the caller.
   CHECK_THROWS_AS(
-      estimate_sobol(
-          d, 1, [](unsigned, const double*, double*) { throw std::runtime_error("x"); }, o),
+      SobolAnalysis(o).run(d, 1,
+                           [](unsigned, const double*, double*) { throw std::runtime_error("x"); }),
       std::runtime_error);
-  CHECK_THROWS_AS(estimate_sobol(
-                      d, 1, [](unsigned, const double*, double* y) { *y = std::nan(""); }, o),
-                  std::runtime_error);
+  CHECK_THROWS_AS(
+      SobolAnalysis(o).run(d, 1, [](unsigned, const double*, double* y) { *y = std::nan(""); }),
+      std::runtime_error);
 }

@@ -536,7 +536,7 @@ int run(const Options& opt) {
         for (std::size_t o = 0; o < kOutputs; ++o) y[o] = w.out[o];
       };
       t0 = std::chrono::steady_clock::now();
-      const SobolResult r = estimate_sobol(design, kOutputs, fn, so);
+      const SobolResult r = SobolAnalysis(so).run(design, kOutputs, fn);
       run.pose_seconds[p] = seconds_since(t0);
       run.sobol_seconds += run.pose_seconds[p];
       run.evaluations += r.evaluations;

@@ -85,8 +85,8 @@ double error(const Problem& p, Sampling sampling, std::size_t n, std::uint64_t s
   const SobolDesign design(p.inputs, o);
   const auto fn = p.f;
   const SobolIndices s =
-      estimate_sobol(
-          design, 1, [fn](unsigned, const double* x, double* y) { *y = fn(x); }, o)
+      SobolAnalysis(o)
+          .run(design, 1, [fn](unsigned, const double* x, double* y) { *y = fn(x); })
           .outputs[0];
   double e = 0;
   for (std::size_t i = 0; i < p.first.size(); ++i)
@@ -176,11 +176,11 @@ void timing(unsigned threads, int repeats) {
     SobolResult r0, r1, rt;
     SobolOptions o0 = o;
     o0.bootstrap = 0;
-    const double t_est0 = best([&] { r0 = estimate_sobol(design, m, model, o0); });
-    const double t_est1 = best([&] { r1 = estimate_sobol(design, m, model, o); });
+    const double t_est0 = best([&] { r0 = SobolAnalysis(o0).run(design, m, model); });
+    const double t_est1 = best([&] { r1 = SobolAnalysis(o).run(design, m, model); });
     SobolOptions ot = o;
     ot.threads = threads;
-    const double t_estt = best([&] { rt = estimate_sobol(design, m, model, ot); });
+    const double t_estt = best([&] { rt = SobolAnalysis(ot).run(design, m, model); });
     std::printf("| 2^%d | %zu | %.3f (%.0f ns each) | %.3f | %.3f | %.3f | %.3f |\n",
                 static_cast<int>(std::log2(static_cast<double>(n))), r0.evaluations, t_bare,
                 1e9 * t_bare / static_cast<double>(r0.evaluations), t_design, t_est0, t_est1,

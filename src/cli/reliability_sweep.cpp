@@ -119,7 +119,7 @@ std::vector<SweepCase> reliability_sweep(const Study& st,
                                 (sensitivities == SensitivityChoice::Auto && out == OutputId::Dp)
                             ? SensitivityMethod::Sampling
                             : SensitivityMethod::Form;
-      cases.push_back({p, k, compute_reliability(prob, o)});
+      cases.push_back({p, k, ReliabilityAnalysis(o).run(prob)});
       progress.update(cases.size());
     }
   }

@@ -9,14 +9,7 @@
 
 #include "weilgen/base/atomic_file.hpp"
 #include "weilgen/base/format.hpp"
-#include "weilgen/base/parallel.hpp"
 #include "weilgen/base/text.hpp"
-#include "weilgen/base/units.hpp"
-#include "weilgen/codegen/generate.hpp"
-#include "weilgen/machine/model_key.hpp"
-#include "weilgen/machine/yaml_loader.hpp"
-#include "weilgen/model/builtin_models.hpp"
-#include "weilgen/model/model_loader.hpp"
 
 namespace po = boost::program_options;
 
@@ -75,134 +68,34 @@ void add_study_options(po::options_description& opts, StudyFlags& f, bool with_t
   opts.add(model).add(where).add(out);
 }
 
-namespace {
-
-GeneratedHeader generate_for_loader(const Description& d, int order) {
-  GeneratedHeader h;
-  h.text = gen::generate_header(d, order, &h.name_space);
-  return h;
+StudyRequest study_request(const StudyFlags& f) {
+  StudyRequest r;
+  r.machine = f.machine;
+  r.order = f.order;
+  r.engine = f.engine;
+  r.compiler = f.compiler;
+  r.params = f.params;
+  r.at = f.at;
+  r.grid = f.grid;
+  r.tolerance = f.tolerance;
+  r.set = f.set;
+  r.tolerance_files = f.tolerance_files;
+  r.threads = f.threads;
+  if (!f.quiet) r.log = [](const std::string& m) { std::cerr << "weilgen: " << m << "\n"; };
+  return r;
 }
-
-std::vector<double> parse_params(const Description& d, const std::vector<std::string>& flags,
-                                 std::vector<double> values) {
-  for (const auto& flag : flags) {
-    const auto eq = flag.find('=');
-    if (eq == std::string::npos)
-      throw std::invalid_argument("--param: \"" + flag + "\": expected NAME=VALUE");
-    const std::string name = trim(flag.substr(0, eq));
-    std::size_t k = 0;
-    while (k < d.parameters.size() && d.parameters[k].name != name) ++k;
-    if (k == d.parameters.size()) {
-      std::string known;
-      for (const auto& p : d.parameters) known += (known.empty() ? "" : ", ") + p.name;
-      throw std::invalid_argument("--param: unknown parameter \"" + name + "\" (machine " + d.name +
-                                  " has " + (known.empty() ? "none" : known) + ")");
-    }
-    const std::string unit = d.parameters[k].unit;
-    values[k] =
-        parse_quantity_unit(flag.substr(eq + 1), unit, "--param " + name).in(parse_unit(unit));
-  }
-  return values;
-}
-
-}  // namespace
 
 std::shared_ptr<Model> open_model(const StudyFlags& f, const Description& desc) {
-  if (f.order < 0) throw std::invalid_argument("--order must be >= 1");
-  LoadOptions lo;
-  lo.order = f.order;
-  if (f.engine == "auto")
-    lo.engine = EngineChoice::Auto;
-  else if (f.engine == "compiled")
-    lo.engine = EngineChoice::Compiled;
-  else if (f.engine == "numeric")
-    lo.engine = EngineChoice::Numeric;
-  else
-    throw std::invalid_argument("--engine must be auto, compiled or numeric, not '" + f.engine +
-                                "'");
-  lo.compiler = f.compiler;
-  lo.builtins = builtin_models();
-  lo.generate = generate_for_loader;
-  if (!f.quiet) lo.log = [](const std::string& m) { std::cerr << "weilgen: " << m << "\n"; };
-  std::shared_ptr<Model> model = load_model(desc, lo);
-  // Parameters are part of what the machine is: set before the model is shared.
-  if (!f.params.empty()) model->set_parameters(parse_params(desc, f.params, model->parameters()));
-  return model;
+  return weilgen::open_model(study_request(f), desc);
 }
 
 Study open_study(const StudyFlags& f, bool need_tolerances) {
-  if (f.machine.empty()) throw std::invalid_argument("no machine given");
-  const Description desc = load_machine_file(resolve_machine(f.machine));
-  Study s;
-  s.poses = parse_poses(desc, f.at, f.grid);
-  s.inputs = error_distributions(desc, f.tolerance_files, f.set);
-  if (need_tolerances) {
-    if (f.tolerance.empty()) throw std::invalid_argument("no --tolerance given (e.g. dx=0.03mm)");
-    s.tolerances = parse_tolerances(f.tolerance);
-  }
-  s.model = open_model(f, desc);
-  s.threads = resolve_threads(f.threads);
-  return s;
-}
-
-std::string pose_label(const PoseSet& poses, std::size_t i) {
-  std::string s;
-  for (std::size_t a = 0; a < poses.axes.size(); ++a)
-    s += (a ? " " : "") + poses.axes[a] + "=" + format_number(poses.poses[i][a]);
-  return s;
-}
-
-nlohmann::json pose_json(const PoseSet& poses, std::size_t i) {
-  nlohmann::json j = nlohmann::json::object();
-  for (std::size_t a = 0; a < poses.axes.size(); ++a) j[poses.axes[a]] = poses.poses[i][a];
-  return j;
-}
-
-nlohmann::json json_number(double v) {
-  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json();
-}
-
-nlohmann::json model_json(const Model& m) {
-  const Description& d = m.description();
-  nlohmann::json axes = nlohmann::json::array();
-  for (int b : d.axes())
-    axes.push_back({{"name", d.bodies[b].joint.coordinate}, {"unit", d.bodies[b].joint.unit}});
-  return {{"machine", d.name},
-          {"source", d.source_file},
-          {"order", m.order()},
-          {"key", model_key(d.source_hash, m.order())},
-          {"engine", engine_name(m.engine())},
-          {"origin", m.origin()},
-          {"axes", axes}};
-}
-
-nlohmann::json inputs_json(const Model& m, const std::vector<InputDistribution>& inputs) {
-  nlohmann::json j = nlohmann::json::array();
-  const auto& errs = m.description().errors;
-  for (std::size_t i = 0; i < errs.size(); ++i) {
-    const double f = errs[i].to_base;
-    const InputDistribution in_unit = inputs[i].scaled(1.0 / f);
-    j.push_back({{"error", errs[i].name},
-                 {"unit", errs[i].unit},
-                 {"distribution", in_unit.str()},
-                 {"mean", in_unit.mean()},
-                 {"stddev", in_unit.stddev()}});
-  }
-  return j;
+  return weilgen::open_study(study_request(f), need_tolerances);
 }
 
 void write_output(const std::string& path, const std::string& text) {
   write_file_atomically(path, text);
 }
-
-std::string csv_field(const std::string& s) {
-  if (s.find_first_of(",\"\n") == std::string::npos) return s;
-  std::string q = "\"";
-  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return q + "\"";
-}
-
-std::string csv_number(double v) { return std::isfinite(v) ? format_number(v) : ""; }
 
 Progress::Progress(std::string what, std::size_t total, bool quiet)
     : what_(std::move(what)),

@@ -204,8 +204,8 @@ int verb_allocate(const Args& args) {
     ao.sigma_upper.push_back(loosen * st.inputs[i].stddev());
   }
 
-  AllocationResult res = allocate_steps(prob, ao);
-  if (vm.count("cost-aware")) res = allocate_cost_aware(prob, ao, res);
+  AllocationResult res = StepAllocation(ao).run(prob);
+  if (vm.count("cost-aware")) res = CostAwareAllocation(ao).run(prob, res);
 
   // ---- stdout: the seed's Tables 5-7 ----
   std::cout << "weilgen allocate: " << st.model->name() << " (order " << st.model->order() << ", "

@@ -159,7 +159,7 @@ int verb_sensitivity(const Args& args) {
                      ? std::sqrt(w.out[0] * w.out[0] + w.out[1] * w.out[1] + w.out[2] * w.out[2])
                      : w.out[static_cast<std::size_t>(outputs[o])];
       };
-      const SobolResult r = estimate_sobol(design, no, fn, so);
+      const SobolResult r = SobolAnalysis(so).run(design, no, fn);
       evaluations += r.evaluations;
       for (std::size_t o = 0; o < no; ++o) {
         const SobolIndices& s = r.outputs[o];

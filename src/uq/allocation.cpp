@@ -24,8 +24,7 @@ void validate(const AllocationProblem& problem, const AllocationOptions& options
     fail(std::to_string(problem.names.size()) + " names for " + std::to_string(n) + " inputs");
   if (problem.groups.empty()) fail("the problem has no groups");
   if (!problem.evaluate) fail("the problem has no evaluate function");
-  for (double target : {options.min_target, options.mean_target})
-    if (!(target > 0 && target <= 1)) fail("the targets must be in (0, 1]");
+  options.validate();
   if (options.step.size() != n)
     fail("step: " + std::to_string(options.step.size()) + " decrements for " + std::to_string(n) +
          " inputs");
@@ -42,8 +41,6 @@ void validate(const AllocationProblem& problem, const AllocationOptions& options
   for (const auto* v : {&options.cost_weights, &options.sigma_lower, &options.sigma_upper})
     if (!v->empty() && v->size() != n)
       fail("cost weights and sigma bounds need one value per input");
-  for (double w : options.cost_weights)
-    if (!(w >= 0) || !std::isfinite(w)) fail("cost weights must be finite and >= 0");
 }
 
 std::vector<AllocationCase> evaluate_checked(const AllocationProblem& problem,
@@ -110,3 +107,26 @@ std::vector<double> stddevs(const std::vector<InputDistribution>& inputs) {
 }
 
 }  // namespace weilgen::allocation_detail
+
+namespace weilgen {
+
+void AllocationOptions::validate() const {
+  for (double target : {min_target, mean_target})
+    if (!(target > 0 && target <= 1))
+      throw std::invalid_argument("allocation: the targets must be in (0, 1]");
+  for (double w : cost_weights)
+    if (!(w >= 0) || !std::isfinite(w))
+      throw std::invalid_argument("allocation: cost weights must be finite and >= 0");
+  if (cost_max_evaluations < 1)
+    throw std::invalid_argument("allocation: cost_max_evaluations must be >= 1");
+}
+
+StepAllocation::StepAllocation(AllocationOptions options) : options_(std::move(options)) {
+  options_.validate();
+}
+
+CostAwareAllocation::CostAwareAllocation(AllocationOptions options) : options_(std::move(options)) {
+  options_.validate();
+}
+
+}  // namespace weilgen

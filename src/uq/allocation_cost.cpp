@@ -112,9 +112,9 @@ void append(std::string& note, const std::string& text) {
 
 }  // namespace
 
-AllocationResult allocate_cost_aware(const AllocationProblem& problem,
-                                     const AllocationOptions& options,
-                                     const AllocationResult& steps) {
+AllocationResult CostAwareAllocation::run(const AllocationProblem& problem,
+                                          const AllocationResult& steps) const {
+  const AllocationOptions& options = options_;
   validate(problem, options);
   const std::size_t n = problem.inputs.size();
   AllocationResult res = steps;

@@ -26,8 +26,8 @@ AllocationStep make_step(std::size_t k, const std::vector<double>& stddev,
 
 }  // namespace
 
-AllocationResult allocate_steps(const AllocationProblem& problem,
-                                const AllocationOptions& options) {
+AllocationResult StepAllocation::run(const AllocationProblem& problem) const {
+  const AllocationOptions& options = options_;
   validate(problem, options);
   const std::size_t n = problem.inputs.size(), G = problem.groups.size();
   const std::vector<double> sigma0 = stddevs(problem.inputs);

@@ -1,4 +1,4 @@
-// compute_reliability: validation, the choice of method, names.
+// ReliabilityAnalysis: validation, the choice of method, names.
 #include "weilgen/uq/reliability.hpp"
 
 #include <algorithm>
@@ -70,10 +70,7 @@ void validate(const ReliabilityProblem& p, const ReliabilityOptions& o) {
     throw std::invalid_argument("reliability: the linear form has " +
                                 std::to_string(p.linear->coefficients.size()) +
                                 " coefficients for " + std::to_string(p.inputs.size()) + " inputs");
-  if (!(o.confidence > 0 && o.confidence < 1))
-    throw std::invalid_argument("reliability: the confidence must be in (0, 1)");
-  if (o.form_max_iterations < 1 || !(o.form_tolerance > 0))
-    throw std::invalid_argument("reliability: FORM needs max iterations >= 1 and a tolerance > 0");
+  o.validate();
 }
 
 // Every input constant: r is a number and R is 0 or 1.
@@ -97,8 +94,20 @@ ReliabilityResult deterministic(const StandardSpace& space, ReliabilityMethod me
 
 bool exact_applicable(const ReliabilityProblem& problem) { return exact_obstacle(problem).empty(); }
 
-ReliabilityResult compute_reliability(const ReliabilityProblem& problem,
-                                      const ReliabilityOptions& options) {
+void ReliabilityOptions::validate() const {
+  if (!(confidence > 0 && confidence < 1))
+    throw std::invalid_argument("reliability: the confidence must be in (0, 1)");
+  if (form_max_iterations < 1 || !(form_tolerance > 0))
+    throw std::invalid_argument("reliability: FORM needs max iterations >= 1 and a tolerance > 0");
+}
+
+ReliabilityAnalysis::ReliabilityAnalysis(ReliabilityOptions options)
+    : options_(std::move(options)) {
+  options_.validate();
+}
+
+ReliabilityResult ReliabilityAnalysis::run(const ReliabilityProblem& problem) const {
+  const ReliabilityOptions& options = options_;
   validate(problem, options);
   ReliabilityMethod method = options.method;
   const std::string obstacle = exact_obstacle(problem);

@@ -80,13 +80,22 @@ std::vector<std::uint16_t> resample_counts(std::size_t n, std::size_t resamples,
   return counts;
 }
 
-void check_options(const SobolOptions& o) {
-  if (!(o.confidence > 0.0 && o.confidence < 1.0))
+}  // namespace
+
+void SobolOptions::validate() const {
+  if (!(confidence > 0.0 && confidence < 1.0))
     throw std::invalid_argument("Sobol' indices: confidence must be in (0, 1), got " +
-                                std::to_string(o.confidence));
+                                std::to_string(confidence));
+  if (samples < 2)
+    throw std::invalid_argument("Sobol' design: the sample size N must be at least 2, got " +
+                                std::to_string(samples));
+  if (samples > 0xffffffffu)
+    throw std::invalid_argument("Sobol' design: the sample size N must be below 2^32");
 }
 
-}  // namespace
+SobolAnalysis::SobolAnalysis(SobolOptions options) : options_(std::move(options)) {
+  options_.validate();
+}
 
 SobolDesign::SobolDesign(std::vector<InputDistribution> inputs, const SobolOptions& options)
     : inputs_(std::move(inputs)),
@@ -94,12 +103,7 @@ SobolDesign::SobolDesign(std::vector<InputDistribution> inputs, const SobolOptio
       sampling_(options.sampling),
       seed_(options.seed),
       resamples_(options.bootstrap) {
-  check_options(options);
-  if (samples_ < 2)
-    throw std::invalid_argument("Sobol' design: the sample size N must be at least 2, got " +
-                                std::to_string(samples_));
-  if (samples_ > 0xffffffffu)
-    throw std::invalid_argument("Sobol' design: the sample size N must be below 2^32");
+  options.validate();
   for (std::size_t i = 0; i < inputs_.size(); ++i)
     if (!inputs_[i].is_constant()) varying_.push_back(i);
   const std::size_t k = inputs_.size(), kv = varying_.size();
@@ -163,9 +167,9 @@ class SobolEstimator {
 // are multiplied by the resample-count matrix W ((R+1) x N; row 0 all ones = the point
 // estimate, row r the multiplicities of bootstrap resample r): acc += W(:, tile) G(tile, :).
 // Every estimator (and every bootstrap replicate) is a ratio of columns of acc.
-SobolResult estimate_sobol(const SobolDesign& design, std::size_t outputs, const VectorFunction& f,
-                           const SobolOptions& options) {
-  check_options(options);
+SobolResult SobolAnalysis::run(const SobolDesign& design, std::size_t outputs,
+                               const VectorFunction& f) const {
+  const SobolOptions& options = options_;
   if (outputs == 0) throw std::invalid_argument("Sobol' indices: no outputs");
   if (!f) throw std::invalid_argument("Sobol' indices: empty function");
   Eigen::initParallel();

@@ -2,9 +2,9 @@
 // reliability requirement group meets its targets (min over its cases >= min_target and mean over
 // its cases >= mean_target). Generic: the caller's `evaluate` computes every case (e.g. one output
 // over a grid of poses) for a set of input distributions, with dR/dsigma per input.
-//   allocate_steps       the seed's procedure (Tables 5-7): choose the most sensitive inputs once,
+//   StepAllocation       the seed's procedure (Tables 5-7): choose the most sensitive inputs once,
 //                        lower each chosen stddev by a fixed step per iteration, re-evaluate.
-//   allocate_cost_aware  minimise sum_i w_i / sigma_i subject to the same targets (NLopt SLSQP,
+//   CostAwareAllocation  minimise sum_i w_i / sigma_i subject to the same targets (NLopt SLSQP,
 //                        gradients from dR/dsigma), started from the step procedure's end point.
 // docs/reliability.md, section "Tolerance allocation", has the details.
 #pragma once
@@ -54,6 +54,10 @@ struct AllocationOptions {
   std::vector<double> cost_weights;
   std::vector<double> sigma_lower, sigma_upper;
   std::size_t cost_max_evaluations = 1000;  // NLopt evaluations of the problem
+
+  // The checks that need no problem: targets in (0, 1], finite non-negative cost weights,
+  // max_steps and cost_max_evaluations >= 1. Throws std::invalid_argument naming the field.
+  void validate() const;
 };
 
 struct AllocationStep {
@@ -83,17 +87,32 @@ struct AllocationResult {
   std::size_t cost_aware_evaluations = 0;  // calls of AllocationProblem::evaluate
 };
 
-// The seed's procedure. Throws std::invalid_argument for inconsistent sizes, targets outside
-// (0, 1], an explicit choice out of range or without a positive step, and for `evaluate`
-// returning cases of a wrong group or gradient size or leaving a group without cases.
-AllocationResult allocate_steps(const AllocationProblem& problem, const AllocationOptions& options);
+// The seed's step procedure.
+class StepAllocation {
+ public:
+  explicit StepAllocation(AllocationOptions options);  // validates the options
+  const AllocationOptions& options() const { return options_; }
+  // Throws std::invalid_argument for sizes inconsistent with the problem, an explicit choice out
+  // of range or without a positive step, and for `evaluate` returning cases of a wrong group or
+  // gradient size or leaving a group without cases.
+  AllocationResult run(const AllocationProblem& problem) const;
 
-// Minimises the cost subject to the targets, starting from `steps` (the result of
-// allocate_steps). Returns `steps` with the cost-aware fields filled in; the note says how the
-// optimiser ended. cost_aware <= cost_step whenever the step procedure met the targets.
-AllocationResult allocate_cost_aware(const AllocationProblem& problem,
-                                     const AllocationOptions& options,
-                                     const AllocationResult& steps);
+ private:
+  AllocationOptions options_;
+};
+
+// Minimises the cost subject to the targets, starting from the step procedure's result.
+class CostAwareAllocation {
+ public:
+  explicit CostAwareAllocation(AllocationOptions options);  // validates the options
+  const AllocationOptions& options() const { return options_; }
+  // Returns `steps` with the cost-aware fields filled in; the note says how the optimiser ended.
+  // cost_aware <= cost_step whenever the step procedure met the targets.
+  AllocationResult run(const AllocationProblem& problem, const AllocationResult& steps) const;
+
+ private:
+  AllocationOptions options_;
+};
 
 // ---- Implementation pieces shared by the allocation*.cpp files (not a stable API) ----------
 
@@ -106,7 +125,7 @@ struct GroupStats {
   std::vector<bool> group_met;
 };
 
-// Checks the problem and options (see allocate_steps).
+// Checks the problem and options (see StepAllocation).
 void validate(const AllocationProblem& problem, const AllocationOptions& options);
 // evaluate() with its result checked.
 std::vector<AllocationCase> evaluate_checked(const AllocationProblem& problem,

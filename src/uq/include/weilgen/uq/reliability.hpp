@@ -80,6 +80,10 @@ struct ReliabilityOptions {
   // HL-RF stops when |g| / |grad g(0)| <= tol * max(1, |u|) and the HL-RF step is
   // <= sqrt(tol) * max(1, |u|): beta to about tol, the direction to about sqrt(tol).
   double form_tolerance = 1e-9;
+
+  // Throws std::invalid_argument naming the field: confidence in (0, 1), FORM iterations >= 1,
+  // FORM tolerance > 0.
+  void validate() const;
 };
 
 struct DesignPoint {
@@ -109,11 +113,20 @@ struct ReliabilityResult {
   std::string note;             // e.g. "FORM side +1: did not converge in 100 iterations"
 };
 
-// Throws std::invalid_argument for: no inputs, t <= 0 or not finite, no response and no linear
-// form, a linear form of the wrong size, samples == 0 for a sampling method, confidence outside
-// (0, 1), Exact requested when the response is not linear or an input is not Normal.
-ReliabilityResult compute_reliability(const ReliabilityProblem& problem,
-                                      const ReliabilityOptions& options);
+// R of one problem by the options' method.
+class ReliabilityAnalysis {
+ public:
+  explicit ReliabilityAnalysis(ReliabilityOptions options);  // validates the options
+  const ReliabilityOptions& options() const { return options_; }
+
+  // Throws std::invalid_argument for: no inputs, t <= 0 or not finite, no response and no
+  // linear form, a linear form of the wrong size, samples == 0 for a sampling method, Exact
+  // requested when the response is not linear or an input is not Normal.
+  ReliabilityResult run(const ReliabilityProblem& problem) const;
+
+ private:
+  ReliabilityOptions options_;
+};
 
 // True when Exact applies: a linear form and every input Normal or constant.
 bool exact_applicable(const ReliabilityProblem& problem);

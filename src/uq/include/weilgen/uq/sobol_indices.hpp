@@ -22,6 +22,9 @@ struct SobolOptions {
   std::size_t bootstrap = 200;  // bootstrap resamples for the confidence intervals (0 = none)
   double confidence = 0.95;     // in (0, 1)
   unsigned threads = 0;         // 0 = all cores
+
+  // Throws std::invalid_argument naming the field: samples >= 2 and < 2^32, confidence in (0, 1).
+  void validate() const;
 };
 
 // Matrices A and B (N x k each, row-major, already mapped through each input's quantile:
@@ -33,7 +36,7 @@ struct SobolOptions {
 // their mean in both. Listing a constant input therefore changes nothing. With MonteCarlo, rows
 // are drawn from std::mt19937_64 streams seeded from (seed, block of 1024 rows).
 // The bootstrap resample multiplicities for (options.seed, options.bootstrap) are drawn here too
-// (2 (R+1) N bytes), so repeated estimate_sobol calls with the same options do not redraw them.
+// (2 (R+1) N bytes), so repeated SobolAnalysis::run calls with the same options do not redraw them.
 // Any N >= 2: with Qmc a power of two keeps the Sobol' net property (the most uniform design);
 // other N take the sequence's first N points (the pipe-cutter seed uses N = 20000).
 // Throws std::invalid_argument for samples < 2, 2k' above the Sobol' table's 3667 dimensions, or
@@ -80,17 +83,26 @@ struct SobolResult {
 
 // f(thread, x, y): x has design.inputs() values; write `outputs` values into y. Called
 // concurrently from different threads with thread in [0, resolve_threads(options.threads)):
-// use it to pick a per-thread workspace. estimate_sobol does not allocate per call.
+// use it to pick a per-thread workspace. run() does not allocate per call.
 using VectorFunction = std::function<void(unsigned thread, const double* x, double* y)>;
 
-// Indices of every output. The sample size and sampling are the design's (options.samples and
-// options.sampling are not used); options.seed seeds the bootstrap, options.threads the
-// parallelism. Bit-identical results for any thread count. Constant inputs get exactly 0
-// (interval [0, 0]); an output whose variance is at rounding level (V <= (8 eps max|f|)^2,
-// e.g. exactly constant) gets mean, variance 0 and all indices and intervals exactly 0.
-// Exceptions thrown by f are rethrown.
-SobolResult estimate_sobol(const SobolDesign& design, std::size_t outputs, const VectorFunction& f,
-                           const SobolOptions& options);
+// The indices of every output of f on a design.
+class SobolAnalysis {
+ public:
+  explicit SobolAnalysis(SobolOptions options);  // validates the options
+  const SobolOptions& options() const { return options_; }
+
+  // The sample size and sampling are the design's (options.samples and options.sampling are
+  // not used); options.seed seeds the bootstrap, options.threads the parallelism. Bit-identical
+  // results for any thread count. Constant inputs get exactly 0 (interval [0, 0]); an output
+  // whose variance is at rounding level (V <= (8 eps max|f|)^2, e.g. exactly constant) gets
+  // mean, variance 0 and all indices and intervals exactly 0. Exceptions thrown by f are
+  // rethrown.
+  SobolResult run(const SobolDesign& design, std::size_t outputs, const VectorFunction& f) const;
+
+ private:
+  SobolOptions options_;
+};
 
 // Exact indices of y = c0 + sum c_i x_i with independent inputs:
 // S_i = S_Ti = c_i^2 s_i^2 / sum_j c_j^2 s_j^2 (all zero when the variance is zero).
