@@ -93,6 +93,27 @@ Study open_study(const StudyFlags& f, bool need_tolerances) {
   return weilgen::open_study(study_request(f), need_tolerances);
 }
 
+void add_reliability_options(po::options_description& opts, ReliabilityFlags& f) {
+  po::options_description r("Reliability");
+  r.add_options()("limit", po::value<std::string>(&f.limit)->default_value(f.limit),
+                  "two-sided | one-sided | radial")(
+      "method", po::value<std::string>(&f.method)->default_value(f.method),
+      "auto | exact | form | is | mc")(
+      "samples", po::value<std::size_t>(&f.samples)->default_value(f.samples),
+      "importance-sampling lines or Monte Carlo samples per pose and output")(
+      "confidence", po::value<double>(&f.confidence)->default_value(f.confidence),
+      "confidence level of the intervals")(
+      "sensitivities", po::value<std::string>(&f.sensitivities)->default_value(f.sensitivities),
+      "dR/dmu, dR/dsigma by: auto (sampling for radial, else FORM; analytic when exact) |\n"
+      "form | sampling (importance sampling differentiating its own estimate)");
+  opts.add(r);
+}
+
+ReliabilitySettings parse_reliability_flags(const ReliabilityFlags& f, std::uint64_t seed) {
+  return parse_reliability_settings(f.method, f.limit, f.sensitivities, f.samples, f.confidence,
+                                    seed);
+}
+
 void write_output(const std::string& path, const std::string& text) {
   write_file_atomically(path, text);
 }

@@ -9,11 +9,12 @@
 #include <string>
 #include <vector>
 
-#include "weilgen/analysis/study_spec.hpp"
+#include "weilgen/analysis/reliability_sweep.hpp"
 #include "weilgen/analysis/study.hpp"
+#include "weilgen/analysis/study_spec.hpp"
 #include "weilgen/measure/ballbar.hpp"
-#include "weilgen/report/json_common.hpp"
 #include "weilgen/model/model.hpp"
+#include "weilgen/report/json_common.hpp"
 #include "weilgen/uq/distribution.hpp"
 
 namespace weilgen::cli {
@@ -45,6 +46,18 @@ StudyRequest study_request(const StudyFlags& flags);
 // analysis/study.hpp's open_model and open_study over the flags.
 std::shared_ptr<Model> open_model(const StudyFlags& flags, const Description& desc);
 Study open_study(const StudyFlags& flags, bool need_tolerances);
+
+// The reliability flags shared by `reliability` and `allocate`: --limit --method --samples
+// --confidence --sensitivities.
+struct ReliabilityFlags {
+  std::string limit = "two-sided", method = "auto", sensitivities = "auto";
+  std::size_t samples = 1u << 14;
+  double confidence = 0.95;
+};
+void add_reliability_options(boost::program_options::options_description& opts,
+                             ReliabilityFlags& flags);
+// Parsed and checked (std::invalid_argument naming the flag).
+ReliabilitySettings parse_reliability_flags(const ReliabilityFlags& flags, std::uint64_t seed);
 
 // Writes `text` to `path` atomically (temporary file, then rename).
 void write_output(const std::string& path, const std::string& text);

@@ -1,9 +1,10 @@
-#include "reliability_sweep.hpp"
+#include "weilgen/analysis/reliability_sweep.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
-namespace weilgen::cli {
+namespace weilgen {
 
 LimitChoice parse_limit(const std::string& text) {
   if (text == "two-sided") return LimitChoice::TwoSided;
@@ -24,40 +25,32 @@ SensitivityChoice parse_sensitivities(const std::string& text) {
   throw std::invalid_argument("--sensitivities must be auto, form or sampling, not '" + text + "'");
 }
 
-void add_reliability_options(boost::program_options::options_description& opts,
-                             ReliabilityFlags& f) {
-  namespace po = boost::program_options;
-  po::options_description r("Reliability");
-  r.add_options()("limit", po::value<std::string>(&f.limit)->default_value(f.limit),
-                  "two-sided | one-sided | radial")(
-      "method", po::value<std::string>(&f.method)->default_value(f.method),
-      "auto | exact | form | is | mc")(
-      "samples", po::value<std::size_t>(&f.samples)->default_value(f.samples),
-      "importance-sampling lines or Monte Carlo samples per pose and output")(
-      "confidence", po::value<double>(&f.confidence)->default_value(f.confidence),
-      "confidence level of the intervals")(
-      "sensitivities", po::value<std::string>(&f.sensitivities)->default_value(f.sensitivities),
-      "dR/dmu, dR/dsigma by: auto (sampling for radial, else FORM; analytic when exact) |\n"
-      "form | sampling (importance sampling differentiating its own estimate)");
-  opts.add(r);
-}
-
-ReliabilitySettings parse_reliability_flags(const ReliabilityFlags& f, std::uint64_t seed) {
-  if (f.samples == 0) throw std::invalid_argument("--samples must be >= 1");
-  if (!(f.confidence > 0 && f.confidence < 1))
+ReliabilitySettings parse_reliability_settings(const std::string& method, const std::string& limit,
+                                               const std::string& sensitivities,
+                                               std::size_t samples, double confidence,
+                                               std::uint64_t seed) {
+  if (samples == 0) throw std::invalid_argument("--samples must be >= 1");
+  if (!(confidence > 0 && confidence < 1))
     throw std::invalid_argument("--confidence must be in (0, 1)");
-  ReliabilitySettings s{parse_limit(f.limit), parse_sensitivities(f.sensitivities), {}};
-  s.options.method = parse_reliability_method(f.method);
-  s.options.samples = f.samples;
+  ReliabilitySettings s{parse_limit(limit), parse_sensitivities(sensitivities), {}};
+  s.options.method = parse_reliability_method(method);
+  s.options.samples = samples;
   s.options.seed = seed;
-  s.options.confidence = f.confidence;
+  s.options.confidence = confidence;
   return s;
 }
 
-std::vector<SweepCase> reliability_sweep(const Study& st,
-                                         const std::vector<InputDistribution>& inputs,
-                                         LimitChoice limit, const ReliabilityOptions& options,
-                                         SensitivityChoice sensitivities, bool quiet) {
+ReliabilitySweep::ReliabilitySweep(ReliabilitySettings settings) : settings_(std::move(settings)) {
+  settings_.options.validate();
+}
+
+std::vector<SweepCase> ReliabilitySweep::run(
+    const Study& st, const std::vector<InputDistribution>& inputs,
+    const std::function<void(std::size_t, std::size_t)>& progress) const {
+  const LimitChoice limit = settings_.limit;
+  const SensitivityChoice sensitivities = settings_.sensitivities;
+  ReliabilityOptions options = settings_.options;
+  options.threads = st.threads;
   const Model& model = *st.model;
   const std::size_t ne = model.num_errors(), np = st.poses.poses.size();
   if (limit == LimitChoice::Radial)
@@ -84,7 +77,7 @@ std::vector<SweepCase> reliability_sweep(const Study& st,
     }
   }
   std::vector<SweepCase> cases;
-  Progress progress("reliability", st.tolerances.size() * np, quiet);
+  const std::size_t total = st.tolerances.size() * np;
   for (std::size_t k = 0; k < st.tolerances.size(); ++k) {
     const OutputId out = st.tolerances[k].output;
     for (std::size_t p = 0; p < np; ++p) {
@@ -120,7 +113,7 @@ std::vector<SweepCase> reliability_sweep(const Study& st,
                             ? SensitivityMethod::Sampling
                             : SensitivityMethod::Form;
       cases.push_back({p, k, ReliabilityAnalysis(o).run(prob)});
-      progress.update(cases.size());
+      if (progress) progress(cases.size(), total);
     }
   }
   return cases;
@@ -141,4 +134,26 @@ std::vector<SweepSummary> summarize(const Study& st, const std::vector<SweepCase
   return s;
 }
 
-}  // namespace weilgen::cli
+}  // namespace weilgen
+
+namespace weilgen {
+
+std::vector<std::pair<std::size_t, double>> ranked_sensitivity(
+    const std::vector<SweepCase>& cases, std::size_t tolerance,
+    const std::vector<InputDistribution>& inputs) {
+  std::vector<double> s(inputs.size(), 0.0);
+  std::size_t n = 0;
+  for (const auto& c : cases) {
+    if (c.tolerance != tolerance) continue;
+    ++n;
+    for (std::size_t i = 0; i < inputs.size() && i < c.result.dR_dsigma.size(); ++i)
+      s[i] += std::abs(c.result.dR_dsigma[i]) * inputs[i].stddev();
+  }
+  std::vector<std::pair<std::size_t, double>> r;
+  for (std::size_t i = 0; i < s.size(); ++i)
+    r.push_back({i, n ? s[i] / static_cast<double>(n) : 0.0});
+  std::stable_sort(r.begin(), r.end(), [](auto& a, auto& b) { return a.second > b.second; });
+  return r;
+}
+
+}  // namespace weilgen

@@ -1,0 +1,128 @@
+#include "weilgen/analysis/sensitivity_study.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "weilgen/base/text.hpp"
+
+namespace weilgen {
+
+void SensitivityOptions::validate() const {
+  if (!local && !exact && !sobol) throw std::invalid_argument("--method: no method chosen");
+  if (outputs.empty()) throw std::invalid_argument("--outputs: no output given");
+  for (std::size_t o = 0; o < outputs.size(); ++o)
+    if (std::find(outputs.begin(), outputs.begin() + static_cast<std::ptrdiff_t>(o), outputs[o]) !=
+        outputs.begin() + static_cast<std::ptrdiff_t>(o))
+      throw std::invalid_argument(std::string("--outputs: \"") + output_name(outputs[o]) +
+                                  "\" given twice");
+  if (sobol) sobol_options.validate();
+}
+
+void parse_sensitivity_method(const std::string& m, SensitivityOptions& o) {
+  if (m != "local" && m != "sobol" && m != "exact" && m != "all")
+    throw std::invalid_argument("--method must be local, sobol, exact or all, not '" + m + "'");
+  o.local = m == "local" || m == "all";
+  o.exact = m == "exact" || m == "all";
+  o.sobol = m == "sobol" || m == "all";
+}
+
+std::vector<OutputId> parse_output_list(const std::string& text) {
+  std::vector<OutputId> out;
+  for (const auto& item : split(text, ',')) {
+    const OutputId o = parse_output(trim(item));
+    if (std::find(out.begin(), out.end(), o) != out.end())
+      throw std::invalid_argument("--outputs: \"" + item + "\" given twice");
+    out.push_back(o);
+  }
+  if (out.empty()) throw std::invalid_argument("--outputs: no output given");
+  return out;
+}
+
+Sampling parse_sampling(const std::string& text) {
+  if (text == "qmc") return Sampling::Qmc;
+  if (text == "mc") return Sampling::MonteCarlo;
+  throw std::invalid_argument("--sampling must be qmc or mc, not '" + text + "'");
+}
+
+SensitivityStudy::SensitivityStudy(SensitivityOptions options) : options_(std::move(options)) {
+  options_.validate();
+}
+
+SensitivityResult SensitivityStudy::run(
+    const Study& st, const std::function<void(std::size_t, std::size_t)>& progress) const {
+  const Model& model = *st.model;
+  const std::vector<OutputId>& outputs = options_.outputs;
+  const std::size_t ne = model.num_errors(), np = st.poses.poses.size(), no = outputs.size();
+  SensitivityResult res;
+  res.outputs = outputs;
+  res.poses = np;
+  res.errors = ne;
+  res.records.resize(np * no * ne);
+  res.summary.resize(np * no);
+  res.confidence = options_.sobol_options.confidence;
+  auto at = [&](std::size_t p, std::size_t o, std::size_t i) -> SensitivityRecord& {
+    return res.records[(p * no + o) * ne + i];
+  };
+  std::vector<double> sigma(ne);
+  for (std::size_t i = 0; i < ne; ++i) sigma[i] = st.inputs[i].stddev();
+
+  // Local coefficients and exact indices (cheap).
+  ModelData data(model);
+  for (std::size_t p = 0; p < np; ++p) {
+    model.coefficients(data, st.poses.poses[p].data(), data.coeff.data());
+    for (std::size_t o = 0; o < no; ++o) {
+      if (outputs[o] == OutputId::Dp) continue;
+      const std::size_t row = static_cast<std::size_t>(outputs[o]);
+      std::vector<double> c(data.coeff.begin() + static_cast<std::ptrdiff_t>(row * ne),
+                            data.coeff.begin() + static_cast<std::ptrdiff_t>((row + 1) * ne));
+      double var = 0;
+      for (std::size_t i = 0; i < ne; ++i) {
+        at(p, o, i).coefficient = c[i];
+        at(p, o, i).contribution = c[i] * sigma[i];
+        var += c[i] * c[i] * sigma[i] * sigma[i];
+      }
+      res.summary[p * no + o].variance_linear = var;
+      if (options_.exact) {
+        const auto s = linear_sobol_indices(c, st.inputs);
+        for (std::size_t i = 0; i < ne; ++i) at(p, o, i).S_exact = s[i];
+      }
+    }
+  }
+  if (!options_.sobol) return res;
+
+  SobolOptions so = options_.sobol_options;
+  so.threads = st.threads;
+  res.bootstrap = so.bootstrap;
+  const SobolDesign design(st.inputs, so);
+  const SobolAnalysis analysis(so);
+  std::vector<ModelData> work;
+  for (unsigned t = 0; t < st.threads; ++t) work.emplace_back(model);
+  for (std::size_t p = 0; p < np; ++p) {
+    const double* pose = st.poses.poses[p].data();
+    const VectorFunction fn = [&](unsigned t, const double* x, double* y) {
+      ModelData& w = work[t];
+      model.deviation(w, pose, x, w.out.data());
+      for (std::size_t o = 0; o < no; ++o)
+        y[o] = outputs[o] == OutputId::Dp
+                   ? std::sqrt(w.out[0] * w.out[0] + w.out[1] * w.out[1] + w.out[2] * w.out[2])
+                   : w.out[static_cast<std::size_t>(outputs[o])];
+    };
+    const SobolResult r = analysis.run(design, no, fn);
+    res.evaluations += r.evaluations;
+    for (std::size_t o = 0; o < no; ++o) {
+      const SobolIndices& s = r.outputs[o];
+      res.summary[p * no + o].mean = s.mean;
+      res.summary[p * no + o].variance = s.variance;
+      for (std::size_t i = 0; i < ne; ++i) {
+        SensitivityRecord& x = at(p, o, i);
+        x.S = s.first[i], x.S_lo = s.first_lo[i], x.S_hi = s.first_hi[i];
+        x.ST = s.total[i], x.ST_lo = s.total_lo[i], x.ST_hi = s.total_hi[i];
+      }
+    }
+    if (progress) progress(p + 1, np);
+  }
+  return res;
+}
+
+}  // namespace weilgen
