@@ -143,9 +143,8 @@ TEST_CASE("iso230-2: hand-computed example, every classical figure") {
   CHECK(runs.positions_mm == std::vector<double>{0, 100, 200});
   CHECK(runs.cycles[kUp] == std::vector<long>{1, 2, 3});
   CHECK(runs.has_time);
-  Iso230_2Evaluation ev(runs);
-  ev.run();
-  const IsoFigures& f = ev.result().figures;
+  const auto ev = Iso230_2Evaluation().run(runs);
+  const IsoFigures& f = ev.figures;
   CHECK(f.k_up == 2);
   CHECK(f.mean_up == std::vector<double>{2, 6, 3});
   CHECK(f.mean_down == std::vector<double>{-1, 4, 7});
@@ -187,10 +186,9 @@ TEST_CASE("iso230-2: hand-computed example, the Student-t widened set") {
   for (std::size_t dof = 1; dof < 60; ++dof)
     CHECK(student_coverage_factor(dof) > student_coverage_factor(dof + 1));
 
-  Iso230_2Evaluation ev(runs_of(read_measurements(small_csv())));
-  ev.run();
-  REQUIRE(ev.result().student);
-  const IsoFigures& s = *ev.result().student;
+  const auto ev = Iso230_2Evaluation().run(runs_of(read_measurements(small_csv())));
+  REQUIRE(ev.student);
+  const IsoFigures& s = *ev.student;
   CHECK(s.k_up == doctest::Approx(k).epsilon(1e-12));
   CHECK(s.R_up == doctest::Approx(6 * k).epsilon(1e-12));
   CHECK(s.R_down == doctest::Approx(4 * k).epsilon(1e-12));
@@ -222,9 +220,8 @@ TEST_CASE("iso230-2: hand-computed example, the Student-t widened set") {
 // freedom: σ̂² = 1, se = sqrt(1/12).
 TEST_CASE("iso230-2: hand-computed example, drift elimination and drift per cycle") {
   const IsoRuns runs = runs_of(read_measurements(small_csv()));
-  DriftElimination de(runs);
-  de.run();
-  const DriftResult& d = de.result();
+  const auto de = DriftElimination().run(runs);
+  const DriftResult& d = de;
   CHECK(d.reference_target == 0);
   CHECK(d.reference_cycle == 1);
   CHECK(d.differences[kUp].mean == std::vector<double>{4, -3});
@@ -290,18 +287,17 @@ TEST_CASE("iso230-2: hand-computed example, drift elimination and drift per cycl
   DriftOptions o;
   o.reference_position_mm = 100;
   o.reference_cycle = 2;
-  DriftElimination de2(runs, o);
-  de2.run();
-  CHECK(de2.result().reference_target == 1);
-  CHECK(de2.result().chart[kUp].value == std::vector<double>{2, 6, 3});
-  CHECK(de2.result().per_cycle.offset_up == std::vector<double>{-2, 0, 2});
+  const auto de2 = DriftElimination(o).run(runs);
+  CHECK(de2.reference_target == 1);
+  CHECK(de2.chart[kUp].value == std::vector<double>{2, 6, 3});
+  CHECK(de2.per_cycle.offset_up == std::vector<double>{-2, 0, 2});
   o.reference_cycle = 7;
-  CHECK_THROWS_WITH_AS(DriftElimination(runs, o).run(),
+  CHECK_THROWS_WITH_AS(DriftElimination(o).run(runs),
                        "--reference-cycle 7: not a cycle of direction +1 (cycles 1 to 3)",
                        std::invalid_argument);
   o.reference_cycle.reset();
   o.reference_position_mm = 50;
-  CHECK_THROWS_WITH_AS(DriftElimination(runs, o).run(),
+  CHECK_THROWS_WITH_AS(DriftElimination(o).run(runs),
                        "--reference-position 50: not a target (targets: 0, 100, 200 mm)",
                        std::invalid_argument);
 }
@@ -326,24 +322,22 @@ TEST_CASE("iso230-2: invariants on random data (B = 0 when directions agree, R >
       }
     }
     const IsoRuns runs = group_iso_runs(obs, "random");
-    Iso230_2Evaluation ev(runs);
-    ev.run();
-    const IsoFigures& f = ev.result().figures;
+    const auto ev = Iso230_2Evaluation().run(runs);
+    const IsoFigures& f = ev.figures;
     CAPTURE(rep);
     check_invariants(f);
-    check_invariants(*ev.result().student);
-    CHECK(ev.result().student->R >= f.R);
-    CHECK(ev.result().student->A >= f.A);
+    check_invariants(*ev.student);
+    CHECK(ev.student->R >= f.R);
+    CHECK(ev.student->A >= f.A);
     if (agree) {
       CHECK(f.B == 0);
       CHECK(f.B_mean == 0);
       CHECK(f.E == f.E_up);
       CHECK(f.M == f.E_up);
     }
-    DriftElimination de(runs);
-    de.run();
-    check_invariants(de.result().figures);
-    if (agree) CHECK(de.result().figures.B == 0);
+    const auto de = DriftElimination().run(runs);
+    check_invariants(de.figures);
+    if (agree) CHECK(de.figures.B == 0);
   }
 }
 
@@ -358,9 +352,8 @@ TEST_CASE("iso230-2 drift: the rebuilt chart recovers the static profile within 
   Synth s;  // 16 targets, 30 cycles, 6 um/h, σ 0.5 um, 8 min per cycle, 4 h in all
   Normal rng(7);
   const IsoRuns runs = group_iso_runs(synth(s, rng), "synthetic");
-  DriftElimination de(runs);
-  de.run();
-  const DriftResult& d = de.result();
+  const auto de = DriftElimination().run(runs);
+  const DriftResult& d = de;
   const double noise = 5 * s.sigma * std::sqrt(2.0 / static_cast<double>(s.n));
   const double c = s.drift_per_h / 3600;  // um/s
   for (int dir = 0; dir < 2; ++dir) {
@@ -377,19 +370,17 @@ TEST_CASE("iso230-2 drift: the rebuilt chart recovers the static profile within 
   }
   // s* estimates σ (pooled over targets and directions: relative standard error about 3 %),
   // while the classical s is inflated by the drift (c·sd(t) = 6 um/h × 1.15 h ≈ 7 um).
-  Iso230_2Evaluation ev(runs);
-  ev.run();
+  const auto ev = Iso230_2Evaluation().run(runs);
   double star2 = 0, classical2 = 0;
   for (int dir = 0; dir < 2; ++dir)
     for (std::size_t i = 0; i < s.m; ++i) {
       star2 += std::pow(d.chart[dir].s[i], 2) / (2.0 * static_cast<double>(s.m));
-      classical2 +=
-          std::pow(dir == kUp ? ev.result().figures.s_up[i] : ev.result().figures.s_down[i], 2) /
-          (2.0 * static_cast<double>(s.m));
+      classical2 += std::pow(dir == kUp ? ev.figures.s_up[i] : ev.figures.s_down[i], 2) /
+                    (2.0 * static_cast<double>(s.m));
     }
   CHECK(std::abs(std::sqrt(star2) - s.sigma) < 0.15 * s.sigma);
   CHECK(std::sqrt(classical2) > 10 * s.sigma);
-  CHECK(d.figures.R < 0.2 * ev.result().figures.R);
+  CHECK(d.figures.R < 0.2 * ev.figures.R);
   // The drift: 6 um/h, 0.8 um per cycle (8 min).
   const DriftPerCycle& p = d.per_cycle;
   CHECK(p.rate_per_h_se < 0.05);
@@ -425,9 +416,8 @@ TEST_CASE("iso230-2 drift: the seed's Monte Carlo check of s_b / s_a = sqrt(2)")
   double ratio = 0;
   for (int r = 0; r < 200; ++r) {
     const IsoRuns runs_ = group_iso_runs(synth(s, rng), "synthetic");
-    DriftElimination de(runs_);
-    de.run();
-    ratio += (de.result().s_ratio[kUp] + de.result().s_ratio[kDown]) / 400;
+    const auto de = DriftElimination().run(runs_);
+    ratio += (de.s_ratio[kUp] + de.s_ratio[kDown]) / 400;
   }
   CHECK(std::abs(ratio - kSqrt2) < 0.03);
 }
@@ -441,9 +431,8 @@ TEST_CASE(
   s.noisy_target = 2;
   Normal rng(3);
   const IsoRuns runs = group_iso_runs(synth(s, rng), "synthetic");
-  DriftElimination de(runs);
-  de.run();
-  const DriftResult& d = de.result();
+  const auto de = DriftElimination().run(runs);
+  const DriftResult& d = de;
   CHECK(d.tests == 2 * 15);
   REQUIRE(d.anomalous_positions.size() == 1);
   CHECK(d.anomalous_positions[0].direction == +1);
@@ -468,10 +457,9 @@ TEST_CASE(
     const IsoRuns null_runs = group_iso_runs(synth(h, rng), "synthetic");
     DriftOptions o;
     o.alpha = alpha;
-    DriftElimination n(null_runs, o);
-    n.run();
-    any += n.result().anomalous_differences.empty() ? 0 : 1;
-    for (double pv : n.result().differences[kUp].p_value) below += pv < 0.1 ? 1 : 0;
+    const auto n = DriftElimination(o).run(null_runs);
+    any += n.anomalous_differences.empty() ? 0 : 1;
+    for (double pv : n.differences[kUp].p_value) below += pv < 0.1 ? 1 : 0;
   }
   CHECK(static_cast<double>(any) / runs_n <= alpha + 3 * 0.011);
   CHECK(std::abs(static_cast<double>(below) / (15.0 * runs_n) - 0.1) < 0.03);
@@ -524,7 +512,7 @@ TEST_CASE("iso230-2: grouping of targets and bad runs name the file and line") {
   const IsoRuns apart = runs_of_text(head +
                                      "0,1,1,1\n0,1,2,1\n0,-1,3,1\n0,-1,4,1\n9,1,1,1\n"
                                      "9,1,2,1\n9,-1,3,1\n9,-1,4,1\n");
-  CHECK_THROWS_WITH_AS(DriftElimination(apart).run(),
+  CHECK_THROWS_WITH_AS(DriftElimination().run(apart),
                        "d.csv: the two directions share no cycle id: the drift elimination needs "
                        "a reference cycle measured in both directions",
                        InputError);

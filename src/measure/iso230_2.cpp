@@ -339,10 +339,15 @@ IsoFigures iso_figures(const std::vector<double>& mean_up, const std::vector<dou
 
 // ---- Classical evaluation --------------------------------------------------------------------
 
-Iso230_2Evaluation::Iso230_2Evaluation(const IsoRuns& runs, Iso230_2Options options)
-    : runs_(runs), options_(options) {}
+void Iso230_2Options::validate() const {
+  if (!(coverage > 0)) throw std::invalid_argument("ISO 230-2: the coverage factor must be > 0");
+}
 
-void Iso230_2Evaluation::run() {
+Iso230_2Evaluation::Iso230_2Evaluation(Iso230_2Options options) : options_(options) {
+  options_.validate();
+}
+
+Iso230_2Result Iso230_2Evaluation::run(const IsoRuns& runs_) const {
   const std::size_t m = runs_.targets();
   std::array<std::vector<double>, 2> mean, s;
   for (int d = 0; d < 2; ++d) {
@@ -351,7 +356,7 @@ void Iso230_2Evaluation::run() {
       s[d].push_back(sample_sd(runs_.x[d][i]));
     }
   }
-  result_ = {};
+  Iso230_2Result result_;
   result_.figures =
       iso_figures(mean[kUp], mean[kDown], s[kUp], s[kDown], options_.coverage, options_.coverage);
   if (options_.student) {
@@ -359,6 +364,7 @@ void Iso230_2Evaluation::run() {
     const double kd = student_coverage_factor(runs_.cycles[kDown].size() - 1, options_.coverage);
     result_.student = iso_figures(mean[kUp], mean[kDown], s[kUp], s[kDown], ku, kd);
   }
+  return result_;
 }
 
 }  // namespace weilgen

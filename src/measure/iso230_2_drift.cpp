@@ -48,11 +48,20 @@ std::pair<double, double> within_slope(
 
 }  // namespace
 
-DriftElimination::DriftElimination(const IsoRuns& runs, DriftOptions options)
-    : runs_(runs), options_(options) {}
+void DriftOptions::validate() const {
+  if (!(alpha > 0 && alpha < 1))
+    throw std::invalid_argument("drift elimination: alpha must be in (0, 1)");
+  if (!(coverage > 0))
+    throw std::invalid_argument("drift elimination: the coverage factor must be > 0");
+  if (!(tolerance_mm > 0))
+    throw std::invalid_argument("drift elimination: tolerance_mm must be > 0");
+}
 
-void DriftElimination::run() {
-  const IsoRuns& R = runs_;
+DriftElimination::DriftElimination(DriftOptions options) : options_(std::move(options)) {
+  options_.validate();
+}
+
+DriftResult DriftElimination::run(const IsoRuns& R) const {
   const std::size_t m = R.targets();
   if (m < 2)
     throw InputError(SourceLoc{R.file, 0, 0},
@@ -273,7 +282,7 @@ void DriftElimination::run() {
       }
     for (std::size_t c = 0; c < nc; ++c) P.time_h.push_back(sum[c] / cnt[c] / 3600.0);
   }
-  result_ = std::move(res);
+  return res;
 }
 
 }  // namespace weilgen

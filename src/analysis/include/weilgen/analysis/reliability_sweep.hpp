@@ -4,12 +4,11 @@
 // the model itself.
 #pragma once
 
+#include <cstdint>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
-
-#include <cstdint>
-#include <functional>
 
 #include "weilgen/analysis/study.hpp"
 #include "weilgen/uq/reliability.hpp"

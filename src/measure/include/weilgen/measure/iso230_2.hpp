@@ -114,6 +114,7 @@ double student_coverage_factor(std::size_t dof, double k_normal = 2.0);
 struct Iso230_2Options {
   double coverage = 2.0;  // k of the standard
   bool student = true;    // also compute the Student-t widened set
+  void validate() const;  // coverage > 0 (std::invalid_argument)
 };
 
 struct Iso230_2Result {
@@ -123,14 +124,12 @@ struct Iso230_2Result {
 
 class Iso230_2Evaluation {
  public:
-  Iso230_2Evaluation(const IsoRuns& runs, Iso230_2Options options = {});
-  void run();
-  const Iso230_2Result& result() const { return result_; }
+  explicit Iso230_2Evaluation(Iso230_2Options options = {});  // validates the options
+  const Iso230_2Options& options() const { return options_; }
+  Iso230_2Result run(const IsoRuns& runs) const;
 
  private:
-  IsoRuns runs_;  // a copy: the algorithm may outlive its argument
   Iso230_2Options options_;
-  Iso230_2Result result_;
 };
 
 // ---- Drift elimination (the drift seed) ----------------------------------------------------
@@ -142,6 +141,8 @@ struct DriftOptions {
   double coverage = 2.0;
   bool student = true;
   double tolerance_mm = 1e-6;  // to match reference_position_mm with a target
+  // alpha in (0, 1), coverage > 0, tolerance_mm > 0 (std::invalid_argument naming the field).
+  void validate() const;
 };
 
 // Adjacent-position differences of one direction: element q (q = 0..m−2) is the difference
@@ -212,16 +213,14 @@ struct DriftResult {
 
 class DriftElimination {
  public:
-  // Needs at least 2 targets. Throws std::invalid_argument when the reference position or cycle
-  // is not in the data.
-  DriftElimination(const IsoRuns& runs, DriftOptions options = {});
-  void run();
-  const DriftResult& result() const { return result_; }
+  explicit DriftElimination(DriftOptions options = {});  // validates the options
+  const DriftOptions& options() const { return options_; }
+  // Needs at least 2 targets (InputError otherwise). Throws std::invalid_argument when the
+  // reference position or cycle is not in the data.
+  DriftResult run(const IsoRuns& runs) const;
 
  private:
-  IsoRuns runs_;  // a copy: the algorithm may outlive its argument
   DriftOptions options_;
-  DriftResult result_;
 };
 
 // ---- Helpers ---------------------------------------------------------------------------------

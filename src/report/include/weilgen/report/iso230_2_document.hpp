@@ -1,0 +1,20 @@
+// The documents of an ISO 230-2 evaluation: the text of `weilgen iso230-2` (per-target table,
+// axis figures classical / Student-t / drift-eliminated, the drift seed's tables), its JSON
+// (docs/iso230-2.md) and its deviation charts.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "weilgen/measure/iso230_2_study.hpp"
+#include "weilgen/report/plot.hpp"
+
+namespace weilgen {
+
+// `data`: the file name as given, for the heading and the JSON.
+std::string iso230_2_text(const std::string& data, const Iso230_2StudyResult& result);
+nlohmann::json iso230_2_json(const std::string& data, const Iso230_2StudyResult& result);
+std::vector<Panel> iso230_2_panels(const Iso230_2StudyResult& result);
+
+}  // namespace weilgen

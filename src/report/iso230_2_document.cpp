@@ -1,0 +1,352 @@
+#include "weilgen/report/iso230_2_document.hpp"
+
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+
+#include "weilgen/base/format.hpp"
+#include "weilgen/base/version.hpp"
+#include "weilgen/report/json_common.hpp"
+
+namespace weilgen {
+
+namespace {
+
+using nlohmann::json;
+
+// The axis figures and per-target arrays of one evaluation (keys end in _um: the deviation
+// column's unit, um for a linear axis).
+json figures_json(const IsoFigures& f) {
+  return {{"k_up", f.k_up},
+          {"k_down", f.k_down},
+          {"mean_up_um", json_numbers(f.mean_up)},
+          {"mean_down_um", json_numbers(f.mean_down)},
+          {"mean_bi_um", json_numbers(f.mean_bi)},
+          {"s_up_um", json_numbers(f.s_up)},
+          {"s_down_um", json_numbers(f.s_down)},
+          {"B_i_um", json_numbers(f.B_i)},
+          {"R_i_up_um", json_numbers(f.R_i_up)},
+          {"R_i_down_um", json_numbers(f.R_i_down)},
+          {"R_i_um", json_numbers(f.R_i)},
+          {"B_um", json_number(f.B)},
+          {"B_mean_um", json_number(f.B_mean)},
+          {"R_up_um", json_number(f.R_up)},
+          {"R_down_um", json_number(f.R_down)},
+          {"R_um", json_number(f.R)},
+          {"E_up_um", json_number(f.E_up)},
+          {"E_down_um", json_number(f.E_down)},
+          {"E_um", json_number(f.E)},
+          {"M_um", json_number(f.M)},
+          {"A_up_um", json_number(f.A_up)},
+          {"A_down_um", json_number(f.A_down)},
+          {"A_um", json_number(f.A)}};
+}
+
+json differences_json(const AdjacentDifferences& D, const std::vector<double>& pos) {
+  json from = json::array(), to = json::array(), flagged = json::array(), pool = json::array();
+  for (std::size_t q = 0; q < D.mean.size(); ++q) {
+    from.push_back(pos[q]);
+    to.push_back(pos[q + 1]);
+    flagged.push_back(static_cast<bool>(D.flagged[q]));
+    pool.push_back(D.pool[q]);
+  }
+  return {{"from_mm", from},
+          {"to_mm", to},
+          {"mean_um", json_numbers(D.mean)},
+          {"s_um", json_numbers(D.s)},
+          {"sem_um", json_numbers(D.sem)},
+          {"F", json_numbers(D.F)},
+          {"p_value", json_numbers(D.p_value)},
+          {"pool", pool},
+          {"flagged", flagged}};
+}
+
+std::string fmt(double v, int precision = 3) {
+  if (!std::isfinite(v)) return "-";
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(precision) << v;
+  return s.str();
+}
+
+std::string dir_label(int d) { return d > 0 ? "+1" : "-1"; }
+
+// Lines of every cycle of one direction (only the first labelled), for a LinePlot.
+void add_cycles(LinePlot& p, const std::vector<std::vector<double>>& x, const std::string& label) {
+  const std::size_t n = x.empty() ? 0 : x[0].size();
+  for (std::size_t j = 0; j < n; ++j) {
+    std::vector<double> y;
+    for (const auto& row : x) y.push_back(row[j]);
+    p.lines.emplace_back(j == 0 ? label : std::string(), y);
+  }
+}
+
+void add_band(LinePlot& p, const std::vector<double>& mean, const std::vector<double>& s, double k,
+              const std::string& label) {
+  std::vector<double> lo, hi;
+  for (std::size_t i = 0; i < mean.size(); ++i)
+    lo.push_back(mean[i] - k * s[i]), hi.push_back(mean[i] + k * s[i]);
+  p.lines.emplace_back(label, mean);
+  p.lines.emplace_back(label + " +" + format_number(k) + "s", hi);
+  p.lines.emplace_back(label + " -" + format_number(k) + "s", lo);
+}
+
+}  // namespace
+
+std::string iso230_2_text(const std::string& data, const Iso230_2StudyResult& res) {
+  const IsoColumns& cols = res.columns;
+  const IsoRuns& runs = res.runs;
+  const Iso230_2Result& cr = res.classical;
+  const std::optional<DriftResult>& drift = res.drift;
+  const std::size_t m = runs.targets();
+  const std::string u = cols.unit;
+  const auto& P = runs.positions_mm;
+  const IsoFigures& F = cr.figures;
+  // ---- stdout ----
+  std::ostringstream o;
+  o << "weilgen iso230-2: " << data << ", axis " << cols.axis << " (deviation " << cols.deviation
+    << "), " << m << " target" << (m == 1 ? "" : "s") << ", " << runs.cycles[kUp].size()
+    << " cycles up, " << runs.cycles[kDown].size() << " cycles down\n\n";
+  o << "Per target (" << u << "; ISO 230-2, k = 2)\n";
+  o << std::setw(12) << "target mm" << std::setw(10) << "mean up" << std::setw(10) << "mean dn"
+    << std::setw(9) << "s up" << std::setw(9) << "s dn" << std::setw(9) << "B_i" << std::setw(9)
+    << "R_i up" << std::setw(9) << "R_i dn" << std::setw(9) << "R_i" << std::setw(10) << "mean bi"
+    << "\n";
+  for (std::size_t i = 0; i < m; ++i)
+    o << std::setw(12) << format_number(P[i]) << std::setw(10) << fmt(F.mean_up[i]) << std::setw(10)
+      << fmt(F.mean_down[i]) << std::setw(9) << fmt(F.s_up[i]) << std::setw(9) << fmt(F.s_down[i])
+      << std::setw(9) << fmt(F.B_i[i]) << std::setw(9) << fmt(F.R_i_up[i]) << std::setw(9)
+      << fmt(F.R_i_down[i]) << std::setw(9) << fmt(F.R_i[i]) << std::setw(10) << fmt(F.mean_bi[i])
+      << "\n";
+
+  struct Row {
+    const char* name;
+    const char* what;
+    double IsoFigures::*field;
+  };
+  const Row rows[] = {{"B", "reversal value", &IsoFigures::B},
+                      {"B mean", "mean reversal value", &IsoFigures::B_mean},
+                      {"R up", "unidirectional repeatability +", &IsoFigures::R_up},
+                      {"R down", "unidirectional repeatability -", &IsoFigures::R_down},
+                      {"R", "bidirectional repeatability", &IsoFigures::R},
+                      {"E up", "unidirectional systematic deviation +", &IsoFigures::E_up},
+                      {"E down", "unidirectional systematic deviation -", &IsoFigures::E_down},
+                      {"E", "bidirectional systematic deviation", &IsoFigures::E},
+                      {"M", "range of mean bidirectional deviation", &IsoFigures::M},
+                      {"A up", "unidirectional accuracy +", &IsoFigures::A_up},
+                      {"A down", "unidirectional accuracy -", &IsoFigures::A_down},
+                      {"A", "bidirectional accuracy", &IsoFigures::A}};
+  const IsoFigures* sets[4] = {&F, cr.student ? &*cr.student : nullptr,
+                               drift ? &drift->figures : nullptr,
+                               drift && drift->student ? &*drift->student : nullptr};
+  o << "\n"
+    << std::left << std::setw(46) << "Axis figures (" + u + ")" << std::right << std::setw(12)
+    << "classical" << std::setw(12) << "Student-t" << std::setw(12) << "drift-elim."
+    << std::setw(12) << "drift+t"
+    << "\n";
+  for (const Row& r : rows) {
+    o << "  " << std::left << std::setw(7) << r.name << std::setw(37) << r.what << std::right;
+    for (const IsoFigures* s : sets) o << std::setw(12) << (s ? fmt(s->*(r.field)) : "-");
+    o << "\n";
+  }
+  o << std::left << std::setw(46) << "  coverage factor k (up/down)" << std::right;
+  for (const IsoFigures* s : sets)
+    o << std::setw(12) << (s ? fmt(s->k_up, 2) + "/" + fmt(s->k_down, 2) : std::string("-"));
+  o << "\n";
+
+  if (drift) {
+    const DriftResult& D = *drift;
+    o << "\nDrift elimination (Stejskal et al. 2017): reference " << cols.axis << "="
+      << format_number(P[D.reference_target]) << " mm, cycle " << D.reference_cycle << "\n";
+    o << std::setw(20) << "between mm" << std::setw(10) << "diff up" << std::setw(9) << "s up"
+      << std::setw(10) << "p up" << std::setw(10) << "diff dn" << std::setw(9) << "s dn"
+      << std::setw(10) << "p dn"
+      << "\n";
+    for (std::size_t q = 0; q + 1 < m; ++q) {
+      auto pv = [&](int d) {
+        const auto& A = D.differences[d];
+        std::ostringstream s;
+        if (std::isfinite(A.p_value[q]))
+          s << std::setprecision(2) << A.p_value[q] << (A.flagged[q] ? "*" : "");
+        else
+          s << "-";
+        return s.str();
+      };
+      o << std::setw(20) << (format_number(P[q]) + ".." + format_number(P[q + 1])) << std::setw(10)
+        << fmt(D.differences[kUp].mean[q]) << std::setw(9) << fmt(D.differences[kUp].s[q])
+        << std::setw(10) << pv(kUp) << std::setw(10) << fmt(D.differences[kDown].mean[q])
+        << std::setw(9) << fmt(D.differences[kDown].s[q]) << std::setw(10) << pv(kDown) << "\n";
+    }
+    o << "  s of differences / s of positions: up " << fmt(D.s_ratio[kUp]) << ", down "
+      << fmt(D.s_ratio[kDown]) << " (sqrt 2 = 1.414 without drift)\n";
+    o << "\n"
+      << std::setw(12) << "target mm" << std::setw(11) << "chart up" << std::setw(9) << "s* up"
+      << std::setw(11) << "chart dn" << std::setw(9) << "s* dn"
+      << "\n";
+    for (std::size_t i = 0; i < m; ++i)
+      o << std::setw(12) << format_number(P[i]) << std::setw(11) << fmt(D.chart[kUp].value[i])
+        << std::setw(9) << fmt(D.chart[kUp].s[i]) << std::setw(11) << fmt(D.chart[kDown].value[i])
+        << std::setw(9) << fmt(D.chart[kDown].s[i]) << "\n";
+    o << "\nAnomaly test (F test of each difference's variance against the same-parity others,\n"
+         "Bonferroni over "
+      << D.tests << " tests, alpha " << format_number(D.alpha) << "): ";
+    if (D.anomalous_differences.empty()) {
+      o << "no anomalous spread\n";
+    } else {
+      o << "\n";
+      for (const auto& a : D.anomalous_differences)
+        o << "  dir " << dir_label(a.direction) << ": " << format_number(P[a.from]) << ".."
+          << format_number(P[a.to]) << " mm, s " << fmt(a.s) << " " << u << ", F " << fmt(a.F, 2)
+          << ", p " << std::setprecision(3) << a.p_value << "\n";
+      for (const auto& a : D.anomalous_positions)
+        o << "  anomalous position: " << cols.axis << "=" << format_number(P[a.target])
+          << " mm (target " << a.target + 1 << "), dir " << dir_label(a.direction) << "\n";
+    }
+    const DriftPerCycle& C = D.per_cycle;
+    o << "\nDrift per cycle (offset of the cycle's mean residual, relative to cycle "
+      << D.reference_cycle << ", " << u << ")\n";
+    o << std::setw(8) << "cycle" << (C.time_h.empty() ? "" : "   time h") << std::setw(10) << "up"
+      << std::setw(10) << "down" << std::setw(10) << "mean"
+      << "\n";
+    for (std::size_t c = 0; c < C.cycles.size(); ++c) {
+      o << std::setw(8) << C.cycles[c];
+      if (!C.time_h.empty()) o << std::setw(9) << fmt(C.time_h[c], 3);
+      o << std::setw(10) << fmt(C.offset_up[c]) << std::setw(10) << fmt(C.offset_down[c])
+        << std::setw(10) << fmt(C.offset[c]) << "\n";
+    }
+    o << "  drift rate: " << fmt(C.rate_per_cycle, 4) << " +- " << fmt(C.rate_per_cycle_se, 4)
+      << " " << u << "/cycle";
+    if (std::isfinite(C.rate_per_h))
+      o << ", " << fmt(C.rate_per_h, 4) << " +- " << fmt(C.rate_per_h_se, 4) << " " << u << "/h";
+    o << "\n";
+  } else {
+    o << "\nDrift elimination: needs at least 2 targets (skipped).\n";
+  }
+
+  return o.str();
+}
+
+nlohmann::json iso230_2_json(const std::string& data, const Iso230_2StudyResult& res) {
+  const IsoColumns& cols = res.columns;
+  const IsoRuns& runs = res.runs;
+  const Iso230_2Result& cr = res.classical;
+  const std::optional<DriftResult>& drift = res.drift;
+  const std::size_t m = runs.targets();
+  const std::string u = cols.unit;
+  const auto& P = runs.positions_mm;
+  const IsoFigures& F = cr.figures;
+  // ---- JSON ----
+  json j;
+  {
+    j = {
+        {"weilgen", kVersion}, {"command", "iso230-2"},         {"file", data},
+        {"axis", cols.axis},   {"column", cols.deviation},      {"deviation_unit", u},
+        {"targets", m},        {"cycles_up", runs.cycles[kUp]}, {"cycles_down", runs.cycles[kDown]},
+        {"positions_mm", P},   {"coverage_factor", F.k_up}};
+    j.update(figures_json(F));
+    j["student"] = cr.student ? figures_json(*cr.student) : json();
+    if (drift) {
+      const DriftResult& D = *drift;
+      json de = figures_json(D.figures);
+      de["reference_position_mm"] = P[D.reference_target];
+      de["reference_cycle"] = D.reference_cycle;
+      de["s_diff_up_um"] = json_numbers(D.chart[kUp].s_diff);
+      de["s_diff_down_um"] = json_numbers(D.chart[kDown].s_diff);
+      de["student"] = D.student ? figures_json(*D.student) : json();
+      de["adjacent_differences"] = {{"up", differences_json(D.differences[kUp], P)},
+                                    {"down", differences_json(D.differences[kDown], P)}};
+      de["s_ratio"] = {{"up", json_number(D.s_ratio[kUp])},
+                       {"down", json_number(D.s_ratio[kDown])}};
+      j["drift_eliminated"] = de;
+      const DriftPerCycle& C = D.per_cycle;
+      j["drift_per_cycle"] = {{"cycles", C.cycles},
+                              {"time_h", C.time_h.empty() ? json() : json_numbers(C.time_h)},
+                              {"offset_up_um", json_numbers(C.offset_up)},
+                              {"offset_down_um", json_numbers(C.offset_down)},
+                              {"offset_um", json_numbers(C.offset)},
+                              {"rate_um_per_cycle", json_number(C.rate_per_cycle)},
+                              {"rate_se_um_per_cycle", json_number(C.rate_per_cycle_se)},
+                              {"rate_um_per_h", json_number(C.rate_per_h)},
+                              {"rate_se_um_per_h", json_number(C.rate_per_h_se)}};
+      j["anomaly_test"] = {
+          {"alpha", D.alpha},
+          {"tests", D.tests},
+          {"threshold_p", D.tests ? json(D.alpha / static_cast<double>(D.tests)) : json()}};
+      json ad = json::array(), ap = json::array();
+      for (const auto& a : D.anomalous_differences)
+        ad.push_back({{"direction", a.direction},
+                      {"from_mm", P[a.from]},
+                      {"to_mm", P[a.to]},
+                      {"s_um", json_number(a.s)},
+                      {"F", json_number(a.F)},
+                      {"p_value", json_number(a.p_value)}});
+      for (const auto& a : D.anomalous_positions)
+        ap.push_back(
+            {{"direction", a.direction}, {"position_mm", P[a.target]}, {"target", a.target + 1}});
+      j["anomalous_differences"] = ad;
+      j["anomalous_positions"] = ap;
+    } else {
+      j["drift_eliminated"] = json();
+      j["drift_per_cycle"] = json();
+      j["anomalous_differences"] = json::array();
+      j["anomalous_positions"] = json::array();
+    }
+  }
+
+  return j;
+}
+
+std::vector<Panel> iso230_2_panels(const Iso230_2StudyResult& res) {
+  const IsoColumns& cols = res.columns;
+  const IsoRuns& runs = res.runs;
+  const Iso230_2Result& cr = res.classical;
+  const std::optional<DriftResult>& drift = res.drift;
+  const std::size_t m = runs.targets();
+  const std::string u = cols.unit;
+  const auto& P = runs.positions_mm;
+  const IsoFigures& F = cr.figures;
+  std::vector<Panel> panels;
+  {
+    const std::string ylabel = "deviation " + cols.deviation + " (" + u + ")";
+    const std::string xlabel = cols.axis + " (mm)";
+    LinePlot c1{"ISO 230-2: every cycle", xlabel, ylabel, P, {}};
+    add_cycles(c1, runs.x[kUp], "cycles up");
+    add_cycles(c1, runs.x[kDown], "cycles down");
+    panels.push_back(c1);
+    LinePlot c2{"ISO 230-2: mean deviations and +-2s", xlabel, ylabel, P, {}};
+    add_band(c2, F.mean_up, F.s_up, 2, "mean up");
+    add_band(c2, F.mean_down, F.s_down, 2, "mean down");
+    panels.push_back(c2);
+    if (drift) {
+      const DriftResult& D = *drift;
+      const std::string ref = cols.axis + "=" + format_number(P[D.reference_target]) +
+                              " mm, cycle " + std::to_string(D.reference_cycle);
+      LinePlot c3{"drift eliminated: every cycle shifted to " + ref, xlabel, ylabel, P, {}};
+      add_cycles(c3, D.chart[kUp].shifted, "cycles up");
+      add_cycles(c3, D.chart[kDown].shifted, "cycles down");
+      panels.push_back(c3);
+      LinePlot c4{"drift eliminated: chart from " + ref + ", +-2s*", xlabel, ylabel, P, {}};
+      add_band(c4, D.chart[kUp].value, D.chart[kUp].s, 2, "chart up");
+      add_band(c4, D.chart[kDown].value, D.chart[kDown].s, 2, "chart down");
+      panels.push_back(c4);
+      BarChart c5{"s of adjacent differences (seed Fig. 10)", "s (" + u + ")", {}, {}};
+      BarSeries su{"up", D.differences[kUp].s, {}, {}}, sd{"down", D.differences[kDown].s, {}, {}};
+      for (std::size_t q = 0; q + 1 < m; ++q)
+        c5.categories.push_back(format_number(P[q]) + ".." + format_number(P[q + 1]));
+      c5.series = {su, sd};
+      panels.push_back(c5);
+      std::vector<double> cyc;
+      for (long c : D.per_cycle.cycles) cyc.push_back(static_cast<double>(c));
+      LinePlot c6{"drift per cycle (relative to cycle " + std::to_string(D.reference_cycle) + ")",
+                  "cycle",
+                  "offset (" + u + ")",
+                  cyc,
+                  {{"up", D.per_cycle.offset_up},
+                   {"down", D.per_cycle.offset_down},
+                   {"mean", D.per_cycle.offset}}};
+      panels.push_back(c6);
+    }
+  }
+  return panels;
+}
+
+}  // namespace weilgen
