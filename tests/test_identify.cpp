@@ -1,5 +1,5 @@
-// Identification (runtime/identify.hpp): recovery of known parameters, the noise level, the
-// exact chain against the first-order model, unidentifiable combinations on a poor layout, the
+// Identification (weilgen/analysis/identify.hpp): recovery of known parameters, the noise level,
+// the exact chain against the first-order model, unidentifiable combinations on a poor layout, the
 // Gauss-Newton path for order >= 2, basis choice and the params header.
 #include <doctest/doctest.h>
 
@@ -87,9 +87,7 @@ TEST_CASE("identify: noise-free data give the identifiable parameters and every 
   auto f = [&](const double* q) { return predict_deviation(m, md, p, truth, q); };
   const PointData data =
       synthesise(grid(levels(0, 500, 5), levels(-400, 0, 4), levels(-300, 0, 4)), f, 0, rng);
-  Identification id(m, p);
-  id.run(data);
-  const IdentifyResult& r = id.result();
+  const IdentifyResult r = Identification().run(m, p, data);
   CHECK(r.observations == 240);
   CHECK(r.rank + r.unidentifiable.size() == p.size());
   CHECK(r.rank < p.size());
@@ -134,9 +132,7 @@ TEST_CASE("identify: with noise, sigma is recovered and parameters lie within th
   const double noise = 0.5;  // µm
   const PointData data =
       synthesise(grid(levels(0, 500, 8), levels(-400, 0, 6), levels(-300, 0, 5)), f, noise, rng);
-  Identification id(m, p);
-  id.run(data);
-  const IdentifyResult& r = id.result();
+  const IdentifyResult r = Identification().run(m, p, data);
   CHECK(r.residual_sigma == doctest::Approx(noise).epsilon(0.06));
   double worst = 0;
   for (std::size_t k = 0; k < p.size(); ++k)
@@ -165,11 +161,9 @@ TEST_CASE("identify: data from the exact chain leave a residual of second order 
       return v;
     };
     const PointData data = synthesise(poses, exact, 0, rng);
-    Identification id(m, p);
-    id.run(data);
+    const IdentifyResult res = Identification().run(m, p, data);
     scales.push_back(s);
-    residuals.push_back(id.result().rms_after[0] + id.result().rms_after[1] +
-                        id.result().rms_after[2]);
+    residuals.push_back(res.rms_after[0] + res.rms_after[1] + res.rms_after[2]);
   }
   CHECK(residuals[0] > 0);
   CHECK(test::loglog_slope(scales, residuals) == doctest::Approx(2).epsilon(0.1));
@@ -184,9 +178,7 @@ TEST_CASE("identify: a line along X cannot identify the shapes of Y and Z errors
   ModelData md(m);
   auto f = [&](const double* q) { return predict_deviation(m, md, p, truth, q); };
   const PointData line = synthesise(grid(levels(0, 500, 11), {-200}, {-150}), f, 0, rng);
-  Identification id(m, p);
-  id.run(line);
-  const IdentifyResult& r = id.result();
+  const IdentifyResult r = Identification().run(m, p, line);
   for (std::size_t k = 0; k < p.size(); ++k) {
     const IdentParameter& ip = p.parameters()[k];
     const std::string& coord = p.coordinate_of(static_cast<std::size_t>(ip.error));
@@ -253,16 +245,14 @@ TEST_CASE("identify: Gauss-Newton fits a nonlinear (order 2) model exactly") {
   auto f = [&](const double* q) { return predict_deviation(exact, md, p, truth, q); };
   const PointData data =
       synthesise(grid(levels(0, 500, 4), levels(-400, 0, 4), levels(-300, 0, 4)), f, 0, rng);
-  Identification gn(exact, p);
-  gn.run(data);
-  Identification lin(linear, p);
-  lin.run(data);
-  CHECK(gn.result().gauss_newton_iterations >= 2);
-  CHECK(gn.result().gauss_newton_iterations <= 8);
-  CHECK(lin.result().rms_after[0] > 0.05);  // second-order terms the linear fit cannot follow
+  const IdentifyResult gn = Identification().run(exact, p, data);
+  const IdentifyResult lin = Identification().run(linear, p, data);
+  CHECK(gn.gauss_newton_iterations >= 2);
+  CHECK(gn.gauss_newton_iterations <= 8);
+  CHECK(lin.rms_after[0] > 0.05);  // second-order terms the linear fit cannot follow
   // Left: directions first-order data cannot see, seen only through error products (the step
   // keeps out of them: docs/identify.md); 1000x below the linear fit's residual.
-  for (int o = 0; o < 3; ++o) CHECK(gn.result().rms_after[o] < 1e-3 * lin.result().rms_after[0]);
+  for (int o = 0; o < 3; ++o) CHECK(gn.rms_after[o] < 1e-3 * lin.rms_after[0]);
 }
 
 TEST_CASE("identify: the basis of each PDGE (flags, machine file) and bad spellings") {
@@ -338,9 +328,7 @@ TEST_CASE("identify: the committed params header is current and evaluates the id
   const ErrorParameterisation p(d, {});
   const MeasurementTable t =
       read_measurements(std::string(WEILGEN_SOURCE_DIR) + "/examples/data/vmc_3axis_points.csv");
-  Identification id(m, p);
-  id.run(point_data(t, d));
-  const IdentifyResult& r = id.result();
+  const IdentifyResult r = Identification().run(m, p, point_data(t, d));
   // The same text as `weilgen identify vmc_3axis --data examples/data/vmc_3axis_points.csv
   // --emit-params generated/vmc_3axis_params.hpp` (scripts/regenerate_params.sh).
   const std::string committed =

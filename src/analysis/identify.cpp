@@ -275,11 +275,18 @@ MatrixXd design_matrix(const Model& model, const ErrorParameterisation& param,
   return A;
 }
 
-Identification::Identification(const Model& model, const ErrorParameterisation& param,
-                               IdentifyOptions options)
-    : model_(model), param_(param), options_(std::move(options)) {}
+void IdentifyOptions::validate() const {
+  if (!(rank_tolerance > 0 && rank_tolerance < 1))
+    throw std::invalid_argument("--rank-tol must be in (0, 1)");
+  if (max_gauss_newton < 0) throw std::invalid_argument("identify: max_gauss_newton must be >= 0");
+}
 
-void Identification::run(const PointData& data) {
+Identification::Identification(IdentifyOptions options) : options_(std::move(options)) {
+  options_.validate();
+}
+
+IdentifyResult Identification::run(const Model& model_, const ErrorParameterisation& param_,
+                                   const PointData& data) const {
   const Description& desc = model_.description();
   const std::size_t np = param_.size(), m = data.observations.size();
   IdentifyResult R;
@@ -402,7 +409,7 @@ void Identification::run(const PointData& data) {
     R.rms_after[o] = n > 0 ? std::sqrt(ss_after[o] / n) : kNaN;
     if (n == 0) R.max_after[o] = kNaN;
   }
-  result_ = std::move(R);
+  return R;
 }
 
 std::array<double, 6> predict_deviation(const Model& model, ModelData& data,
@@ -413,6 +420,28 @@ std::array<double, 6> predict_deviation(const Model& model, ModelData& data,
   model.deviation(data, axes, data.errors.data(), out.data());
   for (std::size_t o = 0; o < 6; ++o) out[o] *= kMeasuredScale[o];
   return out;
+}
+
+// All --data files as one set of observations (rows keep their file for messages).
+PointData merged_point_data(const std::vector<std::string>& files, const Description& desc,
+                            const ReadOptions& ro,
+                            const std::function<void(const std::string&)>& warn) {
+  PointData all;
+  for (const std::string& f : files) {
+    const MeasurementTable t = read_measurements(f, ro);
+    if (warn)
+      for (const auto& w : t.warnings) warn(w);
+    PointData d = point_data(t, desc);
+    const std::size_t base = all.poses.size();
+    for (auto& p : d.poses) all.poses.push_back(std::move(p));
+    for (PointObservation ob : d.observations) {
+      ob.row += base;
+      all.observations.push_back(ob);
+    }
+    for (std::size_t o = 0; o < 6; ++o) all.count[o] += d.count[o];
+    all.file += (all.file.empty() ? "" : ", ") + f;
+  }
+  return all;
 }
 
 }  // namespace weilgen

@@ -18,6 +18,7 @@
 #include <Eigen/Dense>
 #include <array>
 #include <cstddef>
+#include <functional>
 #include <optional>
 #include <string>
 #include <utility>
@@ -136,6 +137,12 @@ struct PointData {
 // naming the column), and at least one deviation cell measured.
 PointData point_data(const MeasurementTable& table, const Description& desc);
 
+// Every --data file's point data as one set of observations (rows keep their file for
+// messages); `warn` receives each file's reader warnings (may be empty).
+PointData merged_point_data(const std::vector<std::string>& files, const Description& desc,
+                            const ReadOptions& options,
+                            const std::function<void(const std::string&)>& warn = {});
+
 // The first-order design matrix: row i is observation i, column p parameter p, in µm (µrad) per
 // unit of θ_p: scale_o · C[o][error_p](pose) · ∂error_p/∂θ_p(pose).
 Eigen::MatrixXd design_matrix(const Model& model, const ErrorParameterisation& param,
@@ -145,6 +152,8 @@ struct IdentifyOptions {
   double rank_tolerance = 1e-9;    // singular values below tol · σ_max (equilibrated) are null
   int max_gauss_newton = 8;        // iterations at order >= 2
   std::vector<std::string> fixed;  // errors held at zero (names or aliases)
+  // rank_tolerance in (0, 1), max_gauss_newton >= 0 (std::invalid_argument naming the field).
+  void validate() const;
 };
 
 // A parameter combination the data cannot determine: adding t·Σ coeff_p e_p (θ units) changes
@@ -171,16 +180,14 @@ struct IdentifyResult {
 
 class Identification {
  public:
-  Identification(const Model& model, const ErrorParameterisation& param,
-                 IdentifyOptions options = {});
-  void run(const PointData& data);
-  const IdentifyResult& result() const { return result_; }
+  explicit Identification(IdentifyOptions options = {});  // validates the options
+  const IdentifyOptions& options() const { return options_; }
+  // The parameters of `param` for the model from the observations in `data`.
+  IdentifyResult run(const Model& model, const ErrorParameterisation& param,
+                     const PointData& data) const;
 
  private:
-  const Model& model_;
-  const ErrorParameterisation& param_;
   IdentifyOptions options_;
-  IdentifyResult result_;
 };
 
 // Predicted deviations (dx..dz µm, da..dc µrad) at a pose from identified parameters.

@@ -3,8 +3,6 @@
 #pragma once
 
 #include <array>
-#include <nlohmann/json.hpp>
-#include <ostream>
 #include <string>
 #include <vector>
 
@@ -12,7 +10,7 @@
 #include "weilgen/measure/ballbar.hpp"
 #include "weilgen/measure/measurement_csv.hpp"
 
-namespace weilgen::cli {
+namespace weilgen {
 
 struct Prediction {
   std::string file;
@@ -30,11 +28,6 @@ struct Prediction {
 Prediction predict_table(const Model& model, const ErrorParameterisation& param,
                          const std::vector<double>& theta, const MeasurementTable& table);
 
-void print_prediction(std::ostream& os, const Prediction& p);
-nlohmann::json prediction_json(const Prediction& p);
-// A measurement CSV (docs/data-format.md) of the predicted deviations.
-std::string prediction_csv(const Prediction& p, const Description& desc);
-
 // A ballbar file: a table with angle_deg (and dr_um when measured) or only the circle's header
 // keys; the circle from the header keys, overridden by `flags`.
 bool is_ballbar_table(const MeasurementTable& table);
@@ -50,7 +43,5 @@ struct BallbarPrediction {
 BallbarPrediction predict_ballbar_table(const Model& model, const ErrorParameterisation& param,
                                         const std::vector<double>& theta,
                                         const MeasurementTable& table, const BallbarFlags& flags);
-void print_ballbar_prediction(std::ostream& os, const BallbarPrediction& p);
-nlohmann::json ballbar_prediction_json(const BallbarPrediction& p);
 
-}  // namespace weilgen::cli
+}  // namespace weilgen

@@ -1,69 +1,15 @@
-#include "prediction.hpp"
+#include "weilgen/report/prediction_document.hpp"
 
-#include <cmath>
 #include <iomanip>
 #include <sstream>
 
-#include "study.hpp"
-#include "weilgen/analysis/ballbar_model.hpp"
 #include "weilgen/base/format.hpp"
-#include "weilgen/base/text.hpp"
+#include "weilgen/report/json_common.hpp"
 
-namespace weilgen::cli {
+namespace weilgen {
 
-namespace {
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-}  // namespace
-
-Prediction predict_table(const Model& model, const ErrorParameterisation& param,
-                         const std::vector<double>& theta, const MeasurementTable& table) {
-  const Description& d = model.description();
-  Prediction p;
-  p.file = table.file;
-  std::vector<const std::vector<double>*> coord;
-  for (int b : d.axes()) {
-    p.axes.push_back(d.bodies[static_cast<std::size_t>(b)].joint.coordinate);
-    coord.push_back(&table.column(p.axes.back()));
-  }
-  ModelData md(model);
-  std::vector<double> pose(p.axes.size());
-  std::array<double, 6> ss_meas{}, ss_diff{};
-  p.max_difference.fill(0);
-  for (std::size_t r = 0; r < table.rows(); ++r) {
-    bool complete = true;
-    for (std::size_t a = 0; a < pose.size(); ++a) {
-      pose[a] = (*coord[a])[r];
-      complete = complete && std::isfinite(pose[a]);
-    }
-    if (!complete) continue;
-    const std::array<double, 6> f = predict_deviation(model, md, param, theta, pose.data());
-    std::array<double, 6> m;
-    for (std::size_t o = 0; o < 6; ++o) {
-      m[o] = table.has(kDeviationColumns[o]) ? table.column(kDeviationColumns[o])[r] : kNaN;
-      if (!std::isfinite(m[o])) continue;
-      ++p.compared[o];
-      ss_meas[o] += m[o] * m[o];
-      ss_diff[o] += (m[o] - f[o]) * (m[o] - f[o]);
-      p.max_difference[o] = std::max(p.max_difference[o], std::abs(m[o] - f[o]));
-    }
-    p.poses.push_back(pose);
-    p.lines.push_back(table.lines[r]);
-    p.predicted.push_back(f);
-    p.measured.push_back(m);
-  }
-  if (p.poses.empty())
-    throw InputError(SourceLoc{table.file, 0, 0},
-                     "no row has every coordinate (" + join(p.axes) + "): nothing to predict");
-  for (std::size_t o = 0; o < 6; ++o) {
-    const double n = static_cast<double>(p.compared[o]);
-    p.rms_measured[o] = n > 0 ? std::sqrt(ss_meas[o] / n) : kNaN;
-    p.rms_difference[o] = n > 0 ? std::sqrt(ss_diff[o] / n) : kNaN;
-    if (n == 0) p.max_difference[o] = kNaN;
-  }
-  return p;
-}
-
-void print_prediction(std::ostream& os, const Prediction& p) {
+std::string prediction_text(const Prediction& p) {
+  std::ostringstream os;
   os << "prediction for " << p.file << ": " << p.poses.size() << " poses\n";
   bool any = false;
   for (std::size_t o = 0; o < 6; ++o) {
@@ -75,6 +21,7 @@ void print_prediction(std::ostream& os, const Prediction& p) {
        << std::setw(10) << format_short(p.max_difference[o]) << "  " << observation_unit(o) << "\n";
   }
   if (!any) os << "(no measured deviations to compare with; --predict-out writes the values)\n";
+  return os.str();
 }
 
 nlohmann::json prediction_json(const Prediction& p) {
@@ -109,33 +56,6 @@ std::string prediction_csv(const Prediction& p, const Description& desc) {
   return s.str();
 }
 
-bool is_ballbar_table(const MeasurementTable& table) {
-  return table.has("angle_deg") || table.has("dr_um") || !table.header_key("plane").empty();
-}
-
-BallbarPrediction predict_ballbar_table(const Model& model, const ErrorParameterisation& param,
-                                        const std::vector<double>& theta,
-                                        const MeasurementTable& table, const BallbarFlags& flags) {
-  BallbarPrediction p;
-  p.file = table.file;
-  const BallbarMachine machine = ballbar_machine(model);
-  p.circle = parse_ballbar_circle(table, machine, flags);
-  auto md = std::make_shared<ModelData>(model);
-  const DeviationFn fn = [&model, &param, &theta, md](const double* axes, double* out6) {
-    param.errors_at(axes, theta.data(), md->errors.data());
-    model.deviation(*md, axes, md->errors.data(), out6);
-  };
-  p.predicted = predict_ballbar(machine, p.circle, fn);
-  p.predicted_evaluation = evaluate_ballbar(p.predicted, p.circle.radius_mm);
-  if (table.has("dr_um")) {
-    for (const BallbarTrace& measured : ballbar_traces(table, p.circle)) {
-      const BallbarTrace at = predict_ballbar_at(machine, p.circle, fn, measured.angle_deg);
-      p.compared.push_back(compare_ballbar(measured, at, p.circle.radius_mm));
-    }
-  }
-  return p;
-}
-
 namespace {
 
 nlohmann::json evaluation_json(const BallbarEvaluation& e) {
@@ -160,7 +80,8 @@ void print_evaluation(std::ostream& os, const char* what, const BallbarEvaluatio
 
 }  // namespace
 
-void print_ballbar_prediction(std::ostream& os, const BallbarPrediction& p) {
+std::string ballbar_prediction_text(const BallbarPrediction& p) {
+  std::ostringstream os;
   const BallbarCircle& c = p.circle;
   os << "ballbar prediction for " << p.file << ": plane " << c.plane << ", radius "
      << format_short(c.radius_mm) << " mm, " << (c.feed > 0 ? "ccw" : "cw") << "\n";
@@ -174,6 +95,7 @@ void print_ballbar_prediction(std::ostream& os, const BallbarPrediction& p) {
        << "; G of the difference (after ideal compensation) "
        << format_short(k.difference.circular_deviation_um) << " µm\n";
   }
+  return os.str();
 }
 
 nlohmann::json ballbar_prediction_json(const BallbarPrediction& p) {
@@ -196,4 +118,4 @@ nlohmann::json ballbar_prediction_json(const BallbarPrediction& p) {
           {"compared", compared}};
 }
 
-}  // namespace weilgen::cli
+}  // namespace weilgen
