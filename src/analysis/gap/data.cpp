@@ -1,0 +1,144 @@
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+#include <optional>
+#include <set>
+#include <stdexcept>
+
+#include "internal.hpp"
+#include "weilgen/analysis/ballbar_model.hpp"
+#include "weilgen/base/format.hpp"
+#include "weilgen/base/text.hpp"
+
+namespace weilgen {
+
+using namespace gap_detail;
+
+namespace {
+
+// A ballbar trace's dr observations: poses on the circle, the ball-to-ball unit vectors.
+PointData ballbar_points(const MeasurementTable& t, const Description& desc,
+                         const BallbarFlags& flags, const std::vector<double>& parameters,
+                         std::optional<BallbarCircle>& circle) {
+  const BallbarMachine machine = ballbar_machine(desc, parameters);
+  circle = parse_ballbar_circle(t, machine, flags);
+  if (!t.has("angle_deg"))
+    throw InputError(SourceLoc{t.file, t.header_line, 0},
+                     "a ballbar trace needs an 'angle_deg' column beside 'dr_um' (columns: " +
+                         join(t.columns) + ")");
+  const std::vector<double>& angle = t.column("angle_deg");
+  const std::vector<double>& dr = t.column("dr_um");
+  PointData p;
+  p.file = t.file;
+  p.poses.assign(t.rows(), {});
+  std::vector<double> angles;  // of the measured rows, for one call to ballbar_directions
+  for (std::size_t r = 0; r < t.rows(); ++r) {
+    if (!std::isfinite(dr[r])) continue;
+    if (!std::isfinite(angle[r]))
+      throw InputError(SourceLoc{t.file, t.lines[r], 0},
+                       "column 'angle_deg' is empty but dr_um is measured");
+    p.poses[r] = ballbar_pose(machine, *circle, angle[r]);
+    PointObservation ob;
+    ob.row = r;
+    ob.line = t.lines[r];
+    ob.output = kRadialOutput;
+    ob.value = dr[r];
+    p.observations.push_back(ob);
+    angles.push_back(angle[r]);
+  }
+  if (p.observations.empty())
+    throw InputError(SourceLoc{t.file, 0, 0}, "no observations (no row has a measured dr_um)");
+  const std::vector<std::array<double, 3>> u = ballbar_directions(machine, *circle, angles);
+  for (std::size_t i = 0; i < u.size(); ++i) p.observations[i].radial = u[i];
+  p.count[kRadialOutput] = p.observations.size();
+  return p;
+}
+
+}  // namespace
+
+GapData gap_data(const MeasurementTable& table, const Description& desc,
+                 const std::map<std::string, double>& fixed, const BallbarFlags& ballbar,
+                 const std::vector<double>& parameters) {
+  MeasurementTable t = table;
+  GapData g;
+  const bool trace = t.has("dr_um");
+  for (int b : desc.axes()) {
+    const std::string& c = desc.bodies[static_cast<std::size_t>(b)].joint.coordinate;
+    g.axes.push_back(c);
+    if (trace || t.has(c)) continue;
+    const auto it = fixed.find(c);
+    if (it == fixed.end())
+      throw InputError(SourceLoc{t.file, t.header_line, 0},
+                       "missing column '" + c + "' (give the coordinate of a pose the data do " +
+                           "not vary with --at " + c + "=VALUE; columns: " + join(t.columns) + ")");
+    t.values[c] = std::vector<double>(t.rows(), it->second);
+    t.columns.push_back(c);
+    ColumnInfo info;
+    info.name = c;
+    info.role = ColumnRole::Coordinate;
+    info.unit = desc.bodies[static_cast<std::size_t>(b)].joint.unit;
+    t.info.push_back(info);
+    g.fixed_axes.push_back(c);
+  }
+  g.points = trace ? ballbar_points(t, desc, ballbar, parameters, g.circle) : point_data(t, desc);
+  const std::size_t rows = t.rows();
+  g.time_s = t.has("t_s") ? t.column("t_s") : std::vector<double>(rows, kNaN);
+  g.cycle = t.has("cycle") ? t.column("cycle") : std::vector<double>(rows, kNaN);
+  // Observed rows only decide what varies.
+  std::vector<bool> observed(rows, false);
+  for (const PointObservation& o : g.points.observations) observed[o.row] = true;
+  auto check_varies = [&](const std::string& name, const std::vector<double>& v, const char* unit) {
+    double lo = INFINITY, hi = -INFINITY;
+    for (std::size_t r = 0; r < rows; ++r) {
+      if (!observed[r]) continue;
+      if (!std::isfinite(v[r]))
+        throw InputError(SourceLoc{t.file, t.lines[r], 0},
+                         "column '" + name +
+                             "' is empty or not a number where a deviation is "
+                             "measured (the diagnosis needs it in every row)");
+      lo = std::min(lo, v[r]), hi = std::max(hi, v[r]);
+    }
+    if (!(hi > lo))
+      throw InputError(SourceLoc{t.file, t.header_line, 0},
+                       "column '" + name + "' is constant (" + format_short(lo) + " " + unit +
+                           "): it cannot explain anything; drop the column");
+  };
+  for (const std::string& c : t.columns_with(ColumnRole::Temperature)) {
+    check_varies(c, t.column(c), "degC");
+    g.temperature[c] = t.column(c);
+  }
+  for (const std::string& c : t.columns_with(ColumnRole::Covariate)) {
+    check_varies(c, t.column(c), t.info_of(c).unit.c_str());
+    g.covariate[c] = t.column(c);
+  }
+  if (t.has("t_s")) check_varies("t_s", g.time_s, "s");
+  // Directions: dir_<axis>, or `dir` for the axis that varies most.
+  if (trace) {
+    check_varies("angle_deg", t.column("angle_deg"), "deg");
+    g.covariate["angle_deg"] = t.column("angle_deg");
+  }
+  for (const std::string& c : t.columns_with(ColumnRole::Direction)) {
+    std::string axis = t.info_of(c).axis;
+    if (axis.empty() && trace) {  // a trace's `dir` is its feed (ccw +1, cw -1)
+      check_varies("dir", t.column(c), "");
+      g.covariate["feed"] = t.column(c);
+      continue;
+    }
+    if (axis.empty()) {
+      std::size_t best = 0;
+      for (const std::string& a : g.axes) {
+        const std::size_t n = t.has(a) ? distinct(t.column(a)) : 0;
+        if (n > best) best = n, axis = a;
+      }
+    }
+    if (!axis.empty()) g.dir[axis] = t.column(c);
+  }
+  if (g.points.observations.size() < 10)
+    throw InputError(SourceLoc{t.file, 0, 0}, "only " +
+                                                  std::to_string(g.points.observations.size()) +
+                                                  " observations: the diagnosis needs at least 10");
+  return g;
+}
+
+}  // namespace weilgen

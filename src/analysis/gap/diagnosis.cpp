@@ -1,0 +1,457 @@
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+#include <optional>
+#include <set>
+#include <stdexcept>
+
+#include "effects.hpp"
+#include "internal.hpp"
+#include "weilgen/base/format.hpp"
+#include "weilgen/base/text.hpp"
+#include "weilgen/uq/lsq.hpp"
+
+namespace weilgen {
+
+using namespace gap_detail;
+
+const std::vector<std::string>& gap_effect_names() {
+  static const std::vector<std::string> names = {"thermal_drift", "reversal",     "periodic",
+                                                 "pdge_shape",    "higher_order", "missing_error",
+                                                 "tool_offset",   "setup"};
+  return names;
+}
+
+GapDiagnosis::GapDiagnosis(std::shared_ptr<const Model> model, const ErrorParameterisation& param,
+                           GapOptions options)
+    : model_(std::move(model)), param_(param), options_(std::move(options)) {}
+
+namespace {
+
+// Evaluates one candidate (all variants; the variant chosen by training SSE over the splits)
+// against the engine's current model.
+struct Evaluated {
+  EffectFit fit;
+  gap_detail::Variant variant;  // the chosen (possibly refined) variant
+  MatrixXd columns;             // full-data columns of the chosen variant (for acceptance)
+  VectorXd heldout;             // held-out residual after
+  VectorXd coef;                // full-data coefficients of the columns
+  double heldout_sse = INFINITY;
+};
+
+// Least-squares coefficients of columns Eperp (already projected off the model's span) for the
+// residual r; empty when the model spans them. The rank is decided on columns scaled by their
+// norm before projection (`norm`): columns (nearly) inside the span would otherwise get huge
+// coefficients from rounding.
+std::optional<VectorXd> projected_fit(const MatrixXd& Eperp, VectorXd norm, const VectorXd& r) {
+  for (Index k = 0; k < norm.size(); ++k)
+    if (!(norm[k] > 0)) norm[k] = 1;
+  const MatrixXd Es = Eperp * norm.cwiseInverse().asDiagonal();
+  Eigen::ColPivHouseholderQR<MatrixXd> qr(Es);
+  qr.setThreshold(1e-6);
+  if (qr.rank() == 0) return std::nullopt;
+  return VectorXd(norm.cwiseInverse().asDiagonal() * qr.solve(r));
+}
+
+// The columns of a θ-dependent variant for the fit `ff` on rows `train`: at the fit's θ, then
+// (Variant::theta_iterations) at the θ of the joint fit [A E] with those columns.
+MatrixXd theta_columns(const gap_detail::Candidate& c, const gap_detail::Variant& v,
+                       const FoldFit& ff, const std::vector<std::size_t>& train, std::size_t np) {
+  MatrixXd E = c.columns(v, split_theta(ff.theta, np));
+  for (int it = 0; it < v.theta_iterations; ++it) {
+    const MatrixXd Etr = rows_of(E, train);
+    const MatrixXd P = ff.U.transpose() * Etr;
+    const auto coef = projected_fit(Etr - ff.U * P, Etr.colwise().norm().transpose(), ff.res_train);
+    if (!coef) break;
+    E = c.columns(v, split_theta(VectorXd(ff.theta - ff.VS * (P * *coef)), np));
+  }
+  return E;
+}
+
+Evaluated evaluate(const gap_detail::Candidate& c, const Engine& e, std::size_t np,
+                   const VectorXd& base_r, const VectorXd& base_h, double s2, double alpha,
+                   double n_candidates) {
+  Evaluated best;
+  double best_train = INFINITY;
+  // Training SSE over the splits and the held-out residual of one variant; false when the
+  // model already spans its columns.
+  auto score = [&](const gap_detail::Variant& v, double& train_sse, VectorXd& after,
+                   MatrixXd& shared) {
+    train_sse = 0;
+    after = VectorXd::Constant(e.y.size(), kNaN);
+    if (!v.needs_theta) shared = c.columns(v, {});
+    for (std::size_t f = 0; f < e.splits.size(); ++f) {
+      const Split& s = e.splits[f];
+      const FoldFit& ff = e.folds[f];
+      const MatrixXd E = v.needs_theta ? theta_columns(c, v, ff, s.train, np) : shared;
+      const MatrixXd Etr = rows_of(E, s.train), Ete = rows_of(E, s.test);
+      const MatrixXd P = ff.U.transpose() * Etr;
+      const MatrixXd Eperp = Etr - ff.U * P;
+      const auto fitted = projected_fit(Eperp, Etr.colwise().norm().transpose(), ff.res_train);
+      if (!fitted) return false;  // the model already spans these columns
+      const VectorXd& coef = *fitted;
+      train_sse += (ff.res_train - Eperp * coef).squaredNorm();
+      const VectorXd delta = (Ete - ff.W * P) * coef;
+      for (std::size_t i = 0; i < s.test.size(); ++i)
+        after[static_cast<Index>(s.test[i])] =
+            ff.res_test[static_cast<Index>(i)] - delta[static_cast<Index>(i)];
+    }
+    return true;
+  };
+  MatrixXd best_shared;
+  for (const gap_detail::Variant& v : c.variants) {
+    double train_sse = 0;
+    VectorXd after;
+    MatrixXd shared;
+    if (!score(v, train_sse, after, shared) || !(train_sse < best_train)) continue;
+    best_train = train_sse;
+    best.variant = v;
+    best.heldout = after;
+    best_shared = shared;
+  }
+  // Continuous hyper-parameters (a period, a lag, a bump's centre and width) are refined between
+  // their grid neighbours by golden section on the training SSE, one after the other, twice; the
+  // p-value keeps the grid's multiplicity.
+  if (std::isfinite(best_train) && !best.variant.refine.empty()) {
+    gap_detail::Variant v = best.variant;
+    auto sse_at = [&](std::size_t k, double x) {
+      gap_detail::Variant t = v;
+      t.hyper[k] = x;
+      double sse = INFINITY;
+      VectorXd after;
+      MatrixXd shared;
+      if (!score(t, sse, after, shared)) return static_cast<double>(INFINITY);
+      return sse;
+    };
+    const double g = (std::sqrt(5.0) - 1) / 2;
+    for (int pass = 0; pass < 2; ++pass)
+      for (const auto& r : v.refine) {
+        double lo = r.lo, hi = r.hi;
+        double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo);
+        double f1 = sse_at(r.index, x1), f2 = sse_at(r.index, x2);
+        for (int it = 0; it < 30 && hi - lo > 1e-6 * std::abs(hi); ++it) {
+          if (f1 < f2) {
+            hi = x2, x2 = x1, f2 = f1, x1 = hi - g * (hi - lo), f1 = sse_at(r.index, x1);
+          } else {
+            lo = x1, x1 = x2, f1 = f2, x2 = lo + g * (hi - lo), f2 = sse_at(r.index, x2);
+          }
+        }
+        const double x = f1 < f2 ? x1 : x2;
+        if (std::min(f1, f2) < sse_at(r.index, v.hyper[r.index])) v.hyper[r.index] = x;
+      }
+    double sse = INFINITY;
+    VectorXd after;
+    MatrixXd shared;
+    if (score(v, sse, after, shared) && sse < best_train) {
+      best_train = sse;
+      best.variant = v;
+      best.heldout = after;
+      best_shared = shared;
+    }
+  }
+  if (std::isfinite(best_train)) {
+    best.fit.variant = best.variant.label;
+    best.columns = best.variant.needs_theta
+                       ? theta_columns(c, best.variant, e.full,
+                                       all_rows(static_cast<std::size_t>(e.y.size())).train, np)
+                       : best_shared;
+    best.fit.tested_variants = static_cast<double>(c.variants.size());
+  }
+  best.fit.name = c.name;
+  if (!std::isfinite(best_train)) return best;
+  // Held-out before/after.
+  Gap before, afterg;
+  std::array<double, kObservationKinds> sb{}, sa{};
+  std::array<std::size_t, kObservationKinds> n{};
+  const auto& obs = e.data.points.observations;
+  best.heldout_sse = 0;
+  for (Index i = 0; i < e.y.size(); ++i) {
+    if (!std::isfinite(best.heldout[i])) continue;
+    const auto o = static_cast<std::size_t>(obs[static_cast<std::size_t>(i)].output);
+    sb[o] += base_r[i] * base_r[i];
+    sa[o] += best.heldout[i] * best.heldout[i];
+    ++n[o];
+    before.ss += base_r[i] * base_r[i];
+    afterg.ss += best.heldout[i] * best.heldout[i];
+    before.expected += s2 * (1 + base_h[i]);
+    ++before.n;
+  }
+  best.heldout_sse = afterg.ss;
+  for (std::size_t o = 0; o < kObservationKinds; ++o) {
+    best.fit.rms_before[o] = n[o] ? std::sqrt(sb[o] / static_cast<double>(n[o])) : kNaN;
+    best.fit.rms_after[o] = n[o] ? std::sqrt(sa[o] / static_cast<double>(n[o])) : kNaN;
+  }
+  const double nn = static_cast<double>(before.n);
+  best.fit.heldout_rms_before_um = std::sqrt(before.ss / nn);
+  best.fit.heldout_rms_after_um = std::sqrt(afterg.ss / nn);
+  best.fit.shrink_pct = 100 * (1 - best.fit.heldout_rms_after_um / best.fit.heldout_rms_before_um);
+  const double excess_before = std::max(0.0, before.ss - before.expected);
+  // Of the excess over the floor; of the whole held-out SS when the floor already exceeds it.
+  const double denominator = excess_before > 0 ? excess_before : before.ss;
+  best.fit.explained_fraction =
+      denominator > 0 ? std::clamp((before.ss - afterg.ss) / denominator, 0.0, 1.0) : 0;
+  // Nested-model F test on all data, corrected for variants and candidates.
+  const MatrixXd& E = best.columns;
+  MatrixXd AE(e.A.rows(), e.A.cols() + E.cols());
+  AE << e.A, E;
+  const FoldFit f1 = fit_fold(AE, e.y, all_rows(static_cast<std::size_t>(e.y.size())));
+  const double q = static_cast<double>(f1.rank) - static_cast<double>(e.full_rank);
+  const double sse1 = f1.res_train.squaredNorm();
+  const double d2 = static_cast<double>(e.y.size()) - static_cast<double>(f1.rank);
+  best.fit.extra_parameters = static_cast<std::size_t>(std::max(0.0, q));
+  if (q > 0 && d2 > 0) {
+    best.fit.f_statistic = ((e.full_sse - sse1) / q) / (sse1 / d2);
+    best.fit.p_value =
+        std::min(1.0, f_sf(best.fit.f_statistic, q, d2) * best.fit.tested_variants * n_candidates);
+  }
+  // Held-out improvement must also beat chance: the drop in held-out SS against the floor.
+  const double heldout_gain = (before.ss - afterg.ss) / s2;
+  best.fit.significant = best.fit.p_value < alpha && heldout_gain > 0;
+  best.coef = f1.theta.tail(E.cols());  // full-data coefficients, for the description
+  return best;
+}
+
+// The shape degrees of freedom the data leave along coordinate `axis` in `output` beyond the
+// baseline design A0 (rank rank0): the rank that one free value per distinct position adds.
+std::size_t shape_dof_free(const MatrixXd& A0, std::size_t rank0, const GapData& d, int axis,
+                           int output) {
+  const auto& obs = d.points.observations;
+  std::vector<double> levels;
+  for (const auto& o : obs)
+    if (observation_weight(o, output) != 0)
+      levels.push_back(d.points.poses[o.row][static_cast<std::size_t>(axis)]);
+  std::sort(levels.begin(), levels.end());
+  levels.erase(std::unique(levels.begin(), levels.end()), levels.end());
+  MatrixXd AG = MatrixXd::Zero(A0.rows(), A0.cols() + static_cast<Index>(levels.size()));
+  AG.leftCols(A0.cols()) = A0;
+  for (std::size_t i = 0; i < obs.size(); ++i) {
+    const double w = observation_weight(obs[i], output);
+    if (w == 0) continue;
+    const double q = d.points.poses[obs[i].row][static_cast<std::size_t>(axis)];
+    const auto l = std::lower_bound(levels.begin(), levels.end(), q) - levels.begin();
+    AG(static_cast<Index>(i), A0.cols() + l) = w;
+  }
+  const std::size_t r = EquilibratedSvd(AG, 1e-9, /*full_v=*/false).rank();
+  return r > rank0 ? r - rank0 : 0;
+}
+
+std::string pct(double fraction) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.0f %%", 100 * fraction);
+  return b;
+}
+
+// The verdict and its reason from the greedy explanation (docs/gap.md, "Verdict"). `shape` holds
+// each accepted effect's (coordinate, output) when it is a shape along a coordinate.
+void decide_verdict(GapResult& R, const GapOptions& opt, const std::vector<std::string>& axes,
+                    bool gap_significant, double explained,
+                    const std::vector<std::pair<int, int>>& shape) {
+  auto unexplained = [&](std::string why) {
+    R.verdict = "unexplained";
+    R.verdict_reason = std::move(why);
+  };
+  if (R.explanation.empty()) {
+    if (gap_significant)
+      unexplained("a significant held-out gap that no candidate of the library removes");
+    else
+      R.verdict = "none", R.verdict_reason = "the held-out gap is at the noise floor";
+    return;
+  }
+  const EffectFit& first = R.explanation.front();
+  for (std::size_t k = 0; k < R.explanation.size(); ++k) {
+    const EffectFit& f = R.explanation[k];
+    if (f.distinguishable || (k > 0 && shape[k] != shape[0])) continue;
+    const std::string along = axes[static_cast<std::size_t>(shape[k].first)];
+    const std::string out = observation_name(static_cast<std::size_t>(shape[k].second));
+    return unexplained(f.name + " along " + along + " in " + out + " fits, but " +
+                       f.indistinct_reason);
+  }
+  if (shape[0].first >= 0 && first.explained_fraction < opt.explain_fraction)
+    for (std::size_t k = 1; k < R.explanation.size(); ++k)
+      if (shape[k] == shape[0])
+        return unexplained(first.name + " removes " + pct(first.explained_fraction) +
+                           " of the excess and needs " + R.explanation[k].name +
+                           " along the same coordinate and output: a shape outside the library");
+  if (first.explained_fraction < 0.5)
+    return unexplained("the first effect, " + first.name + ", removes only " +
+                       pct(first.explained_fraction) + " of the excess held-out sum of squares");
+  if (R.final_p_value < opt.alpha) {
+    if (explained < opt.explain_fraction)
+      return unexplained("the accepted effects remove " + pct(explained) +
+                         " of the excess and leave a significant gap");
+    if (R.final_rms_um > 2 * R.noise.sigma_um)
+      return unexplained(
+          "the accepted effects leave a significant held-out RMS of more than twice the noise "
+          "floor");
+  }
+  R.verdict = first.name;
+  R.verdict_reason =
+      first.name + " removes " + pct(first.explained_fraction) +
+      " of the excess held-out sum of squares" +
+      (R.explanation.size() > 1 ? ", the accepted effects " + pct(explained) : "") +
+      (R.final_p_value >= opt.alpha ? "; the remaining gap is at the noise floor" : "");
+}
+
+}  // namespace
+
+void GapDiagnosis::run(const GapData& data, const HoldoutScheme& scheme,
+                       const std::string& reason) {
+  GapResult R;
+  R.holdout = scheme.str();
+  R.holdout_reason = reason;
+  const auto& obs = data.points.observations;
+  R.observations = obs.size();
+  R.count = data.points.count;
+  R.parameters = param_.size();
+
+  Engine e{data, design_matrix(*model_, param_, data.points), {}, {}, {}, 0, 0, {}};
+  e.y.resize(static_cast<Index>(obs.size()));
+  for (std::size_t i = 0; i < obs.size(); ++i) e.y[static_cast<Index>(i)] = obs[i].value;
+  e.fit_full();
+  R.rank = e.full_rank;
+  e.splits = make_splits(data, scheme, R.rank + 5);
+  if (scheme.kind != HoldoutScheme::Kind::Forward) {  // the folds actually used (K <= groups)
+    HoldoutScheme used = scheme;
+    used.folds = static_cast<int>(e.splits.size());
+    R.holdout = used.str();
+  }
+  e.fit_folds();
+  VectorXd r, h;
+  e.heldout(r, h);
+  R.noise = noise_floor(data, r);
+  const double s2 = R.noise.sigma_um * R.noise.sigma_um;
+
+  auto summarise = [&](const VectorXd& res, std::array<double, kObservationKinds>& rms,
+                       double& total, std::array<double, kObservationKinds>* mx) {
+    std::array<double, kObservationKinds> ss{};
+    std::array<std::size_t, kObservationKinds> n{};
+    double all = 0;
+    std::size_t na = 0;
+    if (mx) mx->fill(0);
+    for (std::size_t i = 0; i < obs.size(); ++i) {
+      const double v = res[static_cast<Index>(i)];
+      if (!std::isfinite(v)) continue;
+      const auto o = static_cast<std::size_t>(obs[i].output);
+      ss[o] += v * v, ++n[o], all += v * v, ++na;
+      if (mx) (*mx)[o] = std::max((*mx)[o], std::abs(v));
+    }
+    for (std::size_t o = 0; o < kObservationKinds; ++o) {
+      rms[o] = n[o] ? std::sqrt(ss[o] / static_cast<double>(n[o])) : kNaN;
+      if (mx && !n[o]) (*mx)[o] = kNaN;
+    }
+    total = na ? std::sqrt(all / static_cast<double>(na)) : kNaN;
+  };
+  // Σ r² and its expectation σ²(1 + h) over the held-out residuals.
+  auto held_gap = [&](const VectorXd& res, const VectorXd& lev) {
+    Gap g;
+    for (Index i = 0; i < res.size(); ++i)
+      if (std::isfinite(res[i])) g.ss += res[i] * res[i], g.expected += s2 * (1 + lev[i]), ++g.n;
+    return g;
+  };
+  summarise(r, R.baseline_rms, R.baseline_rms_um, &R.baseline_max);
+  const Gap base = held_gap(r, h);
+  gap_stats(base, R.noise.dof, R.baseline_excess_um, R.baseline_p_value);
+  R.where = localise(data, r, h, R.noise, options_.alpha);
+  R.residual_before.assign(r.data(), r.data() + r.size());
+
+  gap_detail::EffectContext ctx;
+  ctx.data = &data;
+  ctx.model = model_.get();
+  ctx.param = &param_;
+  auto chain = std::make_shared<NumericChain>(model_->description());
+  chain->set_parameters(model_->parameters());
+  ctx.chain = chain;
+  const std::vector<std::string>& names =
+      options_.effects.empty() ? gap_effect_names() : options_.effects;
+  std::vector<gap_detail::Candidate> candidates = gap_detail::effect_candidates(ctx, names);
+  const double n_candidates = static_cast<double>(std::max<std::size_t>(1, candidates.size()));
+
+  const bool gap_significant = R.baseline_p_value < options_.alpha;
+  VectorXd cur_r = r, cur_h = h;
+  std::vector<bool> used(candidates.size(), false);
+  // Shape effects: free shape dof per (coordinate, output), and the dof the accepted ones use.
+  const MatrixXd A0 = e.A;
+  const std::size_t rank0 = e.full_rank;
+  std::map<std::pair<int, int>, std::size_t> dof_free, dof_used;
+  std::vector<std::pair<int, int>> accepted_shape;  // per accepted effect; (-1, -1) if none
+  auto check_shape = [&](const gap_detail::Variant& v, EffectFit& fit) {
+    if (v.shape_axis < 0) return;
+    const std::pair<int, int> key{v.shape_axis, v.shape_output};
+    if (!dof_free.count(key))
+      dof_free[key] = shape_dof_free(A0, rank0, data, v.shape_axis, v.shape_output);
+    fit.shape_dof_free = dof_free[key];
+    fit.shape_dof_used = dof_used[key] + fit.extra_parameters + v.refine.size();
+    if (fit.shape_dof_used >= fit.shape_dof_free) {
+      const std::string along = data.axes[static_cast<std::size_t>(v.shape_axis)];
+      fit.distinguishable = false;
+      fit.indistinct_reason =
+          "the data leave " + std::to_string(fit.shape_dof_free) +
+          " shape degrees of freedom along " + along + " beyond the model and the fitted shape" +
+          (dof_used[key] ? "s use " : " uses ") + std::to_string(fit.shape_dof_used) +
+          ": any shape would fit as well (a step, a bump, a period); measure "
+          "more positions along " +
+          along;
+    }
+  };
+  for (int step = 0; step < options_.max_effects; ++step) {
+    std::vector<Evaluated> ev;
+    for (std::size_t k = 0; k < candidates.size(); ++k) {
+      if (used[k]) continue;
+      Evaluated x =
+          evaluate(candidates[k], e, param_.size(), cur_r, cur_h, s2, options_.alpha, n_candidates);
+      if (!std::isfinite(x.heldout_sse)) continue;
+      candidates[k].describe(x.variant, x.coef, x.fit);
+      check_shape(x.variant, x.fit);
+      ev.push_back(std::move(x));
+      ev.back().fit.name = candidates[k].name;
+    }
+    std::stable_sort(ev.begin(), ev.end(), [](const Evaluated& a, const Evaluated& b) {
+      return a.heldout_sse < b.heldout_sse;
+    });
+    if (step == 0)
+      for (const Evaluated& x : ev) R.effects.push_back(x.fit);
+    const Evaluated* pick = nullptr;
+    for (const Evaluated& x : ev)
+      if (x.fit.significant) {
+        pick = &x;
+        break;
+      }
+    // A significant effect is evidence of a gap by itself: a floor from repeats that straddle a
+    // drift can be inflated enough to hide the gap from the floor test.
+    if (!pick) break;
+    // Accept: its columns join the model.
+    EffectFit fit = pick->fit;
+    MatrixXd AE(e.A.rows(), e.A.cols() + pick->columns.cols());
+    AE << e.A, pick->columns;
+    e.A = AE;
+    e.refit();
+    e.heldout(cur_r, cur_h);
+    R.explanation.push_back(fit);
+    if (pick->variant.shape_axis >= 0) {
+      accepted_shape.emplace_back(pick->variant.shape_axis, pick->variant.shape_output);
+      dof_used[accepted_shape.back()] = fit.shape_dof_used;
+    } else {
+      accepted_shape.emplace_back(-1, -1);
+    }
+    // Thermal drift may need a second sensor or lag; other effects are taken once.
+    for (std::size_t k = 0; k < candidates.size(); ++k)
+      if (candidates[k].name == fit.name && fit.name != "thermal_drift") used[k] = true;
+    double ex = 0, p = 1;
+    gap_stats(held_gap(cur_r, cur_h), R.noise.dof, ex, p);
+    if (p >= options_.alpha) break;
+  }
+  summarise(cur_r, R.final_rms, R.final_rms_um, nullptr);
+  const Gap final_gap = held_gap(cur_r, cur_h);
+  gap_stats(final_gap, R.noise.dof, R.final_excess_um, R.final_p_value);
+  R.residual_after.assign(cur_r.data(), cur_r.data() + cur_r.size());
+  // Of the excess over the floor (of the whole held-out SS when the floor exceeds it).
+  const double explained_ss = base.ss - final_gap.ss;
+  const double excess_ss = std::max(0.0, base.ss - base.expected);
+  const double explained =
+      excess_ss > 0 ? explained_ss / excess_ss : (base.ss > 0 ? explained_ss / base.ss : 0);
+  decide_verdict(R, options_, data.axes, gap_significant, explained, accepted_shape);
+  result_ = std::move(R);
+}
+
+}  // namespace weilgen

@@ -1,0 +1,210 @@
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+#include <optional>
+#include <set>
+#include <stdexcept>
+
+#include "effects.hpp"
+#include "weilgen/base/text.hpp"
+#include "weilgen/machine/iso_names.hpp"
+
+namespace weilgen::gap_detail {
+
+// ---- Model-based effects: higher_order, missing_error, tool_offset ------------------------
+
+// Exact-chain deviation (µm, µrad) at an observation's pose for given errors (base units).
+std::array<double, 6> exact(const NumericChain& chain, const std::vector<double>& pose,
+                            const std::vector<double>& errors) {
+  std::array<double, 6> v = chain.deviation(pose, errors);
+  for (std::size_t o = 0; o < 6; ++o) v[o] *= kMeasuredScale[o];
+  return v;
+}
+
+void add_higher_order(const EffectContext& ctx, std::vector<Candidate>& out) {
+  Candidate c;
+  c.name = "higher_order";
+  c.variants.push_back({"products of errors (exact kinematics)", {}, true});
+  const GapData& d = *ctx.data;
+  c.columns = [&d, ctx](const Variant&, const std::vector<double>& theta) {
+    const auto& obs = d.points.observations;
+    MatrixXd E(static_cast<Index>(obs.size()), 1);
+    ModelData md(*ctx.model);
+    std::vector<double> err(ctx.model->num_errors());
+    std::size_t row = SIZE_MAX;
+    std::array<double, 6> nonlinear{};
+    for (std::size_t i = 0; i < obs.size(); ++i) {
+      if (obs[i].row != row) {
+        row = obs[i].row;
+        const std::vector<double>& q = d.points.poses[row];
+        ctx.param->errors_at(q.data(), theta.data(), err.data());
+        const std::array<double, 6> full = exact(*ctx.chain, q, err);
+        const std::array<double, 6> lin =
+            predict_deviation(*ctx.model, md, *ctx.param, theta, q.data());
+        for (std::size_t o = 0; o < 6; ++o) nonlinear[o] = full[o] - lin[o];
+      }
+      E(static_cast<Index>(i), 0) = observe(obs[i], nonlinear);
+    }
+    return E;
+  };
+  c.describe = [](const Variant&, const VectorXd& coef, EffectFit& fit) {
+    fit.params["scale"] = coef[0];
+    fit.summary = "second- and higher-order products of the identified errors (scale " +
+                  num(coef[0], 3) +
+                  " of the exact kinematics' nonlinear part; regenerate at "
+                  "algebra order 2)";
+  };
+  out.push_back(std::move(c));
+}
+
+void add_missing_error(const EffectContext& ctx, std::vector<Candidate>& out) {
+  const Description& desc = ctx.model->description();
+  const GapData& d = *ctx.data;
+  struct Missing {
+    std::string name, coordinate;
+    bool pdge;
+    double lo, hi;
+    MatrixXd unit;  // per observation: ∂output/∂error (µm or µrad per declared unit)
+  };
+  auto missing = std::make_shared<std::vector<Missing>>();
+  const std::vector<int> axes = desc.axes();
+  for (std::size_t b = 0; b < desc.bodies.size(); ++b) {
+    const Joint& j = desc.bodies[b].joint;
+    if (j.type == JointType::Fixed || j.link || !iso_not_applicable(j).empty()) continue;
+    std::vector<std::string> names = iso_motion_errors(j);
+    for (const char* k : {"X", "Y", "Z", "A", "B", "C"})  // squareness and location errors
+      names.push_back(std::string("E_") + k + "0" + j.coordinate);
+    std::sort(names.begin(), names.end());
+    names.erase(std::unique(names.begin(), names.end()), names.end());
+    for (const std::string& n : names) {
+      if (desc.error_index(n) >= 0) continue;
+      const IsoMatch m = match_iso_name(j, n);
+      if (m.status != IsoMatch::Status::Fits) continue;
+      Description aug = desc;
+      ErrorDef e;
+      e.name = e.iso = n;
+      e.effect = m.error.effect;
+      e.direction = m.error.direction;
+      e.group = m.error.group;
+      e.placement = m.error.placement;
+      e.dependence = m.error.dependence;
+      e.unit = m.error.unit;
+      e.to_base = e.effect == ErrorEffect::Rotation ? 1e-6 : 1e-3;  // µrad, µm
+      e.body = static_cast<int>(b);
+      aug.errors.push_back(e);
+      aug.bodies[b].errors.push_back(static_cast<int>(aug.errors.size() - 1));
+      NumericChain chain(aug);
+      chain.set_parameters(ctx.model->parameters());
+      const auto& obs = d.points.observations;
+      Missing mi{n,     j.coordinate, e.dependence == Dependence::PDGE,
+                 j.min, j.max,        MatrixXd(static_cast<Index>(obs.size()), 1)};
+      std::vector<double> err(aug.errors.size(), 0.0);
+      std::size_t row = SIZE_MAX;
+      std::array<double, 6> g{};
+      for (std::size_t i = 0; i < obs.size(); ++i) {
+        if (obs[i].row != row) {
+          row = obs[i].row;
+          err.back() = e.to_base;  // 1 µm or µrad: central differences, third order ~1e-12
+          const auto p = exact(chain, d.points.poses[row], err);
+          err.back() = -e.to_base;
+          const auto m2 = exact(chain, d.points.poses[row], err);
+          for (std::size_t o = 0; o < 6; ++o) g[o] = (p[o] - m2[o]) / 2;
+        }
+        mi.unit(static_cast<Index>(i), 0) = observe(obs[i], g);
+      }
+      if (mi.unit.norm() > 0) missing->push_back(std::move(mi));
+    }
+  }
+  if (missing->empty()) return;
+  Candidate c;
+  c.name = "missing_error";
+  for (std::size_t k = 0; k < missing->size(); ++k)
+    c.variants.push_back({(*missing)[k].name, {static_cast<double>(k)}});
+  // The coordinate of each observation for a PDGE's basis (poly:3 on the joint's travel).
+  c.columns = [&d, missing, axes, &desc](const Variant& v, const std::vector<double>&) {
+    const Missing& mi = (*missing)[static_cast<std::size_t>(v.hyper[0])];
+    if (!mi.pdge) return MatrixXd(mi.unit);
+    std::size_t a = 0;
+    for (std::size_t i = 0; i < axes.size(); ++i)
+      if (desc.bodies[static_cast<std::size_t>(axes[i])].joint.coordinate == mi.coordinate) a = i;
+    const auto& obs = d.points.observations;
+    MatrixXd E(static_cast<Index>(obs.size()), 4);
+    for (std::size_t i = 0; i < obs.size(); ++i) {
+      const double u = (2 * d.points.poses[obs[i].row][a] - mi.lo - mi.hi) / (mi.hi - mi.lo);
+      double p = 1;
+      for (Index t = 0; t < 4; ++t, p *= u)
+        E(static_cast<Index>(i), t) = mi.unit(static_cast<Index>(i), 0) * p;
+    }
+    return E;
+  };
+  c.describe = [missing](const Variant& v, const VectorXd& coef, EffectFit& fit) {
+    const Missing& mi = (*missing)[static_cast<std::size_t>(v.hyper[0])];
+    const bool rot =
+        mi.name.size() > 2 && (mi.name[2] == 'A' || mi.name[2] == 'B' || mi.name[2] == 'C');
+    const char* unit = rot ? "µrad" : "µm";
+    if (!mi.pdge) {
+      fit.params[mi.name] = coef[0];
+      fit.summary = mi.name + " = " + num(coef[0], 3) + " " + unit + " (not in the machine file)";
+    } else {
+      double peak = 0;
+      for (double u = -1; u <= 1.0001; u += 0.05)
+        peak = std::max(peak, std::abs(coef[0] + u * (coef[1] + u * (coef[2] + u * coef[3]))));
+      fit.params[mi.name + "_peak"] = peak;
+      fit.summary = mi.name + "(" + mi.coordinate + ") up to " + num(peak, 3) + " " + unit +
+                    " over the travel (poly:3; not in the machine file)";
+    }
+  };
+  out.push_back(std::move(c));
+}
+
+void add_tool_offset(const EffectContext& ctx, std::vector<Candidate>& out) {
+  const Description& desc = ctx.model->description();
+  int tool = -1;
+  for (std::size_t p = 0; p < desc.parameters.size(); ++p)
+    if (lower(desc.parameters[p].name).find("tool") != std::string::npos)
+      tool = static_cast<int>(p);
+  if (tool < 0) return;
+  Candidate c;
+  c.name = "tool_offset";
+  const std::string pname = desc.parameters[static_cast<std::size_t>(tool)].name;
+  c.variants.push_back({pname, {static_cast<double>(tool)}, true});
+  c.variants.back().theta_iterations = 1;
+  const GapData& d = *ctx.data;
+  const double base = ctx.model->parameters()[static_cast<std::size_t>(tool)];
+  c.columns = [&d, ctx, tool, base](const Variant&, const std::vector<double>& theta) {
+    // ∂deviation/∂tool length at the identified errors (µm per mm), by central differences of
+    // the exact chain over ±10 mm.
+    std::vector<double> params = ctx.model->parameters();
+    NumericChain plus(ctx.model->description()), minus(ctx.model->description());
+    params[static_cast<std::size_t>(tool)] = base + 10;
+    plus.set_parameters(params);
+    params[static_cast<std::size_t>(tool)] = base - 10;
+    minus.set_parameters(params);
+    const auto& obs = d.points.observations;
+    MatrixXd E(static_cast<Index>(obs.size()), 1);
+    std::vector<double> err(ctx.model->num_errors());
+    std::size_t row = SIZE_MAX;
+    std::array<double, 6> g{};
+    for (std::size_t i = 0; i < obs.size(); ++i) {
+      if (obs[i].row != row) {
+        row = obs[i].row;
+        const std::vector<double>& q = d.points.poses[row];
+        ctx.param->errors_at(q.data(), theta.data(), err.data());
+        const auto p = exact(plus, q, err), m = exact(minus, q, err);
+        for (std::size_t o = 0; o < 6; ++o) g[o] = (p[o] - m[o]) / 20;
+      }
+      E(static_cast<Index>(i), 0) = observe(obs[i], g);
+    }
+    return E;
+  };
+  c.describe = [pname, base](const Variant&, const VectorXd& coef, EffectFit& fit) {
+    fit.params["offset_mm"] = coef[0];
+    fit.params[pname + "_mm"] = base + coef[0];
+    fit.summary = "tool offset " + num(coef[0], 3) + " mm (" + pname + " " + num(base, 4) + " -> " +
+                  num(base + coef[0], 4) + " mm)";
+  };
+  out.push_back(std::move(c));
+}
+
+}  // namespace weilgen::gap_detail

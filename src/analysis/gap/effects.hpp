@@ -1,0 +1,165 @@
+// The candidate unmodelled effects of the gap diagnosis (docs/gap.md, "Effect library"): each is
+// a set of variants (hyper-parameters such as a period, a lag, an axis), and a variant gives
+// extra design columns for every observation. Internal to the gap diagnosis and its tests.
+#pragma once
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "internal.hpp"
+#include "weilgen/model/numeric_chain.hpp"
+
+namespace weilgen::gap_detail {
+
+// What an effect's columns need to know: the data, the model and its parameterisation, the
+// observation-to-row map, and a numeric chain for the linearised effects.
+struct EffectContext {
+  const GapData* data = nullptr;
+  const Model* model = nullptr;
+  const ErrorParameterisation* param = nullptr;
+  std::shared_ptr<const NumericChain> chain;  // exact kinematics (higher_order, tool_offset)
+};
+
+struct Variant {
+  struct Refine;
+  Variant() = default;
+  Variant(std::string l, std::vector<double> h, bool theta = false, std::vector<Refine> r = {})
+      : label(std::move(l)), hyper(std::move(h)), needs_theta(theta), refine(std::move(r)) {}
+  std::string label;          // "temperature T_1 lagged", "X, dy"
+  std::vector<double> hyper;  // effect-specific numbers
+  bool needs_theta = false;   // columns depend on the identified parameters
+  // Continuous hyper-parameters refined around the grid value: (index, lo, hi) bounds.
+  std::vector<Refine> refine;
+  // A shape along one coordinate in one output (periodic, pdge_shape): GapData::axes index and
+  // output 0..5; -1 for other effects. The diagnosis checks that the data can tell the shape
+  // from any other along that coordinate.
+  int shape_axis = -1, shape_output = -1;
+  // needs_theta: refit θ jointly with the columns this many times before they are taken (the
+  // columns at the first-order θ are biased when that θ has absorbed part of the effect).
+  int theta_iterations = 0;
+};
+
+struct Variant::Refine {
+  std::size_t index;
+  double lo, hi;
+};
+
+struct Candidate {
+  std::string name;
+  std::vector<Variant> variants;
+  // Columns (observations × q) of a variant; `theta` is the baseline parameters of the split
+  // (only read when the variant needs_theta).
+  std::function<Eigen::MatrixXd(const Variant&, const std::vector<double>& theta)> columns;
+  // Fills summary/params/region of `fit` from the full-data coefficients c of the columns.
+  std::function<void(const Variant&, const Eigen::VectorXd& c, EffectFit& fit)> describe;
+};
+
+// The library's candidates that apply to the data (e.g. reversal needs a direction column).
+std::vector<Candidate> effect_candidates(const EffectContext& ctx,
+                                         const std::vector<std::string>& names);
+
+// One family of the library each (effect_*.cpp): appends its candidate, if the data allow it.
+void add_thermal(const EffectContext& ctx, std::vector<Candidate>& out);
+void add_reversal(const EffectContext& ctx, std::vector<Candidate>& out);
+void add_periodic(const EffectContext& ctx, std::vector<Candidate>& out);
+void add_pdge_shape(const EffectContext& ctx, std::vector<Candidate>& out);
+void add_higher_order(const EffectContext& ctx, std::vector<Candidate>& out);
+void add_missing_error(const EffectContext& ctx, std::vector<Candidate>& out);
+void add_tool_offset(const EffectContext& ctx, std::vector<Candidate>& out);
+void add_setup(const EffectContext& ctx, std::vector<Candidate>& out);
+
+// ---- Helpers of the effect files --------------------------------------------------------
+
+inline const char* unit_of(int o) { return observation_unit(static_cast<std::size_t>(o)); }
+
+inline std::string num(double v, int digits = 3) {
+  char b[48];
+  std::snprintf(b, sizeof b, "%.*g", digits, v);
+  return b;
+}
+
+// The deviation outputs (0..5) the observations see: their own, and for ballbar dr the
+// in-plane directions.
+inline std::vector<int> outputs_of(const GapData& d) {
+  std::set<int> o;
+  for (const auto& ob : d.points.observations)
+    for (int k = 0; k < 6; ++k)
+      if (observation_weight(ob, k) != 0) o.insert(k);
+  return {o.begin(), o.end()};
+}
+
+// Per observation: f(row) in output o (as much of it as the observation sees, for dr its radial
+// component), zero elsewhere; one column per output.
+template <typename F>
+MatrixXd per_output(const GapData& d, const std::vector<int>& outs, F f) {
+  const auto& obs = d.points.observations;
+  MatrixXd E = MatrixXd::Zero(static_cast<Index>(obs.size()), static_cast<Index>(outs.size()));
+  for (std::size_t i = 0; i < obs.size(); ++i)
+    for (std::size_t k = 0; k < outs.size(); ++k) {
+      const double w = observation_weight(obs[i], outs[k]);
+      if (w != 0) E(static_cast<Index>(i), static_cast<Index>(k)) = w * f(obs[i].row);
+    }
+  return E;
+}
+
+// "dx +2.1 µm/h, dy -0.4 µm/h" from per-output coefficients.
+inline std::string per_output_text(const std::vector<int>& outs, const VectorXd& c, double scale,
+                                   const std::string& unit_suffix, EffectFit& fit,
+                                   const std::string& key) {
+  std::string s;
+  for (std::size_t k = 0; k < outs.size(); ++k) {
+    const double v = c[static_cast<Index>(k)] * scale;
+    s += (s.empty() ? "" : ", ") + std::string(output_name(static_cast<std::size_t>(outs[k]))) +
+         " " + (v >= 0 ? "+" : "") + num(v, 2) + " " + unit_of(outs[k]) + unit_suffix;
+    fit.params[key + "_" + output_name(static_cast<std::size_t>(outs[k]))] = v;
+  }
+  return s;
+}
+
+inline std::vector<double> axis_values(const GapData& d, std::size_t a) {
+  std::vector<double> v;
+  for (const auto& p : d.points.poses)
+    if (!p.empty() && std::isfinite(p[a])) v.push_back(p[a]);
+  std::sort(v.begin(), v.end());
+  v.erase(std::unique(v.begin(), v.end()), v.end());
+  return v;
+}
+
+// Axes with at least `min_levels` distinct positions, and the columns f_k(position) of one output.
+struct AxisInfo {
+  std::size_t index;
+  std::string name;
+  std::vector<double> levels;
+};
+
+inline std::vector<AxisInfo> varying_axes(const GapData& d, std::size_t min_levels) {
+  std::vector<AxisInfo> v;
+  for (std::size_t a = 0; a < d.axes.size(); ++a) {
+    AxisInfo ai{a, d.axes[a], axis_values(d, a)};
+    if (ai.levels.size() >= min_levels) v.push_back(ai);
+  }
+  return v;
+}
+
+inline MatrixXd one_output(const GapData& d, int output,
+                           const std::vector<std::function<double(double)>>& f, std::size_t axis) {
+  const auto& obs = d.points.observations;
+  MatrixXd E = MatrixXd::Zero(static_cast<Index>(obs.size()), static_cast<Index>(f.size()));
+  for (std::size_t i = 0; i < obs.size(); ++i) {
+    const double w = observation_weight(obs[i], output);
+    if (w == 0) continue;
+    const double q = d.points.poses[obs[i].row][axis];
+    for (std::size_t k = 0; k < f.size(); ++k)
+      E(static_cast<Index>(i), static_cast<Index>(k)) = w * f[k](q);
+  }
+  return E;
+}
+
+}  // namespace weilgen::gap_detail
