@@ -122,9 +122,7 @@ GapResult diagnose(const std::string& csv, std::shared_ptr<const Model> model = 
   const MeasurementTable t = parse_measurements(csv, "g.csv");
   const ErrorParameterisation p(model->description(), c, model->parameters());
   const GapData d = gap_data(t, model->description());
-  GapDiagnosis g(model, p);
-  g.run(d, *parse_holdout(holdout), "test");
-  return g.result();
+  return GapDiagnosis().run(*model, p, d, *parse_holdout(holdout), "test");
 }
 
 const EffectFit* effect(const GapResult& r, const std::string& name) {
@@ -487,9 +485,8 @@ TEST_CASE("gap: ballbar traces are dr observations; reversal on X is read from t
                       return std::array<double, 3>{2.5 * w.dir_X, 0, 0};  // B = 5 µm in dx
                     }),
       "bb.csv");
-  GapDiagnosis g(vmc(), p);
-  g.run(gap_data(tr, vmc()->description()), *parse_holdout("cycle:4"), "test");
-  const GapResult& res = g.result();
+  const GapResult res = GapDiagnosis().run(*vmc(), p, gap_data(tr, vmc()->description()),
+                                           *parse_holdout("cycle:4"), "test");
   CHECK(res.verdict == "reversal");
   const EffectFit* e = effect(res, "reversal");
   REQUIRE(e);

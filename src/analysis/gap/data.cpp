@@ -10,6 +10,7 @@
 #include "weilgen/analysis/ballbar_model.hpp"
 #include "weilgen/base/format.hpp"
 #include "weilgen/base/text.hpp"
+#include "weilgen/base/units.hpp"
 
 namespace weilgen {
 
@@ -139,6 +140,25 @@ GapData gap_data(const MeasurementTable& table, const Description& desc,
                                                   std::to_string(g.points.observations.size()) +
                                                   " observations: the diagnosis needs at least 10");
   return g;
+}
+
+std::map<std::string, double> parse_fixed_coordinates(const Description& desc,
+                                                      const std::vector<std::string>& at) {
+  std::map<std::string, double> fixed;
+  for (const std::string& a : at)
+    for (const std::string& item : split(a, ',')) {
+      const auto eq = item.find('=');
+      if (eq == std::string::npos)
+        throw std::invalid_argument("--at \"" + item + "\": expected NAME=VALUE");
+      const std::string name = trim(item.substr(0, eq));
+      if (desc.coordinate_body(name) < 0)
+        throw std::invalid_argument("--at: '" + name + "' is not a coordinate of " + desc.name);
+      const std::string unit =
+          desc.bodies[static_cast<std::size_t>(desc.coordinate_body(name))].joint.unit;
+      fixed[name] =
+          parse_quantity_unit(item.substr(eq + 1), unit, "--at " + name).in(parse_unit(unit));
+    }
+  return fixed;
 }
 
 }  // namespace weilgen

@@ -23,9 +23,21 @@ const std::vector<std::string>& gap_effect_names() {
   return names;
 }
 
-GapDiagnosis::GapDiagnosis(std::shared_ptr<const Model> model, const ErrorParameterisation& param,
-                           GapOptions options)
-    : model_(std::move(model)), param_(param), options_(std::move(options)) {}
+void GapOptions::validate() const {
+  if (!(alpha > 0 && alpha < 0.5)) throw std::invalid_argument("--alpha must be in (0, 0.5)");
+  if (!(explain_fraction > 0 && explain_fraction <= 1))
+    throw std::invalid_argument("gap: explain_fraction must be in (0, 1]");
+  if (max_effects < 1) throw std::invalid_argument("gap: max_effects must be >= 1");
+  for (const std::string& n : effects)
+    if (std::find(gap_effect_names().begin(), gap_effect_names().end(), n) ==
+        gap_effect_names().end())
+      throw std::invalid_argument("--effects: unknown effect '" + n +
+                                  "' (the library: " + join(gap_effect_names()) + ")");
+}
+
+GapDiagnosis::GapDiagnosis(GapOptions options) : options_(std::move(options)) {
+  options_.validate();
+}
 
 namespace {
 
@@ -295,8 +307,9 @@ void decide_verdict(GapResult& R, const GapOptions& opt, const std::vector<std::
 
 }  // namespace
 
-void GapDiagnosis::run(const GapData& data, const HoldoutScheme& scheme,
-                       const std::string& reason) {
+GapResult GapDiagnosis::run(const Model& model, const ErrorParameterisation& param_,
+                            const GapData& data, const HoldoutScheme& scheme,
+                            const std::string& reason) const {
   GapResult R;
   R.holdout = scheme.str();
   R.holdout_reason = reason;
@@ -305,7 +318,7 @@ void GapDiagnosis::run(const GapData& data, const HoldoutScheme& scheme,
   R.count = data.points.count;
   R.parameters = param_.size();
 
-  Engine e{data, design_matrix(*model_, param_, data.points), {}, {}, {}, 0, 0, {}};
+  Engine e{data, design_matrix(model, param_, data.points), {}, {}, {}, 0, 0, {}};
   e.y.resize(static_cast<Index>(obs.size()));
   for (std::size_t i = 0; i < obs.size(); ++i) e.y[static_cast<Index>(i)] = obs[i].value;
   e.fit_full();
@@ -357,10 +370,10 @@ void GapDiagnosis::run(const GapData& data, const HoldoutScheme& scheme,
 
   gap_detail::EffectContext ctx;
   ctx.data = &data;
-  ctx.model = model_.get();
+  ctx.model = &model;
   ctx.param = &param_;
-  auto chain = std::make_shared<NumericChain>(model_->description());
-  chain->set_parameters(model_->parameters());
+  auto chain = std::make_shared<NumericChain>(model.description());
+  chain->set_parameters(model.parameters());
   ctx.chain = chain;
   const std::vector<std::string>& names =
       options_.effects.empty() ? gap_effect_names() : options_.effects;
@@ -451,7 +464,7 @@ void GapDiagnosis::run(const GapData& data, const HoldoutScheme& scheme,
   const double explained =
       excess_ss > 0 ? explained_ss / excess_ss : (base.ss > 0 ? explained_ss / base.ss : 0);
   decide_verdict(R, options_, data.axes, gap_significant, explained, accepted_shape);
-  result_ = std::move(R);
+  return R;
 }
 
 }  // namespace weilgen

@@ -169,4 +169,12 @@ std::vector<Split> make_splits(const GapData& d, const HoldoutScheme& s, std::si
   return splits;
 }
 
+std::string holdout_reason(const HoldoutScheme& scheme, bool given) {
+  if (given) return "given";
+  if (scheme.kind == HoldoutScheme::Kind::Cycle) return "default: the data have cycles";
+  if (scheme.kind == HoldoutScheme::Kind::Time)
+    return "default: no cycle column with >= 3 cycles; blocks of t_s";
+  return "default: no cycles, no time; blocks along the most-varied axis";
+}
+
 }  // namespace weilgen

@@ -51,6 +51,11 @@ GapData gap_data(const MeasurementTable& table, const Description& desc,
                  const std::map<std::string, double>& fixed = {}, const BallbarFlags& ballbar = {},
                  const std::vector<double>& parameters = {});
 
+// --at NAME=VALUE items (mm, deg; units allowed): the coordinates the data do not list.
+// std::invalid_argument naming --at for a bad item or an unknown coordinate.
+std::map<std::string, double> parse_fixed_coordinates(const Description& desc,
+                                                      const std::vector<std::string>& at);
+
 // How observations are split into training and held-out parts (no observation in both parts of
 // one split; every observation held out exactly once over the splits, except `forward`).
 struct HoldoutScheme {
@@ -146,6 +151,9 @@ struct GapOptions {
   double explain_fraction = 0.9;     // named effects must remove this much of the excess
   int max_effects = 3;
   std::map<std::string, double> fixed;  // coordinates not in the data
+  // alpha in (0, 0.5), explain_fraction in (0, 1], max_effects >= 1, every effect a library
+  // name (std::invalid_argument naming the flag).
+  void validate() const;
 };
 
 // The effect library's names, in report order.
@@ -153,16 +161,18 @@ const std::vector<std::string>& gap_effect_names();
 
 class GapDiagnosis {
  public:
-  GapDiagnosis(std::shared_ptr<const Model> model, const ErrorParameterisation& param,
-               GapOptions options = {});
-  void run(const GapData& data, const HoldoutScheme& scheme, const std::string& reason);
-  const GapResult& result() const { return result_; }
+  explicit GapDiagnosis(GapOptions options = {});  // validates the options
+  const GapOptions& options() const { return options_; }
+  // The diagnosis of `data` against the model with parameterisation `param`, held out by
+  // `scheme`; `reason` says why that scheme (reported).
+  GapResult run(const Model& model, const ErrorParameterisation& param, const GapData& data,
+                const HoldoutScheme& scheme, const std::string& reason) const;
 
  private:
-  std::shared_ptr<const Model> model_;
-  const ErrorParameterisation& param_;
   GapOptions options_;
-  GapResult result_;
 };
+
+// Why the default scheme was chosen ("default: the data have cycles" ...), or "given".
+std::string holdout_reason(const HoldoutScheme& scheme, bool given);
 
 }  // namespace weilgen
