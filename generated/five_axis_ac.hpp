@@ -20,7 +20,7 @@ namespace five_axis_ac {
 
 inline constexpr const char* kMachineName = "five_axis_ac";
 inline constexpr int kOrder = 1;
-// Machine-file text, order and weilgen version: identifies the model (runtime/model_key.hpp).
+// Machine-file text, order and weilgen version: identifies the model (weilgen/machine/model_key.hpp).
 inline constexpr const char* kModelKey = "bce0f89719f25d49";
 inline constexpr std::size_t kNumAxes = 5;
 inline constexpr std::size_t kNumErrors = 43;
@@ -291,15 +291,15 @@ void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
   // Outputs
   if (position != nullptr) {
     auto& _position = *position;
-    _position[0] = E_A0C * _coef19 + E_AZ * _coef4 + E_B0A * _coef15 + E_B0Z * _coef6 + E_BC * _coef17 + E_BX * _coef3 + E_C0Y * _coef11 + E_CY * _coef10 + E_XX * cos_C + E_XZ * cos_C + E_Y0A * _coef14 + _coef0 * _tmp33 + _coef13 * _tmp35 + _coef8 * _tmp36 - E_A0Z * _coef7 - E_AX * _coef2 - E_B0C * _coef20 - E_BA * _coef12 - E_BY * _coef9 - E_BZ * _coef5 - E_C0A * _coef16 - E_X0C * _coef18 - E_XA * cos_C - E_XC - E_XY * cos_C - E_Y0C * sin_C - E_YA * sin_C - _coef1 * _tmp34;
-    _position[1] = E_A0C * _coef20 + E_AZ * _coef25 + E_B0C * _coef19 + E_BA * _coef8 + E_BZ * _coef26 + E_C0A * _coef35 + E_CY * _coef30 + E_X0C * sin_C + E_XA * sin_C + E_XY * sin_C + E_Y0A * _coef33 + _coef12 * _tmp36 + _coef21 * _tmp33 - E_A0Z * _coef28 - E_AC * _coef17 - E_AX * _coef23 - E_B0A * _coef34 - E_B0Z * _coef27 - E_BX * _coef24 - E_BY * _coef29 - E_C0Y * _coef31 - E_XX * sin_C - E_XZ * sin_C - E_Y0C * _coef18 - E_YA * cos_C - E_YC - _coef22 * _tmp34 - _coef32 * _tmp35;
-    _position[2] = E_A0C * _coef44 + E_A0Z * _coef38 + E_AX * _coef36 + E_BA * X + E_BC * _coef32 + E_BY * _coef40 + E_Y0A * sin_A + E_YY * sin_A + E_ZX * cos_A + E_ZZ * cos_A + _coef41 * (E_C0A + E_CY) - E_AC * _coef13 - E_AZ * _coef37 - E_B0A * _coef43 - E_B0C * _coef45 - E_YX * sin_A - E_YZ * sin_A - E_Z0A * _coef42 - E_ZA - E_ZC - E_ZY * cos_A - _coef39 * _tmp36;
+    _position[0] = E_A0C * _coef19 + E_AZ * _coef4 + E_B0A * _coef15 + E_B0Z * _coef6 + E_BC * _coef17 + E_BX * _coef3 + E_C0Y * _coef11 + E_CY * _coef10 + E_XX * cos_C + E_XZ * cos_C + E_Y0A * _coef14 + _coef0 * _tmp33 + _coef13 * _tmp35 + _coef8 * _tmp36 - E_XC - E_A0Z * _coef7 - E_AX * _coef2 - E_B0C * _coef20 - E_BA * _coef12 - E_BY * _coef9 - E_BZ * _coef5 - E_C0A * _coef16 - E_X0C * _coef18 - E_XA * cos_C - E_XY * cos_C - E_Y0C * sin_C - E_YA * sin_C - _coef1 * _tmp34;
+    _position[1] = E_A0C * _coef20 + E_AZ * _coef25 + E_B0C * _coef19 + E_BA * _coef8 + E_BZ * _coef26 + E_C0A * _coef35 + E_CY * _coef30 + E_X0C * sin_C + E_XA * sin_C + E_XY * sin_C + E_Y0A * _coef33 + _coef12 * _tmp36 + _coef21 * _tmp33 - E_YC - E_A0Z * _coef28 - E_AC * _coef17 - E_AX * _coef23 - E_B0A * _coef34 - E_B0Z * _coef27 - E_BX * _coef24 - E_BY * _coef29 - E_C0Y * _coef31 - E_XX * sin_C - E_XZ * sin_C - E_Y0C * _coef18 - E_YA * cos_C - _coef22 * _tmp34 - _coef32 * _tmp35;
+    _position[2] = E_A0C * _coef44 + E_A0Z * _coef38 + E_AX * _coef36 + E_BA * X + E_BC * _coef32 + E_BY * _coef40 + E_Y0A * sin_A + E_YY * sin_A + E_ZX * cos_A + E_ZZ * cos_A + _coef41 * (E_C0A + E_CY) - E_ZA - E_ZC - E_AC * _coef13 - E_AZ * _coef37 - E_B0A * _coef43 - E_B0C * _coef45 - E_YX * sin_A - E_YZ * sin_A - E_Z0A * _coef42 - E_ZY * cos_A - _coef39 * _tmp36;
   }
   if (orientation != nullptr) {
     auto& _orientation = *orientation;
-    _orientation[0] = E_AX * cos_C + E_AZ * cos_C + E_B0A * _coef14 + _coef0 * _tmp37 - E_A0A * cos_C - E_A0C * _coef18 - E_AA * cos_C - E_AC - E_AY * cos_C - E_B0C * sin_C - E_BA * sin_C - _coef1 * _tmp38;
-    _orientation[1] = E_A0A * sin_C + E_A0C * sin_C + E_AA * sin_C + E_AY * sin_C + E_B0A * _coef33 + _coef21 * _tmp37 - E_AX * sin_C - E_AZ * sin_C - E_B0C * _coef18 - E_BA * cos_C - E_BC - _coef22 * _tmp38;
-    _orientation[2] = E_B0A * sin_A + E_BY * sin_A + E_CX * cos_A + E_CZ * cos_A - E_BX * sin_A - E_BZ * sin_A - E_C0A * _coef42 - E_C0C - E_CA - E_CC - E_CY * cos_A;
+    _orientation[0] = E_AX * cos_C + E_AZ * cos_C + E_B0A * _coef14 + _coef0 * _tmp37 - E_AC - E_A0A * cos_C - E_A0C * _coef18 - E_AA * cos_C - E_AY * cos_C - E_B0C * sin_C - E_BA * sin_C - _coef1 * _tmp38;
+    _orientation[1] = E_A0A * sin_C + E_A0C * sin_C + E_AA * sin_C + E_AY * sin_C + E_B0A * _coef33 + _coef21 * _tmp37 - E_BC - E_AX * sin_C - E_AZ * sin_C - E_B0C * _coef18 - E_BA * cos_C - _coef22 * _tmp38;
+    _orientation[2] = E_B0A * sin_A + E_BY * sin_A + E_CX * cos_A + E_CZ * cos_A - E_C0C - E_CA - E_CC - E_BX * sin_A - E_BZ * sin_A - E_C0A * _coef42 - E_CY * cos_A;
   }
 }
 

@@ -20,7 +20,7 @@ namespace gantry_grinder {
 
 inline constexpr const char* kMachineName = "gantry_grinder";
 inline constexpr int kOrder = 1;
-// Machine-file text, order and weilgen version: identifies the model (runtime/model_key.hpp).
+// Machine-file text, order and weilgen version: identifies the model (weilgen/machine/model_key.hpp).
 inline constexpr const char* kModelKey = "fad16e0bf41ce90b";
 inline constexpr std::size_t kNumAxes = 3;
 inline constexpr std::size_t kNumErrors = 21;
@@ -153,9 +153,9 @@ void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
   // Outputs
   if (position != nullptr) {
     auto& _position = *position;
-    _position[0] = E_XY + E_XZ + E_C0X * Y + E_CX * Y - E_B0Z * tool_length - E_BX * _coef0 - E_BY * tool_length - E_BZ * tool_length - E_CZ * Y - E_XX;
+    _position[0] = E_XY + E_XZ + E_C0X * Y + E_CX * Y - E_XX - E_B0Z * tool_length - E_BX * _coef0 - E_BY * tool_length - E_BZ * tool_length - E_CZ * Y;
     _position[1] = E_YY + E_YZ + E_A0Z * tool_length + E_AX * _coef0 + E_AY * tool_length + E_AZ * tool_length + E_C0X * X + E_CX * X - E_YX;
-    _position[2] = E_ZY + E_ZZ + E_A0Z * Y + E_AZ * Y - E_AX * Y - E_BX * X - E_ZX;
+    _position[2] = E_ZY + E_ZZ + E_A0Z * Y + E_AZ * Y - E_ZX - E_AX * Y - E_BX * X;
   }
   if (orientation != nullptr) {
     auto& _orientation = *orientation;

@@ -20,7 +20,7 @@ namespace pipe_cutter {
 
 inline constexpr const char* kMachineName = "pipe_cutter";
 inline constexpr int kOrder = 1;
-// Machine-file text, order and weilgen version: identifies the model (runtime/model_key.hpp).
+// Machine-file text, order and weilgen version: identifies the model (weilgen/machine/model_key.hpp).
 inline constexpr const char* kModelKey = "1b15a044631652b2";
 inline constexpr std::size_t kNumAxes = 6;
 inline constexpr std::size_t kNumErrors = 70;
@@ -262,16 +262,16 @@ void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
   const Scalar _tmp12 = LW * _inv0 * sin_A04;
   const Scalar _tmp13 = _inv0 * sin_A04 * X;
   const Scalar _tmp14 = E_B0A12 + E_BX;
-  const Scalar _tmp15 = E_ZZ453 + E_ZZ454 + Scalar(2) * E_ZA04;
+  const Scalar _tmp15 = Scalar(2) * E_ZA04 + E_ZZ453 + E_ZZ454;
   const Scalar _tmp16 = E_BZ453 + E_BZ454;
   const Scalar _tmp17 = E_CZ453 + E_CZ454;
   const Scalar _tmp18 = E_A0Z453 - E_A0Z454;
-  const Scalar _tmp19 = E_YY231 + E_YY232 + Scalar(2) * E_YA12;
-  const Scalar _tmp20 = E_ZY231 + E_ZY232 + Scalar(2) * E_ZA12;
+  const Scalar _tmp19 = Scalar(2) * E_YA12 + E_YY231 + E_YY232;
+  const Scalar _tmp20 = Scalar(2) * E_ZA12 + E_ZY231 + E_ZY232;
   const Scalar _tmp21 = E_BY231 + E_BY232;
   const Scalar _tmp22 = E_CY231 + E_CY232;
   const Scalar _tmp23 = E_A0Y231 - E_A0Y232;
-  const Scalar _tmp24 = E_YZ453 + E_YZ454 + Scalar(2) * E_YA04;
+  const Scalar _tmp24 = Scalar(2) * E_YA04 + E_YZ453 + E_YZ454;
   const Scalar _tmp25 = E_C0A12 + E_CX;
   const Scalar _tmp26 = E_YY231 + E_YY232;
   const Scalar _tmp27 = E_ZY231 + E_ZY232;
@@ -303,8 +303,8 @@ void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
   const Scalar _coef20 = _tmp1;
   const Scalar _coef21 = L23 * LW * _inv0 * sin_A12;
   const Scalar _coef22 = L23 * LW * _inv0 * cos_A12;
-  const Scalar _coef23 = Scalar(0.5) * L04 * _inv0 * cos_A12 + Scalar(0.5) * _tmp0 + Scalar(0.5) * cos_A12 - Scalar(0.5) * L01 * _inv0 * cos_A12 - Scalar(0.5) * _inv0 * cos_A12 * X - Scalar(0.5) * _tmp2;
-  const Scalar _coef24 = Scalar(0.5) * L04 * _inv0 * sin_A12 + Scalar(0.5) * _tmp1 + Scalar(0.5) * sin_A12 - Scalar(0.5) * L01 * _inv0 * sin_A12 - Scalar(0.5) * _inv0 * sin_A12 * X - Scalar(0.5) * _tmp3;
+  const Scalar _coef23 = Scalar(0.5) * _tmp0 + Scalar(0.5) * cos_A12 + Scalar(0.5) * L04 * _inv0 * cos_A12 - Scalar(0.5) * _tmp2 - Scalar(0.5) * L01 * _inv0 * cos_A12 - Scalar(0.5) * _inv0 * cos_A12 * X;
+  const Scalar _coef24 = Scalar(0.5) * _tmp1 + Scalar(0.5) * L04 * _inv0 * sin_A12 + Scalar(0.5) * sin_A12 - Scalar(0.5) * _tmp3 - Scalar(0.5) * L01 * _inv0 * sin_A12 - Scalar(0.5) * _inv0 * sin_A12 * X;
   const Scalar _coef25 = Scalar(0.5) * L04 * _inv0 * jaw_reach * sin_A12 + Scalar(0.5) * LW * _inv0 * jaw_reach * sin_A12 + Scalar(0.5) * jaw_reach * sin_A12 - Scalar(0.5) * L01 * _inv0 * jaw_reach * sin_A12 - Scalar(0.5) * L23 * _inv0 * jaw_reach * sin_A12 - Scalar(0.5) * _inv0 * jaw_reach * sin_A12 * X;
   const Scalar _coef26 = Scalar(0.5) * L04 * _inv0 * cos_A12 * jaw_reach + Scalar(0.5) * LW * _inv0 * cos_A12 * jaw_reach + Scalar(0.5) * cos_A12 * jaw_reach - Scalar(0.5) * L01 * _inv0 * cos_A12 * jaw_reach - Scalar(0.5) * L23 * _inv0 * cos_A12 * jaw_reach - Scalar(0.5) * _inv0 * cos_A12 * jaw_reach * X;
   const Scalar _coef27 = Scalar(0.5) * L04 * _inv0 * sin_A12 * Y231 + Scalar(0.5) * LW * _inv0 * sin_A12 * Y231 + Scalar(0.5) * sin_A12 * Y231 - Scalar(0.5) * L01 * _inv0 * sin_A12 * Y231 - Scalar(0.5) * L23 * _inv0 * sin_A12 * Y231 - Scalar(0.5) * _inv0 * sin_A12 * X * Y231;
@@ -341,7 +341,7 @@ void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
   // Outputs
   if (position != nullptr) {
     auto& _position = *position;
-    _position[0] = E_XA12 + E_XX + E_BA12 * _coef4 + Scalar(0.5) * E_C0Y232 * Y231 + E_CA04 * _coef12 + Scalar(0.5) * E_XY231 + Scalar(0.5) * E_XY232 + _coef1 * _tmp14 + Scalar(0.5) * _coef10 * _tmp15 + Scalar(0.5) * _coef15 * _tmp17 + Scalar(0.5) * _coef6 * _tmp21 + Scalar(0.5) * _coef9 * _tmp24 - E_B0A04 * _coef13 - E_BA04 * _coef11 - Scalar(0.5) * E_C0Y231 * Y231 - E_CA12 * _coef5 - E_ZX * _coef0 - Scalar(0.5) * _coef14 * _tmp16 - Scalar(0.5) * _coef16 * _tmp18 - Scalar(0.5) * _coef2 * _tmp19 - Scalar(0.5) * _coef3 * _tmp20 - Scalar(0.5) * _coef7 * _tmp22 - Scalar(0.5) * _coef8 * _tmp23;
+    _position[0] = E_XA12 + E_XX + Scalar(0.5) * E_XY231 + Scalar(0.5) * E_XY232 + E_BA12 * _coef4 + Scalar(0.5) * E_C0Y232 * Y231 + E_CA04 * _coef12 + _coef1 * _tmp14 + Scalar(0.5) * _coef10 * _tmp15 + Scalar(0.5) * _coef15 * _tmp17 + Scalar(0.5) * _coef6 * _tmp21 + Scalar(0.5) * _coef9 * _tmp24 - E_B0A04 * _coef13 - E_BA04 * _coef11 - Scalar(0.5) * E_C0Y231 * Y231 - E_CA12 * _coef5 - E_ZX * _coef0 - Scalar(0.5) * _coef14 * _tmp16 - Scalar(0.5) * _coef16 * _tmp18 - Scalar(0.5) * _coef2 * _tmp19 - Scalar(0.5) * _coef3 * _tmp20 - Scalar(0.5) * _coef7 * _tmp22 - Scalar(0.5) * _coef8 * _tmp23;
     _position[1] = E_BA12 * _coef21 + E_CA12 * _coef22 + E_YA12 * _coef19 + E_YX * _coef17 + E_ZA04 * _coef29 + _coef18 * _tmp25 + _coef23 * _tmp26 + _coef25 * _tmp21 + _coef26 * _tmp22 + _coef34 * (E_ZY451 + E_ZY452) + _coef37 * _tmp30 - E_BA04 * _coef30 - E_C0A04 * _coef32 - E_CA04 * _coef31 - E_YA04 * _coef28 - E_ZA12 * _coef20 - _coef24 * _tmp27 - _coef27 * _tmp23 - _coef33 * (E_YY451 + E_YY452) - _coef35 * _tmp28 - _coef36 * _tmp29;
     _position[2] = E_B0A04 * _coef32 + E_BA04 * _coef31 + E_CA12 * _coef21 + E_YA12 * _coef20 + E_ZA12 * _coef19 + E_ZX * _coef17 + _coef23 * _tmp27 + _coef24 * _tmp26 + _coef25 * _tmp22 + _coef36 * _tmp16 + _coef38 * _tmp23 + _coef39 * _tmp18 - E_BA12 * _coef22 - E_CA04 * _coef30 - E_YA04 * _coef29 - E_ZA04 * _coef28 - _coef18 * _tmp14 - _coef26 * _tmp21 - _coef33 * (E_ZZ453 + E_ZZ454) - _coef34 * (E_YZ453 + E_YZ454) - _coef35 * _tmp17;
   }
@@ -349,7 +349,7 @@ void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
     auto& _orientation = *orientation;
     _orientation[0] = Scalar(0);
     _orientation[1] = E_BA12 * _coef43 + E_CA04 * _coef51 + _coef40 * _tmp14 + Scalar(0.5) * _coef45 * _tmp21 + Scalar(0.5) * _coef48 * _tmp24 + Scalar(0.5) * _coef49 * _tmp15 + Scalar(0.5) * _coef54 * _tmp17 - E_B0A04 * _coef52 - E_BA04 * _coef50 - E_CA12 * _coef44 - E_ZX * _inv0 - Scalar(0.5) * _coef41 * _tmp19 - Scalar(0.5) * _coef42 * _tmp20 - Scalar(0.5) * _coef46 * _tmp22 - Scalar(0.5) * _coef47 * _tmp23 - Scalar(0.5) * _coef53 * _tmp16 - Scalar(0.5) * _coef9 * _tmp18;
-    _orientation[2] = E_BA12 * _coef44 + E_CA12 * _coef43 + E_YX * _inv0 + _coef40 * _tmp25 + Scalar(0.5) * _coef42 * _tmp19 + Scalar(0.5) * _coef45 * _tmp22 + Scalar(0.5) * _coef46 * _tmp21 + Scalar(0.5) * _coef48 * (E_ZY451 + E_ZY452 + Scalar(2) * E_ZA04) + Scalar(0.5) * _coef56 * _tmp30 - E_BA04 * _coef51 - E_C0A04 * _coef52 - E_CA04 * _coef50 - Scalar(0.5) * _coef41 * _tmp20 - Scalar(0.5) * _coef49 * (E_YY451 + E_YY452 + Scalar(2) * E_YA04) - Scalar(0.5) * _coef53 * _tmp29 - Scalar(0.5) * _coef54 * _tmp28 - Scalar(0.5) * _coef55 * _tmp23;
+    _orientation[2] = E_BA12 * _coef44 + E_CA12 * _coef43 + E_YX * _inv0 + _coef40 * _tmp25 + Scalar(0.5) * _coef42 * _tmp19 + Scalar(0.5) * _coef45 * _tmp22 + Scalar(0.5) * _coef46 * _tmp21 + Scalar(0.5) * _coef48 * (Scalar(2) * E_ZA04 + E_ZY451 + E_ZY452) + Scalar(0.5) * _coef56 * _tmp30 - E_BA04 * _coef51 - E_C0A04 * _coef52 - E_CA04 * _coef50 - Scalar(0.5) * _coef41 * _tmp20 - Scalar(0.5) * _coef49 * (Scalar(2) * E_YA04 + E_YY451 + E_YY452) - Scalar(0.5) * _coef53 * _tmp29 - Scalar(0.5) * _coef54 * _tmp28 - Scalar(0.5) * _coef55 * _tmp23;
   }
 }
 
@@ -402,7 +402,7 @@ void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
   const Scalar _tmp15 = L23 * LW * _inv0 * sin_A12;
   const Scalar _tmp16 = L23 * LW * _inv0 * cos_A12;
   const Scalar _tmp17 = L23 * _inv0 * cos_A12;
-  const Scalar _tmp18 = Scalar(0.5) * L04 * _inv0 * cos_A12 + Scalar(0.5) * _tmp13 + Scalar(0.5) * cos_A12 - Scalar(0.5) * L01 * _inv0 * cos_A12 - Scalar(0.5) * _inv0 * cos_A12 * X - Scalar(0.5) * _tmp17;
+  const Scalar _tmp18 = Scalar(0.5) * _tmp13 + Scalar(0.5) * cos_A12 + Scalar(0.5) * L04 * _inv0 * cos_A12 - Scalar(0.5) * _tmp17 - Scalar(0.5) * L01 * _inv0 * cos_A12 - Scalar(0.5) * _inv0 * cos_A12 * X;
   const Scalar _tmp19 = L01 * _inv0 * sin_A12;
   const Scalar _tmp20 = L04 * _inv0 * sin_A12;
   const Scalar _tmp21 = L23 * _inv0 * sin_A12;

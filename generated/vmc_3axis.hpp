@@ -20,7 +20,7 @@ namespace vmc_3axis {
 
 inline constexpr const char* kMachineName = "vmc_3axis";
 inline constexpr int kOrder = 1;
-// Machine-file text, order and weilgen version: identifies the model (runtime/model_key.hpp).
+// Machine-file text, order and weilgen version: identifies the model (weilgen/machine/model_key.hpp).
 inline constexpr const char* kModelKey = "5c916ea7bfaab479";
 inline constexpr std::size_t kNumAxes = 3;
 inline constexpr std::size_t kNumErrors = 21;
@@ -153,9 +153,9 @@ void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
   // Outputs
   if (position != nullptr) {
     auto& _position = *position;
-    _position[0] = E_XZ + E_B0Z * Z + E_C0Y * Y - E_BZ * tool_length - E_CX * Y - E_CY * Y - E_XX - E_XY - _coef0 * (E_BX + E_BY);
-    _position[1] = E_YZ + E_AZ * tool_length + E_CX * X + _coef0 * (E_AX + E_AY) - E_A0Z * Z - E_YX - E_YY;
-    _position[2] = E_ZZ + E_AX * Y + E_AY * Y - E_BX * X - E_ZX - E_ZY;
+    _position[0] = E_XZ + E_B0Z * Z + E_C0Y * Y - E_XX - E_XY - E_BZ * tool_length - E_CX * Y - E_CY * Y - _coef0 * (E_BX + E_BY);
+    _position[1] = E_YZ + E_AZ * tool_length + E_CX * X + _coef0 * (E_AX + E_AY) - E_YX - E_YY - E_A0Z * Z;
+    _position[2] = E_ZZ + E_AX * Y + E_AY * Y - E_ZX - E_ZY - E_BX * X;
   }
   if (orientation != nullptr) {
     auto& _orientation = *orientation;

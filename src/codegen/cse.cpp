@@ -20,6 +20,11 @@ ex strip_coefficient(const ex& e) {
     if (!GiNaC::is_a<GiNaC::numeric>(e.op(i))) rest *= e.op(i);
   return rest;
 }
+// b^n for a sum b and a whole n (a divisor's reciprocal, or its square).
+bool is_integer_power_of_sum(const ex& e) {
+  return GiNaC::is_a<GiNaC::power>(e) && GiNaC::is_a<GiNaC::add>(e.op(0)) &&
+         GiNaC::is_a<GiNaC::numeric>(e.op(1)) && GiNaC::ex_to<GiNaC::numeric>(e.op(1)).is_integer();
+}
 }  // namespace
 
 const std::string& CanonicalText::of(const ex& e) {
@@ -43,6 +48,11 @@ const std::string& CanonicalText::of(const ex& e) {
         const Signed r = canonical_sign(op);
         if (r.negated) coeff = -coeff;
         parts.push_back(of(r.value));
+      } else if (is_integer_power_of_sum(op)) {
+        // (−b)^n = (−1)^n b^n: the base's sign is GiNaC's choice too.
+        const Signed r = canonical_sign(op.op(0));
+        if (r.negated && GiNaC::ex_to<GiNaC::numeric>(op.op(1)).is_odd()) coeff = -coeff;
+        parts.push_back("pow(" + of(r.value) + "," + of(op.op(1)) + ")");
       } else {
         parts.push_back(of(op));
       }
@@ -53,6 +63,10 @@ const std::string& CanonicalText::of(const ex& e) {
     for (const auto& p : parts) os << "," << p;
     os << ")";
     s = os.str();
+  } else if (is_integer_power_of_sum(e)) {
+    const Signed r = canonical_sign(e.op(0));
+    const bool flip = r.negated && GiNaC::ex_to<GiNaC::numeric>(e.op(1)).is_odd();
+    s = std::string(flip ? "neg" : "") + "pow(" + of(r.value) + "," + of(e.op(1)) + ")";
   } else {
     std::vector<std::string> parts;
     for (std::size_t i = 0; i < e.nops(); ++i) parts.push_back(of(e.op(i)));
@@ -83,6 +97,10 @@ CanonicalText::Signed CanonicalText::canonical_sign(const ex& sum) {
 
 std::string CanonicalText::unsigned_text(const ex& e) {
   if (!GiNaC::is_a<GiNaC::mul>(e)) return of(e);
+  // −x is mul(−1, x): its text must be x's, or flipping a sum's sign would reorder its terms
+  // (and renumber the temporaries) from one run to the next.
+  const ex core = strip_coefficient(e);
+  if (!GiNaC::is_a<GiNaC::mul>(core)) return of(core);
   const std::string& t = of(e);  // "mul(<coeff>,<factors...>)"
   const auto comma = t.find(',');
   return comma == std::string::npos ? t : "mul(" + t.substr(comma + 1);

@@ -352,7 +352,7 @@ std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_la
   os << "inline constexpr const char* kMachineName = " << string_literal(d.name) << ";\n";
   os << "inline constexpr int kOrder = " << m.order << ";\n";
   os << "// Machine-file text, order and weilgen version: identifies the model "
-        "(runtime/model_key.hpp).\n";
+        "(weilgen/machine/model_key.hpp).\n";
   os << "inline constexpr const char* kModelKey = "
      << string_literal(model_key(d.source_hash, m.order)) << ";\n";
   os << "inline constexpr std::size_t kNumAxes = " << m.axes.size() << ";\n";

@@ -45,6 +45,13 @@ std::string join_term(const std::string& acc, ex coeff, const std::string& name,
     if (2 * negatives > coeff.nops()) {
       negative = true;
       coeff = (-coeff).expand();
+    } else if (2 * negatives == coeff.nops()) {
+      // As many negative terms as positive: GiNaC's sign of the sum varies between runs; take
+      // the canonical one.
+      CanonicalText canon;
+      const CanonicalText::Signed r = canon.canonical_sign(coeff);
+      negative = r.negated;
+      coeff = r.value;
     }
     c = (style == FormStyle::Latex ? "\\left(" : "(") + pr.print(coeff) +
         (style == FormStyle::Latex ? "\\right)" : ")");

@@ -175,7 +175,11 @@ std::string ExprPrinter::factor(const ex& e) {
     const ex base = e.op(0), expo = e.op(1);
     if (GiNaC::is_a<GiNaC::numeric>(expo) && GiNaC::ex_to<GiNaC::numeric>(expo).is_pos_integer()) {
       const long n = GiNaC::ex_to<GiNaC::numeric>(expo).to_long();
-      const std::string b = factor(base);
+      // An even power of a sum: GiNaC picks the base's sign by hash order; print the canonical
+      // one (the sign does not matter).
+      const std::string b = GiNaC::is_a<GiNaC::add>(base) && n % 2 == 0
+                                ? factor(canon_.canonical_sign(base).value)
+                                : factor(base);
       if (style_ != Style::Cpp)
         return b + (style_ == Style::Latex ? "^{" : "^") + std::to_string(n) +
                (style_ == Style::Latex ? "}" : "");
