@@ -330,6 +330,44 @@ workpiece: {body: bed}
   CHECK(d.errors.at(0).distribution.b == doctest::Approx(0.005));
 }
 
+TEST_CASE("loader: the one unit table: µm and µrad (micro sign or Greek mu) read as um and urad") {
+  // The same machine written with um/urad and with µm (U+00B5), μm (U+03BC) and µrad: the same
+  // description, the units stored in their ASCII spelling.
+  const auto machine = [](const std::string& length, const std::string& angle) {
+    return "weilgen: 1\nname: m\nerror_defaults:\n  angular: {sigma: 2, unit: " + angle +
+           "}\nbodies:\n  bed: {}\n  x:\n    parent: bed\n"
+           "    joint: {type: prismatic, axis: x, coordinate: X, unit: " +
+           length + "}\n    errors: {E_XX: {sigma: 5, unit: " + length +
+           "}, E_AX: {unit: " + angle + "}}\ntool: {body: x}\nworkpiece: {body: bed}\n";
+  };
+  const Description ascii = load_machine_text(machine("um", "urad"), "a.yaml");
+  for (const auto& [length, angle] : std::vector<std::pair<std::string, std::string>>{
+           {"\u00b5m", "\u00b5rad"}, {"\u03bcm", "\u03bcrad"}}) {
+    CAPTURE(length);
+    const Description d = load_machine_text(machine(length, angle), "b.yaml");
+    REQUIRE(d.errors.size() == 2);
+    for (std::size_t i = 0; i < 2; ++i) {
+      CHECK(d.errors[i].unit == ascii.errors[i].unit);
+      CHECK(d.errors[i].to_base == ascii.errors[i].to_base);
+      CHECK(d.errors[i].distribution.b == ascii.errors[i].distribution.b);
+    }
+    CHECK(d.errors[0].unit == "um");
+    CHECK(d.errors[0].to_base == 1e-3);
+    CHECK(d.errors[1].unit == "urad");
+    CHECK(d.errors[1].to_base == 1e-6);
+    const Joint& j = d.bodies[static_cast<std::size_t>(d.coordinate_body("X"))].joint;
+    CHECK(j.unit == "um");
+    CHECK(j.to_base == 1e-3);
+  }
+  // Dimension checks apply to the micro spellings too: a length unit on a rotation, named as
+  // written.
+  const std::string bad = machine("um", "urad");
+  std::string wrong = bad;
+  wrong.replace(wrong.find("E_AX: {unit: urad}"), 18, "E_AX: {unit: \u00b5m}");
+  expect_error(wrong, "bad.yaml:10:55",
+               {"bodies.x.errors.E_AX.unit", "unit '\u00b5m' is a length", "'E_AX' is a rotation"});
+}
+
 TEST_CASE("loader: shipped machines load and resolve by name") {
   namespace fs = std::filesystem;
   int count = 0;

@@ -54,6 +54,8 @@ bool unit_char(char c) {
 
 }  // namespace
 
+std::string ascii_unit(const std::string& unit) { return ascii_micro(unit); }
+
 std::string known_units() {
   return "lengths: mm, um, µm, nm, m; angles: rad, mrad, urad, µrad, deg, arcsec; slopes: mm/m, "
          "um/m";

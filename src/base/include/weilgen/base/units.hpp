@@ -19,6 +19,10 @@ struct UnitFactor {
 // Greek mu (U+03BC). Throws std::invalid_argument naming the unit and the known ones.
 UnitFactor parse_unit(const std::string& unit);
 
+// The unit's name in ASCII as the table spells it: "µm" and "μm" -> "um", "µrad" -> "urad"
+// (other text unchanged). Files and reports store this spelling.
+std::string ascii_unit(const std::string& unit);
+
 // Every unit parse_unit knows, for messages: "lengths: mm, ...; angles: ...; slopes: ...".
 std::string known_units();
 
