@@ -6,6 +6,7 @@
 //
 // Inside a generated header it sees the model's namespace: kNumAxes, kNumErrors, kNumParams,
 // NominalPose, NominalJacobian, Deviation, and <array>, <cmath>, <cstddef>.
+// clang-format off: the text below is emitted byte for byte (the generated files are golden).
 // ---- weilgen template: emitted from the next line ----
 // ---- Compensation (docs/compensation.md) -------------------------------------
 // Compensate finds the command q whose predicted pose is the nominal pose at the target t:
