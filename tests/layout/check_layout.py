@@ -1,0 +1,85 @@
+#!/usr/bin/env python3
+"""The layout rules of docs/architecture.md, checked on the source tree (CTest `layout`):
+
+  - every #include "weilgen/<layer>/..." in src/<from>/ names <from> or a layer <from> may use
+    (the build enforces the same arrows through include paths; this names the file and line);
+  - no source folder holds more than 20 .cpp files;
+  - every src/cli/verb_*.cpp has at most 200 lines;
+  - the codegen layer's CMake file links no NLopt and no Eigen;
+  - nothing under src/ includes another layer's internal headers ("../", "src/").
+
+Usage: check_layout.py SOURCE_DIR. Prints each violation as file:line: message; exit 1 if any.
+"""
+import os
+import re
+import sys
+
+ALLOWED = {
+    "base": set(),
+    "machine": {"base"},
+    "codegen": {"machine", "base"},
+    "model": {"machine", "base"},
+    "uq": {"base"},
+    "measure": {"machine", "base"},
+    "analysis": {"model", "uq", "measure", "codegen", "machine", "base"},
+    "report": {"analysis", "model", "uq", "measure", "codegen", "machine", "base"},
+    "cli": {"report", "analysis", "model", "uq", "measure", "codegen", "machine", "base"},
+}
+INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"')
+
+
+def main(root):
+    problems = []
+    src = os.path.join(root, "src")
+    for layer in sorted(os.listdir(src)):
+        layer_dir = os.path.join(src, layer)
+        if not os.path.isdir(layer_dir):
+            continue
+        if layer not in ALLOWED:
+            problems.append(f"src/{layer}: a folder that is not a layer of docs/architecture.md")
+            continue
+        for dirpath, _, files in os.walk(layer_dir):
+            cpps = [f for f in files if f.endswith(".cpp")]
+            if len(cpps) > 20:
+                rel = os.path.relpath(dirpath, root)
+                problems.append(f"{rel}: {len(cpps)} .cpp files (at most 20: split by job)")
+            for f in files:
+                if not f.endswith((".cpp", ".hpp", ".h")):
+                    continue
+                path = os.path.join(dirpath, f)
+                rel = os.path.relpath(path, root)
+                with open(path, encoding="utf-8") as fh:
+                    lines = fh.read().split("\n")
+                if layer == "cli" and f.startswith("verb_") and f.endswith(".cpp"):
+                    n = len(lines) - (1 if lines and lines[-1] == "" else 0)
+                    if n > 200:
+                        problems.append(f"{rel}: {n} lines (a verb parses and prints: <= 200)")
+                for number, line in enumerate(lines, 1):
+                    m = INCLUDE.match(line)
+                    if not m:
+                        continue
+                    target = m.group(1)
+                    if target.startswith("../") or target.startswith("src/"):
+                        problems.append(f"{rel}:{number}: includes '{target}' by path: use the "
+                                        "layer's public header weilgen/<layer>/...")
+                    parts = target.split("/")
+                    if len(parts) >= 3 and parts[0] == "weilgen":
+                        to = parts[1]
+                        if to != layer and to not in ALLOWED[layer]:
+                            problems.append(f"{rel}:{number}: {layer} may not include {to} "
+                                            f"('{target}'; allowed: "
+                                            f"{', '.join(sorted(ALLOWED[layer])) or 'none'})")
+    cmake = os.path.join(src, "codegen", "CMakeLists.txt")
+    with open(cmake, encoding="utf-8") as fh:
+        text = "\n".join(l.split("#")[0] for l in fh.read().split("\n"))  # without comments
+    for lib in ("NLopt", "Eigen3", "nlopt"):
+        if lib in text:
+            problems.append(f"src/codegen/CMakeLists.txt: links {lib} (codegen uses GiNaC only)")
+    for p in problems:
+        print(p)
+    print(f"layout: {len(problems)} problem(s)")
+    return 1 if problems else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1] if len(sys.argv) > 1 else "."))
