@@ -1,5 +1,5 @@
 // Evaluation cost per pose: the generated closed forms (generated/<machine>.hpp) against the
-// straightforward exact numeric Eigen chain (runtime/numeric_chain.hpp), side by side per shipped
+// straightforward exact numeric Eigen chain (weilgen/model/numeric_chain.hpp), side by side per shipped
 // machine, in one run. One benchmark iteration is one pose (items/s = poses/s):
 //
 //   generated_dev         Deviation (position + orientation)

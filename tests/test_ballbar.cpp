@@ -1,4 +1,4 @@
-// Ballbar circle prediction and evaluation (runtime/ballbar.hpp, docs/ballbar.md): closed-form
+// Ballbar circle prediction and evaluation (weilgen/measure/ballbar.hpp, docs/ballbar.md): closed-form
 // traces of a centre offset, a squareness, scale errors and a constant tangential deviation;
 // feed order; the vmc_3axis model against the closed form and the exact numeric chain; the
 // circle's header keys and flags with their messages; measured traces; the comparison; and the

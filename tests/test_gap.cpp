@@ -1,4 +1,4 @@
-// Gap diagnosis (runtime/gap.hpp): each effect's fit on a small synthetic set, the false-positive
+// Gap diagnosis (weilgen/analysis/gap.hpp): each effect's fit on a small synthetic set, the false-positive
 // rate on effect-free data, the held-out splits and bad data.
 #include <doctest/doctest.h>
 

@@ -1,4 +1,4 @@
-// ISO 230-2 evaluation and the drift seed's thermal-drift elimination (runtime/iso230_2.hpp,
+// ISO 230-2 evaluation and the drift seed's thermal-drift elimination (weilgen/measure/iso230_2.hpp,
 // docs/iso230-2.md): a hand-computed example with every figure pinned, invariants on random
 // data, drift recovery on synthetic data, the seed's sqrt(2) Monte Carlo check, the anomaly
 // test's false-positive rate and power, grouping errors, and the CLI end to end.

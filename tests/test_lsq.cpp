@@ -1,4 +1,4 @@
-// The column-equilibrated SVD (runtime/lsq.hpp) that identify and the gap folds share.
+// The column-equilibrated SVD (weilgen/uq/lsq.hpp) that identify and the gap folds share.
 #include <doctest/doctest.h>
 
 #include "test_support.hpp"

@@ -1,4 +1,4 @@
-// The measurement CSV reader (runtime/measurement_csv.hpp, docs/data-format.md): every column
+// The measurement CSV reader (weilgen/measure/measurement_csv.hpp, docs/data-format.md): every column
 // role, comments and header keys, CRLF, and each kind of bad input with its exact file:line:column.
 #include <doctest/doctest.h>
 

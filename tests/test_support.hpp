@@ -117,7 +117,7 @@ inline double loglog_slope(const std::vector<double>& s, const std::vector<doubl
   return sxy / sxx;
 }
 
-// A file's whole text (runtime/atomic_file.hpp's read_file), "" when it cannot be read.
+// A file's whole text (weilgen/base/atomic_file.hpp's read_file), "" when it cannot be read.
 inline std::string read_text(const std::string& path) {
   std::string text;
   read_file(path, text);

@@ -13,7 +13,7 @@
 //   E_CY  = 3.0 sin(2πy/400)                 yaw of Y
 //   E_C0Y = 12                               squareness of Y to X
 // all others 0. The deviation is the generated model's (generated/vmc_3axis.hpp, order 1);
-// written independently of runtime/ballbar.cpp so that the test comparing the two checks both.
+// written independently of src/measure/ballbar.cpp so that the test comparing the two checks both.
 // The table carries X and Y, so the tool moves relative to the workpiece by (-X, -Y, +Z): the
 // nominal vector from the table ball to the tool ball is v = -R (cos θ, sin θ, 0), and
 //   dr = |v + d| - R                       (exact, µm)

@@ -1,8 +1,8 @@
 // The truth generator of the sim-to-real gap benchmark (bench/gap/README.md): a shipped machine
 // with random geometric errors within its spreads, evaluated with the exact numeric chain
-// (runtime/numeric_chain.hpp), plus exactly one effect withheld from the model (or none), sampled
+// (weilgen/model/numeric_chain.hpp), plus exactly one effect withheld from the model (or none), sampled
 // in one measurement layout and written as a measurement CSV (docs/data-format.md) with a
-// truth.json. Nothing here calls or mirrors the diagnosis code (cli/verb_gap.cpp): the only
+// truth.json. Nothing here calls or mirrors the diagnosis code (src/cli/verb_gap.cpp): the only
 // shared pieces are the machine description, the exact chain and the CSV format.
 #pragma once
 
