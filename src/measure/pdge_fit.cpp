@@ -372,6 +372,15 @@ PeriodSearchResult PeriodSearch::run(const std::vector<double>& x, const std::ve
   return out;
 }
 
+void PdgeFitOptions::validate() const {
+  if (min_order < 0 || max_order < min_order)
+    throw std::invalid_argument("fit: order range " + std::to_string(min_order) + ".." +
+                                std::to_string(max_order) + " is empty");
+  if (cv.folds < 2) throw std::invalid_argument("fit: the CV needs at least 2 folds");
+}
+
+PdgeFit::PdgeFit(PdgeFitOptions options) : options_(std::move(options)) { options_.validate(); }
+
 PdgeFitResult PdgeFit::run(const std::vector<double>& x, const std::vector<double>& y,
                            const std::vector<int>& cycles, const BasisSpec& spec, double a,
                            double b) const {

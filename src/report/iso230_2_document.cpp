@@ -61,12 +61,8 @@ json differences_json(const AdjacentDifferences& D, const std::vector<double>& p
           {"flagged", flagged}};
 }
 
-std::string fmt(double v, int precision = 3) {
-  if (!std::isfinite(v)) return "-";
-  std::ostringstream s;
-  s << std::fixed << std::setprecision(precision) << v;
-  return s.str();
-}
+// Table cells: fixed decimals (3 unless said), "-" when not computed.
+std::string fmt(double v, int decimals = 3) { return format_fixed(v, decimals); }
 
 std::string dir_label(int d) { return d > 0 ? "+1" : "-1"; }
 

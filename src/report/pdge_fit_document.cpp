@@ -6,6 +6,7 @@
 #include <map>
 #include <sstream>
 
+#include "weilgen/base/format.hpp"
 #include "weilgen/base/version.hpp"
 #include "weilgen/report/json_common.hpp"
 
@@ -15,19 +16,9 @@ namespace {
 
 using nlohmann::json;
 
-std::string fmt(double v, int precision) {
-  if (!std::isfinite(v)) return "-";
-  std::ostringstream s;
-  s << std::fixed << std::setprecision(precision) << v;
-  return s.str();
-}
-
-std::string fmt_g(double v, int precision = 4) {
-  if (!std::isfinite(v)) return "-";
-  std::ostringstream s;
-  s << std::setprecision(precision) << v;
-  return s.str();
-}
+// Table cells: fixed decimals, or significant digits (4 unless said); "-" when not computed.
+std::string fmt(double v, int decimals) { return format_fixed(v, decimals); }
+std::string fmt_g(double v, int digits = 4) { return format_significant(v, digits); }
 
 // Mean of y at each distinct x (sorted): the data line of the plot.
 void position_means(const std::vector<double>& x, const std::vector<double>& y,

@@ -158,6 +158,8 @@ struct PdgeFitOptions {
   // the cost of choosing its period.
   PeriodSearchOptions period_search;
   LeastSquaresOptions least_squares;
+  // 0 <= min_order <= max_order and CV folds >= 2 (std::invalid_argument naming the field).
+  void validate() const;
 };
 
 // One order on the CV curve.
@@ -190,7 +192,7 @@ struct PdgeFitResult {
 // positions (leave-one-position-out); result.folds says how many were used.
 class PdgeFit {
  public:
-  explicit PdgeFit(PdgeFitOptions options = {}) : options_(options) {}
+  explicit PdgeFit(PdgeFitOptions options = {});  // validates the options
   // Throws std::invalid_argument when the data cannot support any order tried (auto) or the
   // fixed order (fixed; the LeastSquaresFit message), or for bad options.
   PdgeFitResult run(const std::vector<double>& x, const std::vector<double>& y,
