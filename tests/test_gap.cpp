@@ -567,3 +567,75 @@ TEST_CASE("gap: a cosine error of the measuring set-up along X is setup, with it
   CHECK(e->variant == "dx along X");
   CHECK(e->params.at("quadratic_um_per_m2") == doctest::Approx(20).epsilon(0.1));
 }
+
+
+namespace {
+
+// Adds `size_um` to the dx cell of `rows` data rows (1-based after the header) of a CSV.
+std::string with_gross_readings(const std::string& csv, const std::vector<int>& rows,
+                                double size_um) {
+  std::istringstream in(csv);
+  std::ostringstream out;
+  std::string line;
+  int n = -1;
+  while (std::getline(in, line)) {
+    if (n >= 0 && std::find(rows.begin(), rows.end(), n + 1) != rows.end()) {
+      // dx_um is the 8th field.
+      std::vector<std::string> f;
+      std::stringstream ls(line);
+      for (std::string cell; std::getline(ls, cell, ',');) f.push_back(cell);
+      f[7] = std::to_string(std::stod(f[7]) + size_um);
+      line.clear();
+      for (std::size_t k = 0; k < f.size(); ++k) line += (k ? "," : "") + f[k];
+    }
+    out << line << "\n";
+    ++n;
+  }
+  return out.str();
+}
+
+}  // namespace
+
+TEST_CASE("gap: five gross readings are reported and removed; the reversal is still named") {
+  const std::string clean = synth(1, [](const Row& w) {
+    return std::array<double, 3>{2.0 * w.dir_X, 0, 0};  // B = 4 µm in dx
+  });
+  const std::vector<int> rows = {17, 90, 151, 240, 333};
+  const GapResult r = diagnose(with_gross_readings(clean, rows, 60));
+  REQUIRE(r.outliers.size() == 5);
+  for (std::size_t k = 0; k < 5; ++k) {
+    CHECK(r.outliers[k].output == "dx");
+    CHECK(r.outliers[k].line == rows[k] + 1);  // the header is line 1
+    CHECK(r.outliers[k].residual_um == doctest::Approx(60).epsilon(0.1));
+    CHECK(r.outliers[k].sigmas > 6);
+  }
+  CHECK(r.verdict == "reversal");
+  const EffectFit* e = effect(r, "reversal");
+  REQUIRE(e);
+  CHECK(e->params.at("reversal_dx") == doctest::Approx(4.0).epsilon(0.1));
+  CHECK(std::isnan(r.residual_before[static_cast<std::size_t>(r.outliers[0].observation)]));
+}
+
+TEST_CASE("gap: effect-free data with gross readings: outliers, and the verdict none") {
+  int named = 0;
+  for (std::uint32_t s = 0; s < 10; ++s) {
+    const GapResult r =
+        diagnose(with_gross_readings(synth(300 + s, none, 0.5, 3, 5), {5, 50, 95}, -40));
+    CHECK(r.outliers.size() == 3);
+    if (r.verdict != "none") ++named;
+  }
+  CHECK(named <= 1);
+}
+
+TEST_CASE("gap: no significant held-out gap, no effect named") {
+  // The baseline gap test decides: with effect-free data the verdict is none even when the
+  // ranking's best candidate is (by chance) nominally significant, and the reason names it.
+  for (std::uint32_t s = 0; s < 5; ++s) {
+    const GapResult r = diagnose(synth(500 + s, none, 0.5, 3, 5));
+    if (r.baseline_p_value >= 0.01) {
+      CHECK(r.verdict == "none");
+      CHECK(r.explanation.empty());
+      CHECK(r.verdict_reason.find("noise floor") != std::string::npos);
+    }
+  }
+}

@@ -71,8 +71,18 @@ nlohmann::json gap_json(const GapResult& r, const Model& model, const std::strin
   for (const EffectFit& e : r.effects) effects.push_back(effect_json(e, r.count));
   for (const EffectFit& e : r.explanation)
     expl.push_back(effect_json(e, r.count)), names.push_back(e.name);
+  json outliers = json::array();
+  for (const GapOutlier& g : r.outliers)
+    outliers.push_back({{"observation", g.observation},
+                        {"line", g.line},
+                        {"output", g.output},
+                        {"value_um", g.value_um},
+                        {"residual_um", g.residual_um},
+                        {"robust_sigmas", g.sigmas}});
   return {{"weilgen", kVersion},
+          {"verb", "gap"},
           {"model", model_json(model)},
+          {"outliers", outliers},
           {"data", data},
           {"baseline",
            {{"holdout", r.holdout},
@@ -128,6 +138,16 @@ std::string gap_text(const GapResult& r, const Model& model, const std::string& 
   os << "\n"
      << (markdown ? "\n" : "") << "Why: " << r.verdict_reason << ".\n\n"
      << h2 << "Baseline\n\n";
+  if (!r.outliers.empty()) {
+    os << r.outliers.size() << " gross reading" << (r.outliers.size() > 1 ? "s" : "")
+       << " removed before the diagnosis (beyond max(6, z_n) robust standard deviations and "
+          "unlike their neighbours):\n";
+    for (const GapOutlier& g : r.outliers)
+      os << (markdown ? "- " : "  ") << "line " << g.line << ", " << g.output << " "
+         << f3(g.value_um) << " (residual " << f3(g.residual_um) << ", " << f3(g.sigmas)
+         << " sigma)\n";
+    os << "\n";
+  }
   os << "identified on the training part, predicted on the held-out part (" << r.holdout << "; "
      << r.holdout_reason << "): " << r.observations << " observations, " << r.parameters
      << " parameters (rank " << r.rank << ").\n";

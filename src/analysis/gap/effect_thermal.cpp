@@ -64,20 +64,8 @@ void add_thermal(const EffectContext& ctx, std::vector<Candidate>& out) {
     for (const auto& o : d.points.observations) sum += v[o.row], ++n;
     return n ? sum / static_cast<double>(n) : 0.0;
   };
-  // First-order lag of a per-row signal in time order.
   auto lagged = [&d](const std::vector<double>& T, double tau) {
-    if (!(tau > 0)) return T;
-    std::vector<std::size_t> rows;
-    for (std::size_t r = 0; r < T.size(); ++r)
-      if (std::isfinite(T[r]) && std::isfinite(d.time_s[r])) rows.push_back(r);
-    std::stable_sort(rows.begin(), rows.end(),
-                     [&](std::size_t a, std::size_t b) { return d.time_s[a] < d.time_s[b]; });
-    std::vector<double> f = T;
-    for (std::size_t k = 1; k < rows.size(); ++k) {
-      const double dt = d.time_s[rows[k]] - d.time_s[rows[k - 1]];
-      f[rows[k]] = f[rows[k - 1]] + (1 - std::exp(-dt / tau)) * (T[rows[k]] - f[rows[k - 1]]);
-    }
-    return f;
+    return first_order_lag(d, T, tau);
   };
   c.columns = [&d, outs, t0, sensors, mean_of, lagged](const Variant& v,
                                                        const std::vector<double>&) {

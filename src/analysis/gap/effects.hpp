@@ -57,6 +57,13 @@ struct Candidate {
   // Columns (observations × q) of a variant; `theta` is the baseline parameters of the split
   // (only read when the variant needs_theta).
   std::function<Eigen::MatrixXd(const Variant&, const std::vector<double>& theta)> columns;
+  // A regularised model of many inputs (the multi-sensor thermal model) instead of `columns`:
+  // its columns are fitted on a training part, from those rows (observation indices) and the
+  // baseline's residual there, and predict every observation. Held-out observations never
+  // inform their own columns, so the candidate is tested on its held-out improvement.
+  std::function<Eigen::MatrixXd(const Variant&, const std::vector<std::size_t>& train,
+                                const Eigen::VectorXd& train_residual)>
+      fitted_columns;
   // Fills summary/params/region of `fit` from the full-data coefficients c of the columns.
   std::function<void(const Variant&, const Eigen::VectorXd& c, EffectFit& fit)> describe;
 };
@@ -67,6 +74,7 @@ std::vector<Candidate> effect_candidates(const EffectContext& ctx,
 
 // One family of the library each (effect_*.cpp): appends its candidate, if the data allow it.
 void add_thermal(const EffectContext& ctx, std::vector<Candidate>& out);
+void add_thermal_sensors(const EffectContext& ctx, std::vector<Candidate>& out);
 void add_reversal(const EffectContext& ctx, std::vector<Candidate>& out);
 void add_periodic(const EffectContext& ctx, std::vector<Candidate>& out);
 void add_pdge_shape(const EffectContext& ctx, std::vector<Candidate>& out);
@@ -160,6 +168,24 @@ inline MatrixXd one_output(const GapData& d, int output,
       E(static_cast<Index>(i), static_cast<Index>(k)) = w * f[k](q);
   }
   return E;
+}
+
+// First-order lag (time constant tau_s, s) of a per-row signal, in time order; the signal as it
+// is for tau_s <= 0. Rows without a time or a value keep theirs.
+inline std::vector<double> first_order_lag(const GapData& d, const std::vector<double>& T,
+                                           double tau_s) {
+  if (!(tau_s > 0)) return T;
+  std::vector<std::size_t> rows;
+  for (std::size_t r = 0; r < T.size(); ++r)
+    if (std::isfinite(T[r]) && std::isfinite(d.time_s[r])) rows.push_back(r);
+  std::stable_sort(rows.begin(), rows.end(),
+                   [&](std::size_t a, std::size_t b) { return d.time_s[a] < d.time_s[b]; });
+  std::vector<double> f = T;
+  for (std::size_t k = 1; k < rows.size(); ++k) {
+    const double dt = d.time_s[rows[k]] - d.time_s[rows[k - 1]];
+    f[rows[k]] = f[rows[k - 1]] + (1 - std::exp(-dt / tau_s)) * (T[rows[k]] - f[rows[k - 1]]);
+  }
+  return f;
 }
 
 }  // namespace weilgen::gap_detail

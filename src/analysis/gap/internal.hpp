@@ -105,6 +105,9 @@ inline void gap_stats(const Gap& g, double dof, double& excess, double& p) {
   p = g.n ? f_sf((g.ss / g.expected), static_cast<double>(g.n), dof) : 1;
 }
 
+// Gross readings in the baseline's full-data residual `r` (docs/gap.md, "Outliers").
+std::vector<GapOutlier> find_outliers(const GapData& d, const VectorXd& r);
+
 // The noise floor of the held-out residual (docs/gap.md, "Noise floor").
 NoiseFloor noise_floor(const GapData& d, const VectorXd& heldout);
 

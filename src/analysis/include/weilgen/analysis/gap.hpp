@@ -125,9 +125,22 @@ struct EffectFit {
   std::string indistinct_reason;  // why not, one clause
 };
 
+// A gross reading: far outside the spread of the baseline's residual and unlike its neighbours
+// (the observations nearest in the pose space, same output), so no smooth effect explains it.
+// Removed before the diagnosis and reported.
+struct GapOutlier {
+  std::size_t observation = 0;  // index into GapData::points.observations
+  int line = 0;                 // source line of its row
+  std::string output;           // dx ... dc, dr
+  double value_um = 0;          // as measured (µm, µrad)
+  double residual_um = 0;       // from the baseline fitted on all data
+  double sigmas = 0;            // |residual| / the robust spread of its output
+};
+
 struct GapResult {
-  std::string holdout;         // the scheme used
-  std::string holdout_reason;  // why (default choice) or "given"
+  std::vector<GapOutlier> outliers;  // removed before everything below
+  std::string holdout;               // the scheme used
+  std::string holdout_reason;        // why (default choice) or "given"
   std::size_t observations = 0, parameters = 0, rank = 0;
   std::array<std::size_t, kObservationKinds> count{};
   NoiseFloor noise;
@@ -141,7 +154,8 @@ struct GapResult {
   std::string verdict_reason;          // one sentence: why this verdict
   std::array<double, kObservationKinds> final_rms{};  // held-out after the accepted effects
   double final_rms_um = 0, final_excess_um = 0, final_p_value = 1;
-  // Held-out residuals for plots: per observation (NaN when never held out).
+  // Held-out residuals for plots: per observation of the data given (NaN when never held out,
+  // and for outliers).
   std::vector<double> residual_before, residual_after;
 };
 
