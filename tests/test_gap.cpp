@@ -639,3 +639,31 @@ TEST_CASE("gap: no significant held-out gap, no effect named") {
     }
   }
 }
+
+TEST_CASE("gap: a heat-up drift with a lag of 0.18 x the run is found under cycle folds") {
+  // 432 rows 60 s apart: the run spans 25,860 s; the lag is 0.18 of it (4,655 s = 1.29 h). The
+  // temperature column is dropped: the heat-up in time is what is tested (a sensor lagged behind
+  // the synthetic spindle temperature can mimic it).
+  const double span = 431 * 60.0, tau = 0.18 * span;
+  std::string csv = synth(41, [tau](const Row& w) {
+    return std::array<double, 3>{4 * (1 - std::exp(-w.t_s / tau)), 0,
+                                 -3 * (1 - std::exp(-w.t_s / tau))};
+  });
+  std::istringstream in(csv);
+  std::ostringstream out;
+  for (std::string line; std::getline(in, line);) {
+    std::vector<std::string> f;
+    std::stringstream ls(line);
+    for (std::string cell; std::getline(ls, cell, ',');) f.push_back(cell);
+    f.erase(f.begin() + 6);  // T_spindle
+    for (std::size_t k = 0; k < f.size(); ++k) out << (k ? "," : "") << f[k];
+    out << "\n";
+  }
+  const GapResult r = diagnose(out.str());
+  CHECK(r.verdict == "thermal_drift");
+  const EffectFit* e = effect(r, "thermal_drift");
+  REQUIRE(e);
+  INFO("variant: " << e->variant << ", summary: " << e->summary);
+  REQUIRE(e->params.count("tau_h"));
+  CHECK(e->params.at("tau_h") == doctest::Approx(tau / 3600).epsilon(0.1));
+}

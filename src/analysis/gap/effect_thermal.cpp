@@ -27,13 +27,19 @@ void add_thermal(const EffectContext& ctx, std::vector<Candidate>& out) {
   c.name = "thermal_drift";
   // hyper: [kind, tau_s or sensor index]; kind 0 = linear in time, 1 = lag in time,
   // 2 = temperature (offset), 3 = temperature × coordinate along the output (scale).
+  // Lags are scanned over the whole range on a fine log grid (ratio 1.5) before the best is
+  // refined between its neighbours: with cycle folds the training error over the lag has
+  // several minima, and a coarse grid refined by golden section can settle in the wrong one.
+  const double ratio = 1.5;
+  std::vector<double> lags;  // fractions of the run
+  for (double f = 0.01; f <= 2.0 * ratio; f *= ratio) lags.push_back(f);
   if (time) {
     c.variants.push_back({"linear in time", {0, 0}});
-    for (double f : {0.03, 0.1, 0.3, 1.0})
+    for (double f : lags)
       c.variants.push_back({"heat-up lag",
                             {1, (t1 - t0) * f},
                             false,
-                            {{1, (t1 - t0) * f / 3.2, (t1 - t0) * f * 3.2}}});
+                            {{1, (t1 - t0) * f / ratio, (t1 - t0) * f * ratio}}});
   }
   std::vector<std::string> sensors;
   for (const auto& [name, v] : d.temperature) sensors.push_back(name);
@@ -52,11 +58,12 @@ void add_thermal(const EffectContext& ctx, std::vector<Candidate>& out) {
           (target < 0 ? "" : std::string(" on ") + output_name(static_cast<std::size_t>(target)));
       c.variants.push_back({head, {2, static_cast<double>(j), 0, target}});
       if (time)
-        for (double f : {0.03, 0.1, 0.3})
-          c.variants.push_back({head + " lagged",
-                                {2, static_cast<double>(j), (t1 - t0) * f, target},
-                                false,
-                                {{2, (t1 - t0) * f / 3.2, (t1 - t0) * f * 3.2}}});
+        for (double f : lags)
+          if (f <= 0.5)
+            c.variants.push_back({head + " lagged",
+                                  {2, static_cast<double>(j), (t1 - t0) * f, target},
+                                  false,
+                                  {{2, (t1 - t0) * f / ratio, (t1 - t0) * f * ratio}}});
     }
   auto mean_of = [&d](const std::vector<double>& v) {
     double sum = 0;
