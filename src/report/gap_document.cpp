@@ -21,6 +21,10 @@ std::string f3(double v) { return std::isfinite(v) ? format_short(v) : "-"; }
 json region_json(const GapRegion& g) {
   return {{"by", g.by},
           {"output", g.output},
+          {"unit", g.unit},
+          {"same_as", g.same_as},
+          {"explained", json_number(g.explained)},
+          {"source", g.source},
           {"from", json_number(g.from)},
           {"to", json_number(g.to)},
           {"n", g.n},
@@ -175,9 +179,17 @@ std::string gap_text(const GapResult& r, const Model& model, const std::string& 
     if (!g.significant || shown == 12) break;
     ++shown;
     os << (markdown ? "- " : "  ") << g.output;
-    if (g.by != "output") os << " over " << g.by << " " << f3(g.from) << " .. " << f3(g.to);
-    os << ": RMS " << f3(g.rms_um) << ", excess " << f3(g.excess_um) << " over the floor (n " << g.n
-       << ", p " << f3(g.p_value) << ")\n";
+    if (g.by != "output") {
+      os << " along " << g.by;
+      for (const std::string& s : g.same_as) os << " (= " << s << ")";
+      os << " " << f3(g.from) << " .. " << f3(g.to) << (g.unit.empty() ? "" : " " + g.unit);
+    }
+    os << ": RMS " << f3(g.rms_um) << ", excess " << f3(g.excess_um) << " over the floor (n "
+       << g.n;
+    if (g.by != "output" && g.source == "residual")
+      os << "; the dimension explains " << f3(100 * g.explained) << " % of the residual";
+    if (g.source == "effect") os << "; where the accepted effect acts";
+    os << ", p " << f3(g.p_value) << ")\n";
   }
   if (!shown) os << (markdown ? "- " : "  ") << "no region above the noise floor\n";
   os << "\n" << h2 << "Which effect\n\n";

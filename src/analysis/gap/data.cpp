@@ -67,6 +67,7 @@ GapData gap_data(const MeasurementTable& table, const Description& desc,
   for (int b : desc.axes()) {
     const std::string& c = desc.bodies[static_cast<std::size_t>(b)].joint.coordinate;
     g.axes.push_back(c);
+    g.axis_units.push_back(desc.bodies[static_cast<std::size_t>(b)].joint.unit);
     if (trace || t.has(c)) continue;
     const auto it = fixed.find(c);
     if (it == fixed.end())

@@ -558,6 +558,19 @@ GapResult GapDiagnosis::run(const Model& model, const ErrorParameterisation& par
   const double explained =
       excess_ss > 0 ? explained_ss / excess_ss : (base.ss > 0 ? explained_ss / base.ss : 0);
   decide_verdict(R, options_, data.axes, gap_significant, explained, accepted_shape);
+  // The accepted effects' own regions lead the list: where the named cause acts.
+  std::vector<GapRegion> own;
+  for (const EffectFit& f : R.explanation) {
+    if (!f.region) continue;
+    GapRegion g = *f.region;
+    g.source = "effect";
+    g.p_value = f.p_value;
+    g.significant = f.significant;
+    for (std::size_t a = 0; a < data.axes.size() && a < data.axis_units.size(); ++a)
+      if (data.axes[a] == g.by) g.unit = data.axis_units[a];
+    own.push_back(g);
+  }
+  R.where.insert(R.where.begin(), own.begin(), own.end());
   return R;
 }
 

@@ -1,149 +1,176 @@
+// Where the held-out residual concentrates (docs/gap.md, "Where"). Every dimension of every
+// output gets a one-way analysis of variance over up to 8 bins of equal count: the F test of the
+// between-bin against the within-bin variation says whether the dimension structures the
+// residual at all, and the between-bin share how much of it. Ranking by that share (not by the
+// size of the worst bin) puts the cause first: a bump along Y is "Y", not "the largest bin of
+// dir_Y"; a drift spread over all data is "t_s", not whichever cycle is largest.
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
+#include <map>
 #include <numeric>
-#include <optional>
-#include <set>
-#include <stdexcept>
 
 #include "internal.hpp"
-#include "weilgen/base/format.hpp"
-#include "weilgen/base/text.hpp"
 
 namespace weilgen::gap_detail {
+
+namespace {
+
+struct Dim {
+  std::string by, unit;
+  std::vector<double> value;  // per observation
+  bool ordered = true;
+  std::vector<std::string> same_as;
+};
+
+}  // namespace
 
 std::vector<GapRegion> localise(const GapData& d, const VectorXd& r, const VectorXd& h,
                                 const NoiseFloor& nf, double alpha) {
   const auto& obs = d.points.observations;
   const double s2 = nf.sigma_um * nf.sigma_um;
-  struct Dim {
-    std::string by;
-    std::vector<double> value;  // per observation
-    bool ordered = true;
-  };
   std::vector<Dim> dims;
-  for (std::size_t a = 0; a < d.axes.size(); ++a) {
-    Dim dm{d.axes[a], {}, true};
-    for (const auto& o : obs) dm.value.push_back(d.points.poses[o.row][a]);
-    if (distinct(dm.value) >= 2) dims.push_back(dm);
-  }
-  auto add = [&](const std::string& name, const std::vector<double>& per_row, bool ordered) {
-    Dim dm{name, {}, ordered};
-    for (const auto& o : obs) dm.value.push_back(per_row[o.row]);
-    if (distinct(dm.value) >= 2) dims.push_back(dm);
+  auto add = [&](const std::string& name, const std::string& unit, std::vector<double> value,
+                 bool ordered) {
+    if (distinct(value) < 2) return;
+    // The very same values as a dimension already taken (dir_X = dir_Y in a diagonal run):
+    // reported once.
+    for (Dim& other : dims)
+      if (other.value == value) {
+        other.same_as.push_back(name);
+        return;
+      }
+    dims.push_back({name, unit, std::move(value), ordered, {}});
   };
-  add("t_s", d.time_s, true);
-  for (const auto& [a, v] : d.dir) add("dir_" + a, v, false);
-  add("cycle", d.cycle, false);
-  for (const auto& [n, v] : d.temperature) add(n, v, true);
-  for (const auto& [n, v] : d.covariate) add(n, v, true);
+  for (std::size_t a = 0; a < d.axes.size(); ++a) {
+    std::vector<double> v;
+    for (const auto& o : obs) v.push_back(d.points.poses[o.row][a]);
+    add(d.axes[a], a < d.axis_units.size() ? d.axis_units[a] : "", std::move(v), true);
+  }
+  auto per_obs = [&](const std::vector<double>& per_row) {
+    std::vector<double> v;
+    for (const auto& o : obs) v.push_back(per_row[o.row]);
+    return v;
+  };
+  add("t_s", "s", per_obs(d.time_s), true);
+  for (const auto& [a, v] : d.dir) add("dir_" + a, "", per_obs(v), false);
+  add("cycle", "", per_obs(d.cycle), false);
+  for (const auto& [n, v] : d.temperature) add(n, "°C", per_obs(v), true);
+  for (const auto& [n, v] : d.covariate) add(n, n == "rpm" ? "1/min" : "", per_obs(v), true);
 
-  std::vector<GapRegion> bins;
-  auto stats = [&](GapRegion& g, const std::vector<std::size_t>& idx) {
+  auto bin_stats = [&](GapRegion& g, const std::vector<std::size_t>& idx) {
     Gap gp;
-    double ss = 0;
     for (std::size_t i : idx) {
       const double ri = r[static_cast<Index>(i)];
       if (!std::isfinite(ri)) continue;
       gp.ss += ri * ri;
       gp.expected += s2 * (1 + h[static_cast<Index>(i)]);
-      ss += ri * ri;
       ++gp.n;
     }
     g.n = gp.n;
-    g.rms_um = gp.n ? std::sqrt(ss / static_cast<double>(gp.n)) : 0;
-    gap_stats(gp, nf.dof, g.excess_um, g.p_value);
+    g.rms_um = gp.n ? std::sqrt(gp.ss / static_cast<double>(gp.n)) : 0;
+    double p = 1;
+    gap_stats(gp, nf.dof, g.excess_um, p);
+    return p;
   };
+  std::vector<GapRegion> outputs, regions;
   for (int o = 0; o < static_cast<int>(kObservationKinds); ++o) {
     std::vector<std::size_t> idx;
     for (std::size_t i = 0; i < obs.size(); ++i)
-      if (obs[i].output == o) idx.push_back(i);
+      if (obs[i].output == o && std::isfinite(r[static_cast<Index>(i)])) idx.push_back(i);
     if (idx.empty()) continue;
-    GapRegion g;
-    g.by = "output";
-    g.output = observation_name(static_cast<std::size_t>(o));
-    stats(g, idx);
-    bins.push_back(g);
+    GapRegion whole;
+    whole.by = "output";
+    whole.output = observation_name(static_cast<std::size_t>(o));
+    whole.p_value = bin_stats(whole, idx);
+    outputs.push_back(whole);
     for (const Dim& dm : dims) {
-      // Up to 8 bins of (nearly) equal count over the sorted distinct values.
-      std::vector<double> vals;
-      for (std::size_t i : idx) vals.push_back(dm.value[i]);
-      std::vector<double> u = vals;
+      std::vector<double> u;
+      for (std::size_t i : idx) u.push_back(dm.value[i]);
       std::sort(u.begin(), u.end());
       u.erase(std::unique(u.begin(), u.end()), u.end());
+      if (u.size() < 2) continue;
       const std::size_t nb = std::min<std::size_t>(8, u.size());
       std::vector<std::vector<std::size_t>> members(nb);
       std::vector<std::pair<double, double>> range(nb, {INFINITY, -INFINITY});
-      for (std::size_t k = 0; k < idx.size(); ++k) {
+      for (std::size_t i : idx) {
         const auto l =
-            static_cast<std::size_t>(std::lower_bound(u.begin(), u.end(), vals[k]) - u.begin());
+            static_cast<std::size_t>(std::lower_bound(u.begin(), u.end(), dm.value[i]) - u.begin());
         const std::size_t b = l * nb / u.size();
-        members[b].push_back(idx[k]);
-        range[b].first = std::min(range[b].first, vals[k]);
-        range[b].second = std::max(range[b].second, vals[k]);
+        members[b].push_back(i);
+        range[b].first = std::min(range[b].first, dm.value[i]);
+        range[b].second = std::max(range[b].second, dm.value[i]);
       }
+      // One-way analysis of variance of the residual over the bins.
+      double mean = 0;
+      for (std::size_t i : idx) mean += r[static_cast<Index>(i)];
+      mean /= static_cast<double>(idx.size());
+      double ssb = 0, ssw = 0;
+      std::size_t k = 0;
+      std::vector<double> rms(nb, 0.0);
       for (std::size_t b = 0; b < nb; ++b) {
-        GapRegion reg;
-        reg.by = dm.by;
-        reg.output = observation_name(static_cast<std::size_t>(o));
-        reg.from = range[b].first;
-        reg.to = range[b].second;
-        stats(reg, members[b]);
-        bins.push_back(reg);
+        if (members[b].empty()) continue;
+        ++k;
+        double m = 0, ss = 0;
+        for (std::size_t i : members[b]) m += r[static_cast<Index>(i)];
+        m /= static_cast<double>(members[b].size());
+        for (std::size_t i : members[b]) {
+          const double ri = r[static_cast<Index>(i)];
+          ssw += (ri - m) * (ri - m);
+          ss += ri * ri;
+        }
+        ssb += static_cast<double>(members[b].size()) * (m - mean) * (m - mean);
+        rms[b] = std::sqrt(ss / static_cast<double>(members[b].size()));
       }
+      const double n = static_cast<double>(idx.size());
+      if (k < 2 || n <= static_cast<double>(k)) continue;
+      const double f = ssw > 0 ? (ssb / static_cast<double>(k - 1)) / (ssw / (n - double(k)))
+                               : (ssb > 0 ? INFINITY : 0);
+      // The worst bin, widened over ordered neighbours nearly as bad.
+      std::size_t worst = 0;
+      for (std::size_t b = 1; b < nb; ++b)
+        if (rms[b] > rms[worst]) worst = b;
+      std::size_t lo = worst, hi = worst;
+      while (dm.ordered && lo > 0 && rms[lo - 1] >= 0.7 * rms[worst]) --lo;
+      while (dm.ordered && hi + 1 < nb && rms[hi + 1] >= 0.7 * rms[worst]) ++hi;
+      std::vector<std::size_t> in;
+      for (std::size_t b = lo; b <= hi; ++b)
+        in.insert(in.end(), members[b].begin(), members[b].end());
+      GapRegion g;
+      g.by = dm.by;
+      g.unit = dm.unit;
+      g.same_as = dm.same_as;
+      g.output = observation_name(static_cast<std::size_t>(o));
+      g.from = range[lo].first;
+      g.to = range[hi].second;
+      bin_stats(g, in);
+      g.p_value = f_sf(f, static_cast<double>(k - 1), n - static_cast<double>(k));
+      g.explained = (ssb + ssw) > 0 ? ssb / (ssb + ssw) : 0;
+      regions.push_back(g);
     }
   }
-  const double tests = static_cast<double>(bins.size());
-  for (GapRegion& g : bins) {
-    g.p_value = std::min(1.0, g.p_value * tests);  // Bonferroni over every bin tested
-    g.significant = g.p_value < alpha;
-  }
-  // Merge runs of adjacent significant bins of one ordered dimension and output into regions.
-  std::map<std::string, std::size_t> first_of, end_of;
-  for (std::size_t i = 0; i < bins.size(); ++i) {
-    const std::string key = bins[i].by + "/" + bins[i].output;
-    if (!first_of.count(key)) first_of[key] = i;
-    end_of[key] = i + 1;
-  }
-  std::vector<GapRegion> out;
-  for (std::size_t i = 0; i < bins.size();) {
-    GapRegion g = bins[i];
-    std::size_t j = i + 1;
-    const bool ordered =
-        g.by != "output" && std::any_of(dims.begin(), dims.end(),
-                                        [&](const Dim& dm) { return dm.by == g.by && dm.ordered; });
-    while (ordered && g.significant && j < bins.size() && bins[j].significant &&
-           bins[j].by == g.by && bins[j].output == g.output) {
-      const double w1 = static_cast<double>(g.n), w2 = static_cast<double>(bins[j].n);
-      g.rms_um =
-          std::sqrt((g.rms_um * g.rms_um * w1 + bins[j].rms_um * bins[j].rms_um * w2) / (w1 + w2));
-      g.excess_um =
-          std::sqrt((g.excess_um * g.excess_um * w1 + bins[j].excess_um * bins[j].excess_um * w2) /
-                    (w1 + w2));
-      g.p_value = std::min(g.p_value, bins[j].p_value);
-      g.to = bins[j].to;
-      g.n += bins[j].n;
-      ++j;
+  // Bonferroni over every test: the outputs' gap tests and every dimension's F test.
+  const double tests = static_cast<double>(outputs.size() + regions.size());
+  for (auto* list : {&outputs, &regions})
+    for (GapRegion& g : *list) {
+      g.p_value = std::min(1.0, g.p_value * tests);
+      g.significant = g.p_value < alpha;
     }
-    // A region spanning its whole dimension says no more than the output's own entry.
-    const bool whole = g.by != "output" && i == first_of[g.by + "/" + g.output] &&
-                       j == end_of[g.by + "/" + g.output] && j - i > 1;
-    if (!whole) out.push_back(g);
-    i = j;
-  }
-  // A region holding every held-out residual of its output repeats the output's entry.
-  std::map<std::string, std::size_t> per_output_n;
-  for (const GapRegion& g : out)
-    if (g.by == "output") per_output_n[g.output] = g.n;
-  out.erase(std::remove_if(out.begin(), out.end(),
-                           [&](const GapRegion& g) {
-                             return g.by != "output" && g.n == per_output_n[g.output];
-                           }),
-            out.end());
-  std::stable_sort(out.begin(), out.end(), [](const GapRegion& a, const GapRegion& b) {
+  // Dimensions that structure the residual first, by how much of it they explain; then the
+  // outputs' own entries; then the rest.
+  std::stable_sort(regions.begin(), regions.end(), [](const GapRegion& a, const GapRegion& b) {
+    if (a.significant != b.significant) return a.significant;
+    return a.explained > b.explained;
+  });
+  std::stable_sort(outputs.begin(), outputs.end(), [](const GapRegion& a, const GapRegion& b) {
     if (a.significant != b.significant) return a.significant;
     return a.excess_um > b.excess_um;
   });
+  std::vector<GapRegion> out;
+  for (const GapRegion& g : regions)
+    if (g.significant) out.push_back(g);
+  out.insert(out.end(), outputs.begin(), outputs.end());
+  for (const GapRegion& g : regions)
+    if (!g.significant) out.push_back(g);
   return out;
 }
 

@@ -28,6 +28,7 @@ namespace weilgen {
 struct GapData {
   PointData points;                                // poses per row, observations
   std::vector<std::string> axes;                   // coordinate names (Description::axes())
+  std::vector<std::string> axis_units;             // each coordinate's unit (mm, deg)
   std::vector<double> time_s;                      // per row; NaN when absent
   std::vector<double> cycle;                       // per row; NaN when absent
   std::map<std::string, std::vector<double>> dir;  // axis -> ±1 per row (dir or dir_<axis>)
@@ -91,13 +92,23 @@ struct NoiseFloor {
   std::string detail;  // "412 successive differences of repeated poses"
 };
 
+// Where the held-out residual concentrates: a whole output (by "output"), or the worst region
+// of one dimension (a coordinate, t_s, a direction, cycle, a temperature, a covariate) of one
+// output. A dimension's p-value is the F test of its bins (between-bin against within-bin
+// variance of the held-out residual, Bonferroni over every dimension and output tested) and
+// `explained` the share of the residual's variation its bins explain: dimensions are ranked by
+// it; the region is the dimension's worst bin, widened over neighbours nearly as bad.
 struct GapRegion {
   std::string by;           // "output", a coordinate, "t_s", "dir_X", "cycle", "T_3", "rpm"
-  std::string output;       // dx ... dc
-  double from = 0, to = 0;  // the region's range in the unit of `by` (output: 0..0)
+  std::string output;       // dx ... dc, dr
+  std::string unit;         // of from/to: the coordinate's (mm, deg), s, °C, 1/min; "" else
+  std::vector<std::string> same_as;  // dimensions with the very same bins (dir_Y = dir_X ...)
+  double from = 0, to = 0;  // the region's range in `unit` (output: 0..0)
   std::size_t n = 0;
   double rms_um = 0, excess_um = 0, p_value = 1;
+  double explained = 0;  // between-bin share of the residual's sum of squares (dimensions)
   bool significant = false;
+  std::string source = "residual";  // "residual", or "effect": an accepted effect's own region
 };
 
 struct EffectFit {
