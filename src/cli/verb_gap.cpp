@@ -27,6 +27,7 @@ int verb_gap(const Args& args) {
   std::string data, holdout = "auto", json_path, report_path, plot_dir;
   std::vector<std::string> effects, pdge, at;
   double alpha = 0.01;
+  unsigned threads = 0;
   opts.add_options()("help,h", "show this help")("data", po::value<std::string>(&data),
                                                  "measurement CSV (docs/data-format.md)")(
       "holdout", po::value<std::string>(&holdout)->default_value(holdout),
@@ -46,6 +47,8 @@ int verb_gap(const Args& args) {
       "plot", po::value<std::string>(&plot_dir),
       "draw residual-versus-coordinate and effect-ranking plots into DIR (PNG)")(
       "allow-unknown", "warn about unknown columns instead of failing")(
+      "threads", po::value<unsigned>(&threads)->default_value(0),
+      "worker threads (0 = all cores; the result is the same for any count)")(
       "quiet,q", po::bool_switch(&flags.quiet), "no model messages on stderr");
   BallbarFlags circle;
   opts.add(ballbar_circle_options(circle));
@@ -60,6 +63,7 @@ int verb_gap(const Args& args) {
   for (const std::string& e : effects)
     for (const std::string& n : split(e, ',')) go.effects.push_back(trim(n));
   go.alpha = alpha;
+  go.threads = threads;
   try {
     go.validate();
   } catch (const std::invalid_argument& e) {

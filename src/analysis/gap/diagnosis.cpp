@@ -9,6 +9,7 @@
 #include "effects.hpp"
 #include "internal.hpp"
 #include "weilgen/base/format.hpp"
+#include "weilgen/base/parallel.hpp"
 #include "weilgen/base/text.hpp"
 #include "weilgen/uq/lsq.hpp"
 
@@ -83,7 +84,7 @@ MatrixXd theta_columns(const gap_detail::Candidate& c, const gap_detail::Variant
 
 Evaluated evaluate(const gap_detail::Candidate& c, const Engine& e, std::size_t np,
                    const VectorXd& base_r, const VectorXd& base_h, double s2, double alpha,
-                   double n_candidates) {
+                   double n_candidates, unsigned threads) {
   Evaluated best;
   double best_train = INFINITY;
   // Training SSE over the splits and the held-out residual of one variant; false when the
@@ -115,15 +116,23 @@ Evaluated evaluate(const gap_detail::Candidate& c, const Engine& e, std::size_t 
     return true;
   };
   MatrixXd best_shared;
-  for (const gap_detail::Variant& v : c.variants) {
-    double train_sse = 0;
-    VectorXd after;
-    MatrixXd shared;
-    if (!score(v, train_sse, after, shared) || !(train_sse < best_train)) continue;
-    best_train = train_sse;
-    best.variant = v;
-    best.heldout = after;
-    best_shared = shared;
+  // The grid of variants on every core; the choice is made in variant order, so it is the same
+  // for any number of threads.
+  const std::size_t nv = c.variants.size();
+  std::vector<double> variant_sse(nv, INFINITY);
+  std::vector<VectorXd> afters(nv);
+  std::vector<MatrixXd> shareds(nv);
+  std::vector<char> usable(nv, 0);
+  parallel_blocks(nv, 1, threads, [&](std::size_t, std::size_t b, std::size_t end, unsigned) {
+    for (std::size_t k = b; k < end; ++k)
+      usable[k] = score(c.variants[k], variant_sse[k], afters[k], shareds[k]) ? 1 : 0;
+  });
+  for (std::size_t k = 0; k < nv; ++k) {
+    if (!usable[k] || !(variant_sse[k] < best_train)) continue;
+    best_train = variant_sse[k];
+    best.variant = c.variants[k];
+    best.heldout = std::move(afters[k]);
+    best_shared = std::move(shareds[k]);
   }
   // Continuous hyper-parameters (a period, a lag, a bump's centre and width) are refined between
   // their grid neighbours by golden section on the training SSE, one after the other, twice; the
@@ -500,8 +509,8 @@ GapResult GapDiagnosis::run(const Model& model, const ErrorParameterisation& par
     std::vector<Evaluated> ev;
     for (std::size_t k = 0; k < candidates.size(); ++k) {
       if (used[k]) continue;
-      Evaluated x =
-          evaluate(candidates[k], e, param_.size(), cur_r, cur_h, s2, options_.alpha, n_candidates);
+      Evaluated x = evaluate(candidates[k], e, param_.size(), cur_r, cur_h, s2, options_.alpha,
+                             n_candidates, options_.threads);
       if (!std::isfinite(x.heldout_sse)) continue;
       candidates[k].describe(x.variant, x.coef, x.fit);
       check_shape(x.variant, x.fit);
@@ -564,6 +573,7 @@ GapResult GapDiagnosis::run(const Model& model, const ErrorParameterisation& par
     if (!f.region) continue;
     GapRegion g = *f.region;
     g.source = "effect";
+    if (data.circle) g.output = "dr";  // a trace's observations are dr
     g.p_value = f.p_value;
     g.significant = f.significant;
     for (std::size_t a = 0; a < data.axes.size() && a < data.axis_units.size(); ++a)

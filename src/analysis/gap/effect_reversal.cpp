@@ -38,6 +38,12 @@ void add_reversal(const EffectContext& ctx, std::vector<Candidate>& out) {
                   unit_of(outs[big]) + " on " + axis + " (" +
                   per_output_text(outs, coef, 1, "", fit, "reversal") + ")";
     fit.params["axis_" + axis] = 1;
+    GapRegion r;
+    r.by = "dir_" + axis;
+    r.output = output_name(static_cast<std::size_t>(outs[big]));
+    r.from = -1;
+    r.to = 1;
+    fit.region = r;
   };
   out.push_back(std::move(c));
 }

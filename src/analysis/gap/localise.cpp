@@ -144,7 +144,13 @@ std::vector<GapRegion> localise(const GapData& d, const VectorXd& r, const Vecto
       g.to = range[hi].second;
       bin_stats(g, in);
       g.p_value = f_sf(f, static_cast<double>(k - 1), n - static_cast<double>(k));
-      g.explained = (ssb + ssw) > 0 ? ssb / (ssb + ssw) : 0;
+      // omega^2: the between-bin share less what k bins would explain by chance, so a
+      // dimension of 8 bins does not outrank a direction (2 bins) by its bin count alone.
+      const double msw = ssw / (n - static_cast<double>(k));
+      g.explained =
+          (ssb + ssw) > 0
+              ? std::max(0.0, (ssb - static_cast<double>(k - 1) * msw) / (ssb + ssw + msw))
+              : 0;
       regions.push_back(g);
     }
   }

@@ -176,6 +176,7 @@ struct GapOptions {
   double explain_fraction = 0.9;     // named effects must remove this much of the excess
   int max_effects = 3;
   std::map<std::string, double> fixed;  // coordinates not in the data
+  unsigned threads = 0;                 // 0 = every core; results identical for any count
   // alpha in (0, 0.5), explain_fraction in (0, 1], max_effects >= 1, every effect a library
   // name (std::invalid_argument naming the flag).
   void validate() const;
