@@ -1,5 +1,5 @@
-// Gap diagnosis (weilgen/analysis/gap.hpp): each effect's fit on a small synthetic set, the false-positive
-// rate on effect-free data, the held-out splits and bad data.
+// Gap diagnosis (weilgen/analysis/gap.hpp): each effect's fit on a small synthetic set, the
+// false-positive rate on effect-free data, the held-out splits and bad data.
 #include <doctest/doctest.h>
 
 #include <filesystem>
@@ -142,7 +142,7 @@ TEST_CASE("gap: reversal on X is named, with its size") {
   CHECK(r.verdict == "reversal");
   const EffectFit* e = effect(r, "reversal");
   REQUIRE(e);
-  CHECK(e->params.at("reversal_dx") == doctest::Approx(4.0).epsilon(0.1));
+  CHECK(std::abs(e->params.at("reversal_um")) == doctest::Approx(4.0).epsilon(0.1));
   CHECK(e->heldout_rms_after_um < 1.2 * r.noise.sigma_um);
   CHECK(r.noise.sigma_um == doctest::Approx(0.5).epsilon(0.15));
 }
@@ -332,7 +332,7 @@ TEST_CASE("gap CLI: JSON schema, report, and bad flags or data") {
                           "shrink_pct", "significant", "p_value"})
     CHECK(j["effects"][0].contains(key));
   CHECK(j["effects"][0]["name"] == "reversal");
-  CHECK(j["effects"][0]["params"]["reversal_dx"].get<double>() ==
+  CHECK(std::abs(j["effects"][0]["params"]["reversal_um"].get<double>()) ==
         doctest::Approx(3.0).epsilon(0.1));
   CHECK(j["where"][0]["output"] == "dx");
   CHECK(std::filesystem::exists(md));
@@ -490,7 +490,7 @@ TEST_CASE("gap: ballbar traces are dr observations; reversal on X is read from t
   CHECK(res.verdict == "reversal");
   const EffectFit* e = effect(res, "reversal");
   REQUIRE(e);
-  CHECK(std::abs(e->params.at("reversal_dx")) == doctest::Approx(5.0).epsilon(0.1));
+  CHECK(std::abs(e->params.at("reversal_um")) == doctest::Approx(5.0).epsilon(0.1));
   CHECK(res.final_rms[kRadialOutput] < 1.2 * 0.4);
 }
 
@@ -568,7 +568,6 @@ TEST_CASE("gap: a cosine error of the measuring set-up along X is setup, with it
   CHECK(e->params.at("quadratic_um_per_m2") == doctest::Approx(20).epsilon(0.1));
 }
 
-
 namespace {
 
 // Adds `size_um` to the dx cell of `rows` data rows (1-based after the header) of a CSV.
@@ -612,7 +611,7 @@ TEST_CASE("gap: five gross readings are reported and removed; the reversal is st
   CHECK(r.verdict == "reversal");
   const EffectFit* e = effect(r, "reversal");
   REQUIRE(e);
-  CHECK(e->params.at("reversal_dx") == doctest::Approx(4.0).epsilon(0.1));
+  CHECK(std::abs(e->params.at("reversal_um")) == doctest::Approx(4.0).epsilon(0.1));
   CHECK(std::isnan(r.residual_before[static_cast<std::size_t>(r.outliers[0].observation)]));
 }
 
@@ -666,4 +665,58 @@ TEST_CASE("gap: a heat-up drift with a lag of 0.18 x the run is found under cycl
   INFO("variant: " << e->variant << ", summary: " << e->summary);
   REQUIRE(e->params.count("tau_h"));
   CHECK(e->params.at("tau_h") == doctest::Approx(tau / 3600).epsilon(0.1));
+}
+
+TEST_CASE(
+    "gap: on a rotary table, a reversal of C is named through the kinematics, with its size") {
+  // five_axis_ac: an R-test-like layout (the tool over points off the table's centre, A and C
+  // turning), C approached alternately from both sides with 20 µrad of lost motion. The
+  // deviation reaches dx and dy rotated by C: a constant per output cannot describe it.
+  const auto model = test::builtin_model("five_axis_ac");
+  const Description& desc = model->description();
+  NumericChain chain(desc);
+  std::mt19937 rng(3);
+  std::normal_distribution<double> n01(0, 1);
+  std::vector<double> errors(desc.errors.size());
+  for (std::size_t i = 0; i < errors.size(); ++i)
+    errors[i] = desc.errors[i].distribution.b * desc.errors[i].to_base * n01(rng);
+  std::vector<std::string> names;
+  for (int b : desc.axes())
+    names.push_back(desc.bodies[static_cast<std::size_t>(b)].joint.coordinate);
+  const double B_urad = 20, B_deg = B_urad * 1e-6 * 180 / 3.14159265358979323846;
+  std::ostringstream csv;
+  for (const std::string& a : names) csv << a << ",";
+  csv << "dir_C,cycle,t_s,dx_um,dy_um,dz_um\n";
+  double t = 0;
+  for (int cy = 1; cy <= 3; ++cy)
+    for (double A : {-30.0, 0.0, 30.0})
+      for (double xy : {60.0, 120.0})
+        for (int k = 0; k < 16; ++k) {
+          const bool up = k < 8;
+          const double C = 45.0 * (up ? k : 15 - k);
+          const double dir = up ? 1 : -1;
+          std::vector<double> q;
+          for (const std::string& a : names)
+            q.push_back(a == "X" ? xy : a == "Y" ? -xy / 2 : a == "Z" ? -150 : a == "A" ? A : C);
+          std::vector<double> actual = q;
+          for (std::size_t a = 0; a < names.size(); ++a)
+            if (names[a] == "C") actual[a] -= dir * B_deg / 2;
+          const Eigen::Matrix4d real = chain.tool_in_workpiece(actual, errors);
+          const Eigen::Matrix4d nominal =
+              chain.tool_in_workpiece(q, std::vector<double>(errors.size(), 0.0));
+          for (double v : q) csv << v << ",";
+          csv << dir << "," << cy << "," << t;
+          for (int o = 0; o < 3; ++o)
+            csv << "," << 1000 * (real(o, 3) - nominal(o, 3)) + 0.3 * n01(rng);
+          csv << "\n";
+          t += 30;
+        }
+  const GapResult r = diagnose(csv.str(), model, "cycle:3", poly2());
+  CHECK(r.verdict == "reversal");
+  const EffectFit* e = effect(r, "reversal");
+  REQUIRE(e);
+  CHECK(e->summary.find("reversal of C") != std::string::npos);
+  CHECK(std::abs(e->params.at("reversal_urad")) == doctest::Approx(B_urad).epsilon(0.1));
+  REQUIRE_FALSE(r.where.empty());
+  CHECK(r.where.front().by == "dir_C");
 }

@@ -1,46 +1,90 @@
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <numeric>
-#include <optional>
-#include <set>
-#include <stdexcept>
+#include <memory>
 
 #include "effects.hpp"
 #include "weilgen/base/text.hpp"
-#include "weilgen/machine/iso_names.hpp"
 
 namespace weilgen::gap_detail {
 
 // ---- reversal ------------------------------------------------------------------------------
+// Backlash of one axis: the axis stops short by half its lost motion B in the direction of
+// approach, q_actual = q - dir B/2, and that reaches the outputs through the kinematic chain
+// (the nominal Jacobian at the pose): on a turning table a reversal of C moves dx and dy by the
+// table's radius times B/2, whatever C is. One parameter per axis: B, in µm for a linear axis
+// and µrad for a rotary one.
 
 void add_reversal(const EffectContext& ctx, std::vector<Candidate>& out) {
   const GapData& d = *ctx.data;
-  if (d.dir.empty()) return;
-  const std::vector<int> outs = outputs_of(d);
+  if (d.dir.empty() || !ctx.chain) return;
   Candidate c;
   c.name = "reversal";
   std::vector<std::string> axes;
+  std::vector<std::size_t> index;  // into GapData::axes
   for (const auto& [axis, v] : d.dir) {
+    const auto it = std::find(d.axes.begin(), d.axes.end(), axis);
+    if (it == d.axes.end()) continue;  // a direction of something that is not an axis
     axes.push_back(axis);
+    index.push_back(static_cast<std::size_t>(it - d.axes.begin()));
     c.variants.push_back({axis, {static_cast<double>(axes.size() - 1)}});
   }
-  c.columns = [&d, outs, axes](const Variant& v, const std::vector<double>&) {
-    const std::vector<double>& dir = d.dir.at(axes[static_cast<std::size_t>(v.hyper[0])]);
-    return per_output(d, outs, [&](std::size_t r) { return dir[r] / 2; });  // ±B/2
+  if (axes.empty()) return;
+  const auto jacobians = std::make_shared<std::vector<MatrixXd>>(axis_jacobians(ctx));
+  // Per unit of B (µm or µrad) of each axis: its unit's size in mm or rad.
+  std::vector<double> per_unit;
+  for (std::size_t k = 0; k < axes.size(); ++k) {
+    const std::string& u = index[k] < d.axis_units.size() ? d.axis_units[index[k]] : "mm";
+    const bool rotary = u == "deg" || u == "rad";
+    // B in µm (linear, axis in mm) or µrad (rotary): the axis moves by B in its own unit.
+    per_unit.push_back(rotary ? (u == "deg" ? 1e-6 * 180 / 3.14159265358979323846 : 1e-6)
+                              : (u == "um"  ? 1.0
+                                 : u == "m" ? 1e-6
+                                            : 1e-3));
+  }
+  // The measured output each axis moves most (the region's output).
+  std::vector<std::string> moved;
+  for (std::size_t k = 0; k < axes.size(); ++k) {
+    std::array<double, kObservationKinds> size{};
+    for (const auto& ob : d.points.observations) {
+      const MatrixXd& J = (*jacobians)[ob.row];
+      if (J.size() == 0) continue;
+      for (int o = 0; o < kNumDeviationOutputs; ++o)
+        size[static_cast<std::size_t>(ob.output)] +=
+            std::abs(observation_weight(ob, o) * kMeasuredScale[static_cast<std::size_t>(o)] *
+                     J(o, static_cast<Index>(index[k])));
+    }
+    moved.push_back(observation_name(
+        static_cast<std::size_t>(std::max_element(size.begin(), size.end()) - size.begin())));
+  }
+  c.columns = [&d, jacobians, index, axes, per_unit](const Variant& v, const std::vector<double>&) {
+    const auto k = static_cast<std::size_t>(v.hyper[0]);
+    const std::vector<double>& dir = d.dir.at(axes[k]);
+    const auto& obs = d.points.observations;
+    MatrixXd E = MatrixXd::Zero(static_cast<Index>(obs.size()), 1);
+    for (std::size_t i = 0; i < obs.size(); ++i) {
+      const MatrixXd& J = (*jacobians)[obs[i].row];
+      if (J.size() == 0) continue;
+      double s = 0;
+      for (int o = 0; o < kNumDeviationOutputs; ++o)
+        s += observation_weight(obs[i], o) * kMeasuredScale[static_cast<std::size_t>(o)] *
+             J(o, static_cast<Index>(index[k]));
+      // q_actual = q - dir B/2.
+      E(static_cast<Index>(i), 0) = -dir[obs[i].row] / 2 * per_unit[k] * s;
+    }
+    return E;
   };
-  c.describe = [outs, axes](const Variant& v, const VectorXd& coef, EffectFit& fit) {
-    const std::string& axis = axes[static_cast<std::size_t>(v.hyper[0])];
-    std::size_t big = 0;
-    for (std::size_t k = 1; k < outs.size(); ++k)
-      if (std::abs(coef[static_cast<Index>(k)]) > std::abs(coef[static_cast<Index>(big)])) big = k;
-    fit.summary = "reversal " + num(std::abs(coef[static_cast<Index>(big)]), 2) + " " +
-                  unit_of(outs[big]) + " on " + axis + " (" +
-                  per_output_text(outs, coef, 1, "", fit, "reversal") + ")";
+  c.describe = [&d, axes, index, moved](const Variant& v, const VectorXd& coef, EffectFit& fit) {
+    const auto k = static_cast<std::size_t>(v.hyper[0]);
+    const std::string& axis = axes[k];
+    const std::string u = index[k] < d.axis_units.size() ? d.axis_units[index[k]] : "mm";
+    const bool rotary = u == "deg" || u == "rad";
+    const double b = coef.size() ? coef[0] : 0;
+    fit.summary = "reversal of " + axis + ": " + num(std::abs(b), 2) + (rotary ? " µrad" : " µm");
+    fit.params[rotary ? "reversal_urad" : "reversal_um"] = b;
     fit.params["axis_" + axis] = 1;
     GapRegion r;
     r.by = "dir_" + axis;
-    r.output = output_name(static_cast<std::size_t>(outs[big]));
+    r.output = moved[k];
     r.from = -1;
     r.to = 1;
     fit.region = r;

@@ -188,4 +188,10 @@ inline std::vector<double> first_order_lag(const GapData& d, const std::vector<d
   return f;
 }
 
+// The nominal Jacobian of the outputs with respect to every axis at each table row, from the
+// exact chain by central differences: [row] -> 6 x axes, in mm (or rad) per unit of the axis
+// (mm, deg). An effect of an axis (its backlash, its scale) reaches the outputs through it, the
+// rotation of a turning table included.
+std::vector<Eigen::MatrixXd> axis_jacobians(const EffectContext& ctx);
+
 }  // namespace weilgen::gap_detail
