@@ -720,3 +720,49 @@ TEST_CASE(
   REQUIRE_FALSE(r.where.empty());
   CHECK(r.where.front().by == "dir_C");
 }
+
+TEST_CASE("gap: on a tilting table, a spindle drift fixed in the machine frame is thermal_drift") {
+  // five_axis_ac: the tool point drifts 8 µm along the machine's z with a heat-up lag; the
+  // workpiece frame turns with A and C, so in dx dy dz the drift is R(A, C)^T (0, 0, 8) µm.
+  const auto model = test::builtin_model("five_axis_ac");
+  const Description& desc = model->description();
+  NumericChain chain(desc);
+  std::mt19937 rng(5);
+  std::normal_distribution<double> n01(0, 1);
+  std::vector<double> errors(desc.errors.size());
+  for (std::size_t i = 0; i < errors.size(); ++i)
+    errors[i] = desc.errors[i].distribution.b * desc.errors[i].to_base * n01(rng);
+  std::vector<std::string> names;
+  for (int b : desc.axes())
+    names.push_back(desc.bodies[static_cast<std::size_t>(b)].joint.coordinate);
+  std::ostringstream csv;
+  for (const std::string& a : names) csv << a << ",";
+  csv << "cycle,t_s,dx_um,dy_um,dz_um\n";
+  const double tau = 5000;
+  double t = 0;
+  for (int cy = 1; cy <= 3; ++cy)
+    for (double A : {-60.0, -20.0, 20.0, 60.0})
+      for (double C : {0.0, 60.0, 120.0, 180.0, 240.0, 300.0}) {
+        std::vector<double> q;
+        for (const std::string& a : names)
+          q.push_back(a == "X" ? 50 : a == "Y" ? -40 : a == "Z" ? -150 : a == "A" ? A : C);
+        const Eigen::Matrix3d r = chain.workpiece_in_base(q).block<3, 3>(0, 0);
+        const Eigen::Vector3d drift =
+            r.transpose() * Eigen::Vector3d(0, 0, 8 * (1 - std::exp(-t / tau)));
+        const Eigen::Vector3d dev(chain.deviation(q, errors)[0], chain.deviation(q, errors)[1],
+                                  chain.deviation(q, errors)[2]);
+        for (double v : q) csv << v << ",";
+        csv << cy << "," << t;
+        for (int o = 0; o < 3; ++o) csv << "," << 1000 * dev[o] + drift[o] + 0.2 * n01(rng);
+        csv << "\n";
+        t += 200;
+      }
+  const GapResult r = diagnose(csv.str(), model, "cycle:3", poly2());
+  CHECK(r.verdict == "thermal_drift");
+  const EffectFit* e = effect(r, "thermal_drift");
+  REQUIRE(e);
+  INFO(e->summary);
+  REQUIRE(e->params.count("machine_z_um"));
+  CHECK(std::abs(e->params.at("machine_z_um")) == doctest::Approx(8).epsilon(0.15));
+  CHECK(std::abs(e->params.at("machine_x_um")) < 1);
+}

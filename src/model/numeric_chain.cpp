@@ -157,6 +157,22 @@ Eigen::Matrix4d NumericChain::tool_in_workpiece(const std::vector<double>& axes,
          branch(desc_.tool, q_body, errors);
 }
 
+Eigen::Matrix4d NumericChain::workpiece_in_base(const std::vector<double>& axes) const {
+  if (axes.size() != axis_bodies_.size())
+    throw std::invalid_argument("expected " + std::to_string(axis_bodies_.size()) + " axis values");
+  if (desc_.output) return Eigen::Matrix4d::Identity();
+  std::vector<double> q_body(desc_.bodies.size(), 0.0);
+  for (std::size_t k = 0; k < axis_bodies_.size(); ++k)
+    q_body[static_cast<std::size_t>(axis_bodies_[k])] = axes[k];
+  if (!linked_bodies_.empty()) {
+    const std::map<std::string, double> values = coordinate_values(axes);
+    for (int b : linked_bodies_)
+      q_body[static_cast<std::size_t>(b)] =
+          values.at(desc_.bodies[static_cast<std::size_t>(b)].joint.coordinate);
+  }
+  return branch(desc_.workpiece, q_body, std::vector<double>(desc_.errors.size(), 0.0));
+}
+
 std::array<double, 6> NumericChain::deviation(const std::vector<double>& axes,
                                               const std::vector<double>& errors) const {
   const Eigen::Matrix4d actual = tool_in_workpiece(axes, errors);

@@ -139,3 +139,106 @@ void add_thermal(const EffectContext& ctx, std::vector<Candidate>& out) {
 }
 
 }  // namespace weilgen::gap_detail
+
+namespace weilgen::gap_detail {
+
+// ---- thermal_drift in the machine frame ----------------------------------------------------
+// The spindle, column and headstock grow in the machine's frame; a table that turns (A, C)
+// shows that growth to the workpiece rotated by its own orientation. Offered when the
+// workpiece frame turns over the data: a drift vector fixed in the machine frame (3 parameters)
+// following time (linear or a heat-up lag) or a sensor (as read or lagged), seen through
+// R_workpiece(q)^T.
+void add_thermal_machine_frame(const EffectContext& ctx, std::vector<Candidate>& out) {
+  const GapData& d = *ctx.data;
+  if (!ctx.chain) return;
+  auto rt = std::make_shared<std::vector<Eigen::Matrix3d>>(d.points.poses.size(),
+                                                           Eigen::Matrix3d::Identity());
+  bool turns = false;
+  std::vector<char> needed(d.points.poses.size(), 0);
+  for (const auto& o : d.points.observations) needed[o.row] = 1;
+  const Eigen::Matrix3d* first = nullptr;
+  for (std::size_t r = 0; r < rt->size(); ++r) {
+    if (!needed[r] || d.points.poses[r].size() != d.axes.size()) continue;
+    (*rt)[r] = ctx.chain->workpiece_in_base(d.points.poses[r]).block<3, 3>(0, 0).transpose();
+    if (!first) first = &(*rt)[r];
+    turns = turns || ((*rt)[r] - *first).norm() > 1e-9;
+  }
+  if (!turns) return;
+  double t0 = INFINITY, t1 = -INFINITY;
+  for (const auto& o : d.points.observations)
+    if (std::isfinite(d.time_s[o.row]))
+      t0 = std::min(t0, d.time_s[o.row]), t1 = std::max(t1, d.time_s[o.row]);
+  const bool time = t1 > t0;
+  std::vector<std::string> sensors;
+  for (const auto& [name, v] : d.temperature) sensors.push_back(name);
+  if (!time && sensors.empty()) return;
+  Candidate c;
+  c.name = "thermal_drift";
+  // hyper: [kind, tau_s, sensor]; kind 0 = linear in time, 1 = heat-up lag, 2 = sensor (lag
+  // tau_s, 0 = as read).
+  const double ratio = 1.5;
+  if (time) {
+    c.variants.push_back({"linear in time (machine frame)", {0, 0, -1}});
+    for (double f = 0.01; f <= 2.0 * ratio; f *= ratio)
+      c.variants.push_back({"heat-up lag (machine frame)",
+                            {1, (t1 - t0) * f, -1},
+                            false,
+                            {{1, (t1 - t0) * f / ratio, (t1 - t0) * f * ratio}}});
+  }
+  for (std::size_t j = 0; j < sensors.size(); ++j) {
+    c.variants.push_back(
+        {"temperature " + sensors[j] + " (machine frame)", {2, 0, static_cast<double>(j)}});
+    if (time)
+      for (double f = 0.01; f <= 0.5; f *= ratio)
+        c.variants.push_back({"temperature " + sensors[j] + " lagged (machine frame)",
+                              {2, (t1 - t0) * f, static_cast<double>(j)},
+                              false,
+                              {{1, (t1 - t0) * f / ratio, (t1 - t0) * f * ratio}}});
+  }
+  c.columns = [&d, rt, t0, sensors](const Variant& v, const std::vector<double>&) {
+    const int kind = static_cast<int>(v.hyper[0]);
+    std::vector<double> signal(d.time_s.size(), 0.0);
+    if (kind == 0) {
+      for (std::size_t r = 0; r < signal.size(); ++r) signal[r] = (d.time_s[r] - t0) / 3600.0;
+    } else if (kind == 1) {
+      for (std::size_t r = 0; r < signal.size(); ++r)
+        signal[r] = 1 - std::exp(-(d.time_s[r] - t0) / v.hyper[1]);
+    } else {
+      signal = first_order_lag(d, d.temperature.at(sensors[static_cast<std::size_t>(v.hyper[2])]),
+                               v.hyper[1]);
+      double mean = 0;
+      for (const auto& o : d.points.observations) mean += signal[o.row];
+      mean /= static_cast<double>(std::max<std::size_t>(1, d.points.observations.size()));
+      for (double& s : signal) s -= mean;
+    }
+    const auto& obs = d.points.observations;
+    MatrixXd E = MatrixXd::Zero(static_cast<Index>(obs.size()), 3);
+    for (std::size_t i = 0; i < obs.size(); ++i)
+      for (int o = 0; o < 3; ++o) {
+        const double w = observation_weight(obs[i], o);
+        if (w == 0) continue;
+        for (int k = 0; k < 3; ++k)  // µm of drift along machine axis k
+          E(static_cast<Index>(i), k) += w * (*rt)[obs[i].row](o, k) * signal[obs[i].row];
+      }
+    return E;
+  };
+  c.describe = [sensors](const Variant& v, const VectorXd& coef, EffectFit& fit) {
+    const int kind = static_cast<int>(v.hyper[0]);
+    std::string what = kind == 0 ? "drift per h" : kind == 1 ? "heat-up drift" : "per K";
+    if (kind == 1) fit.params["tau_h"] = v.hyper[1] / 3600;
+    if (kind == 2) {
+      fit.params["sensor_" + sensors[static_cast<std::size_t>(v.hyper[2])]] = 1;
+      fit.params["lag_h"] = v.hyper[1] / 3600;
+    }
+    std::string s;
+    for (int k = 0; k < 3 && k < coef.size(); ++k) {
+      const std::string axis(1, static_cast<char>('x' + k));
+      fit.params["machine_" + axis + "_um"] = coef[k];
+      s += (k ? ", " : "") + axis + " " + num(coef[k], 2) + " µm";
+    }
+    fit.summary = "thermal in the machine frame (" + v.label + "), " + what + ": " + s;
+  };
+  out.push_back(std::move(c));
+}
+
+}  // namespace weilgen::gap_detail

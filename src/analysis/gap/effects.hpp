@@ -75,6 +75,7 @@ std::vector<Candidate> effect_candidates(const EffectContext& ctx,
 // One family of the library each (effect_*.cpp): appends its candidate, if the data allow it.
 void add_thermal(const EffectContext& ctx, std::vector<Candidate>& out);
 void add_thermal_sensors(const EffectContext& ctx, std::vector<Candidate>& out);
+void add_thermal_machine_frame(const EffectContext& ctx, std::vector<Candidate>& out);
 void add_reversal(const EffectContext& ctx, std::vector<Candidate>& out);
 void add_periodic(const EffectContext& ctx, std::vector<Candidate>& out);
 void add_pdge_shape(const EffectContext& ctx, std::vector<Candidate>& out);

@@ -28,6 +28,11 @@ class NumericChain {
   Eigen::Matrix4d tool_in_workpiece(const std::vector<double>& axes,
                                     const std::vector<double>& errors) const;
 
+  // The workpiece frame in the base (machine) frame at zero errors; the identity for a machine
+  // with an `output` transform (its outputs are in the base frame). What the workpiece frame's
+  // outputs see of a displacement fixed in the machine: R^T times it.
+  Eigen::Matrix4d workpiece_in_base(const std::vector<double>& axes) const;
+
   // (dx, dy, dz) in mm and the rotation vector (da, db, dc) in rad of the actual tool pose
   // relative to the nominal one, both in the workpiece frame (machines/README.md, "Outputs").
   std::array<double, 6> deviation(const std::vector<double>& axes,
