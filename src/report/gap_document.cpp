@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <iomanip>
+#include <set>
 #include <sstream>
 
 #include "weilgen/base/format.hpp"
@@ -119,9 +120,15 @@ nlohmann::json gap_json(const GapResult& r, const Model& model, const std::strin
 namespace {
 
 std::string not_distinguishable(const EffectFit& e) {
-  return " (uses " + std::to_string(e.shape_dof_used) + " of the " +
-         std::to_string(e.shape_dof_free) +
-         " shape degrees of freedom the data leave: any shape fits)";
+  return " (needs " + std::to_string(e.shape_dof_used) + " shape degrees of freedom where the " +
+         "data leave " + std::to_string(e.shape_dof_free) + ": any shape fits)";
+}
+
+// What a candidate's row says: its fit when significant; a rejected candidate's parameters
+// are whatever least squares made of noise (a tool offset of -2.6e5 mm) and are not shown.
+std::string candidate_text(const EffectFit& e) {
+  if (!e.significant) return "not significant";
+  return e.summary + (e.distinguishable ? "" : not_distinguishable(e));
 }
 
 }  // namespace
@@ -198,16 +205,14 @@ std::string gap_text(const GapResult& r, const Model& model, const std::string& 
           "significant |\n|---|---|---|---|---|---|\n";
   for (const EffectFit& e : r.effects) {
     if (markdown)
-      os << "| " << e.name << " | " << e.summary
-         << (e.distinguishable ? "" : not_distinguishable(e)) << " | "
-         << f3(e.heldout_rms_before_um) << " → " << f3(e.heldout_rms_after_um) << " | "
-         << f3(e.shrink_pct) << " % | " << f3(e.p_value) << " | " << (e.significant ? "yes" : "no")
-         << " |\n";
+      os << "| " << e.name << " | " << candidate_text(e) << " | " << f3(e.heldout_rms_before_um)
+         << " → " << f3(e.heldout_rms_after_um) << " | " << f3(e.shrink_pct) << " % | "
+         << f3(e.p_value) << " | " << (e.significant ? "yes" : "no") << " |\n";
     else
       os << "  " << std::left << std::setw(14) << e.name << std::right << std::setw(8)
          << f3(e.heldout_rms_after_um) << " µm (" << std::setw(6) << f3(e.shrink_pct) << " %)  p "
-         << std::setw(8) << f3(e.p_value) << (e.significant ? "  *  " : "     ") << e.summary
-         << (e.distinguishable ? "" : not_distinguishable(e)) << "\n";
+         << std::setw(8) << f3(e.p_value) << (e.significant ? "  *  " : "     ")
+         << candidate_text(e) << "\n";
   }
   os << "\n" << h2 << "How far it shrinks\n\n";
   os << "held-out RMS " << f3(r.baseline_rms_um) << " → " << f3(r.final_rms_um) << " µm ("
@@ -223,6 +228,9 @@ LinePlot residual_plot(const GapData& d, const GapResult& r, const std::string& 
   LinePlot p;
   p.title = "held-out residual RMS along " + by;
   p.xlabel = by;
+  for (std::size_t a = 0; a < d.axes.size() && a < d.axis_units.size(); ++a)
+    if (d.axes[a] == by) p.xlabel = by + " (" + d.axis_units[a] + ")";
+  if (by == "t_s") p.xlabel = "t (s)";
   p.ylabel = "RMS (µm)";
   const auto& obs = d.points.observations;
   std::vector<std::pair<double, std::size_t>> key;
@@ -263,7 +271,9 @@ LinePlot residual_plot(const GapData& d, const GapResult& r, const std::string& 
     before.push_back(std::sqrt(sb / n));
     after.push_back(std::sqrt(sa / n));
   }
-  p.lines = {{"baseline", before}, {"with the explanation", after}};
+  p.lines = {{"baseline", before},
+             {"with the explanation", after},
+             {"noise floor", std::vector<double>(before.size(), r.noise.sigma_um)}};
   return p;
 }
 
@@ -281,10 +291,15 @@ std::vector<GapPlot> gap_plots(const GapData& gd, const GapResult& r) {
       bys.push_back(by);
   };
   for (const EffectFit& e : r.explanation)  // where the named effects act
-    if (e.region) add(e.region->by, 4);
+    if (e.region) add(e.region->by, 100);
+  // Every coordinate that varies, in its unit (deg for a rotary axis); never one that does not.
+  for (std::size_t a = 0; a < gd.axes.size(); ++a) {
+    std::set<double> v;
+    for (const auto& o : gd.points.observations) v.insert(gd.points.poses[o.row][a]);
+    if (v.size() > 1) add(gd.axes[a], 100);
+  }
   for (const GapRegion& g : r.where)
-    if (g.significant) add(g.by, 3);
-  if (bys.empty()) bys.push_back(gd.axes[0]);
+    if (g.significant) add(g.by, 100);
   for (const std::string& by : bys)
     out.push_back({"residual_" + by, "held-out residual along " + by, {residual_plot(gd, r, by)}});
   BarChart bc;
