@@ -156,6 +156,97 @@ inline constexpr std::array<ParamInfo, kNumParams> kParams = {{
 inline constexpr std::array<const char*, kNumOutputs> kOutputs = {{"dx", "dy", "dz", "da", "db", "dc"}};
 inline constexpr std::array<const char*, kNumOutputs> kOutputUnits = {{"mm", "mm", "mm", "rad", "rad", "rad"}};
 
+// Named indices into the axes, errors and params arrays (kAxes, kErrors, kParams order),
+// e.g. axes[axis::X], errors[error::E_A0Z454].
+namespace axis {
+inline constexpr std::size_t X = 0;
+inline constexpr std::size_t A12 = 1;
+inline constexpr std::size_t Y231 = 2;
+inline constexpr std::size_t A04 = 3;
+inline constexpr std::size_t Y451 = 4;
+inline constexpr std::size_t Z453 = 5;
+}  // namespace axis
+namespace error {
+inline constexpr std::size_t E_XX = 0;
+inline constexpr std::size_t E_YX = 1;
+inline constexpr std::size_t E_ZX = 2;
+inline constexpr std::size_t E_AX = 3;
+inline constexpr std::size_t E_BX = 4;
+inline constexpr std::size_t E_CX = 5;
+inline constexpr std::size_t E_XA12 = 6;
+inline constexpr std::size_t E_YA12 = 7;
+inline constexpr std::size_t E_ZA12 = 8;
+inline constexpr std::size_t E_AA12 = 9;
+inline constexpr std::size_t E_BA12 = 10;
+inline constexpr std::size_t E_CA12 = 11;
+inline constexpr std::size_t E_B0A12 = 12;
+inline constexpr std::size_t E_C0A12 = 13;
+inline constexpr std::size_t E_XY231 = 14;
+inline constexpr std::size_t E_YY231 = 15;
+inline constexpr std::size_t E_ZY231 = 16;
+inline constexpr std::size_t E_AY231 = 17;
+inline constexpr std::size_t E_BY231 = 18;
+inline constexpr std::size_t E_CY231 = 19;
+inline constexpr std::size_t E_C0Y231 = 20;
+inline constexpr std::size_t E_A0Y231 = 21;
+inline constexpr std::size_t E_XY232 = 22;
+inline constexpr std::size_t E_YY232 = 23;
+inline constexpr std::size_t E_ZY232 = 24;
+inline constexpr std::size_t E_AY232 = 25;
+inline constexpr std::size_t E_BY232 = 26;
+inline constexpr std::size_t E_CY232 = 27;
+inline constexpr std::size_t E_C0Y232 = 28;
+inline constexpr std::size_t E_A0Y232 = 29;
+inline constexpr std::size_t E_XA04 = 30;
+inline constexpr std::size_t E_YA04 = 31;
+inline constexpr std::size_t E_ZA04 = 32;
+inline constexpr std::size_t E_AA04 = 33;
+inline constexpr std::size_t E_BA04 = 34;
+inline constexpr std::size_t E_CA04 = 35;
+inline constexpr std::size_t E_B0A04 = 36;
+inline constexpr std::size_t E_C0A04 = 37;
+inline constexpr std::size_t E_XY451 = 38;
+inline constexpr std::size_t E_YY451 = 39;
+inline constexpr std::size_t E_ZY451 = 40;
+inline constexpr std::size_t E_AY451 = 41;
+inline constexpr std::size_t E_BY451 = 42;
+inline constexpr std::size_t E_CY451 = 43;
+inline constexpr std::size_t E_C0Y451 = 44;
+inline constexpr std::size_t E_A0Y451 = 45;
+inline constexpr std::size_t E_XY452 = 46;
+inline constexpr std::size_t E_YY452 = 47;
+inline constexpr std::size_t E_ZY452 = 48;
+inline constexpr std::size_t E_AY452 = 49;
+inline constexpr std::size_t E_BY452 = 50;
+inline constexpr std::size_t E_CY452 = 51;
+inline constexpr std::size_t E_C0Y452 = 52;
+inline constexpr std::size_t E_A0Y452 = 53;
+inline constexpr std::size_t E_XZ453 = 54;
+inline constexpr std::size_t E_YZ453 = 55;
+inline constexpr std::size_t E_ZZ453 = 56;
+inline constexpr std::size_t E_AZ453 = 57;
+inline constexpr std::size_t E_BZ453 = 58;
+inline constexpr std::size_t E_CZ453 = 59;
+inline constexpr std::size_t E_B0Z453 = 60;
+inline constexpr std::size_t E_A0Z453 = 61;
+inline constexpr std::size_t E_XZ454 = 62;
+inline constexpr std::size_t E_YZ454 = 63;
+inline constexpr std::size_t E_ZZ454 = 64;
+inline constexpr std::size_t E_AZ454 = 65;
+inline constexpr std::size_t E_BZ454 = 66;
+inline constexpr std::size_t E_CZ454 = 67;
+inline constexpr std::size_t E_B0Z454 = 68;
+inline constexpr std::size_t E_A0Z454 = 69;
+}  // namespace error
+namespace param {
+inline constexpr std::size_t L01 = 0;
+inline constexpr std::size_t L23 = 1;
+inline constexpr std::size_t L04 = 2;
+inline constexpr std::size_t L45 = 3;
+inline constexpr std::size_t LW = 4;
+inline constexpr std::size_t jaw_reach = 5;
+}  // namespace param
+
 // Monomials of degree >= 2 with a non-zero coefficient: error indices, padded with -1.
 inline constexpr std::array<std::array<int, 1>, kNumHigherTerms> kHigherTerms = {{
 }};

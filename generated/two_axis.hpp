@@ -89,6 +89,30 @@ inline constexpr std::array<ParamInfo, kNumParams> kParams = {{
 inline constexpr std::array<const char*, kNumOutputs> kOutputs = {{"dx", "dy", "dz", "da", "db", "dc"}};
 inline constexpr std::array<const char*, kNumOutputs> kOutputUnits = {{"mm", "mm", "mm", "rad", "rad", "rad"}};
 
+// Named indices into the axes, errors and params arrays (kAxes, kErrors, kParams order),
+// e.g. axes[axis::Y], errors[error::E_CA].
+namespace axis {
+inline constexpr std::size_t Y = 0;
+inline constexpr std::size_t A = 1;
+}  // namespace axis
+namespace error {
+inline constexpr std::size_t E_XY = 0;
+inline constexpr std::size_t E_YY = 1;
+inline constexpr std::size_t E_ZY = 2;
+inline constexpr std::size_t E_AY = 3;
+inline constexpr std::size_t E_BY = 4;
+inline constexpr std::size_t E_CY = 5;
+inline constexpr std::size_t E_XA = 6;
+inline constexpr std::size_t E_YA = 7;
+inline constexpr std::size_t E_ZA = 8;
+inline constexpr std::size_t E_AA = 9;
+inline constexpr std::size_t E_BA = 10;
+inline constexpr std::size_t E_CA = 11;
+}  // namespace error
+namespace param {
+inline constexpr std::size_t tool_length = 0;
+}  // namespace param
+
 // Monomials of degree >= 2 with a non-zero coefficient: error indices, padded with -1.
 inline constexpr std::array<std::array<int, 1>, kNumHigherTerms> kHigherTerms = {{
 }};

@@ -17,7 +17,7 @@ const std::map<std::string, Verb>& verbs() {
   static const std::map<std::string, Verb> v = {
       {"generate",
        {weilgen::cli::verb_generate,
-        "generate <machine>... [--order r] [--out DIR] [--check]\n"
+        "generate <machine>... [--order r] [--out DIR] [--check] [--c-api]\n"
         "      multiply the error HTMs over the Weil algebra and write the C++ header\n"
         "      and the closed-form report (generated/<machine>.hpp, .md)"}},
 #ifndef WEILGEN_CODEGEN_ONLY
