@@ -58,6 +58,10 @@ const std::map<std::string, Verb>& verbs() {
        {weilgen::cli::verb_gap,
         "gap <machine> --data FILE [--holdout ...] [--effects ...] [--json F] [--report F.md]\n"
         "      where model and machine disagree, which unmodelled effect, how far it shrinks"}},
+      {"linuxcnc",
+       {weilgen::cli::verb_linuxcnc,
+        "linuxcnc <machine> --out DIR [--params P] [--name NAME]\n"
+        "      a LinuxCNC HAL component compensating the machine's errors in the servo thread"}},
 #endif
   };
   return v;
