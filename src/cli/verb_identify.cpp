@@ -3,6 +3,7 @@
 // write the parameters as a controller header. docs/identify.md.
 #include <iostream>
 
+#include "comp_table.hpp"
 #include "study.hpp"
 #include "verbs.hpp"
 #include "weilgen/analysis/identify.hpp"
@@ -54,6 +55,8 @@ int verb_identify(const Args& args) {
       "quiet,q", po::bool_switch(&flags.quiet), "no model messages on stderr");
   opts.add(ballbar_circle_options(circle));
   opts.add(model_options(flags));
+  CompTableFlags comp;
+  opts.add(comp_table_options(comp, true));
   po::variables_map vm;
   if (auto stop = parse_args<std::string>("identify", args, opts, "machine", 1, vm)) return *stop;
   if (!vm.count("machine")) return usage_error("identify", "no machine given");
@@ -63,8 +66,12 @@ int verb_identify(const Args& args) {
   if (!predict_out.empty() && predict.empty())
     return usage_error("identify", "--predict-out needs a --predict file");
   flags.machine = vm["machine"].as<std::string>();
+  std::vector<std::string> inputs = data;
+  inputs.insert(inputs.end(), predict.begin(), predict.end());
+  check_comp_table_flags(comp, vm, inputs, true);
 
   const Description desc = load_machine_file(resolve_machine(flags.machine));
+  if (!comp.path.empty()) check_axis_comp_table(desc, comp.options);
   const PdgeBasisChoice choice = parse_pdge_flags(desc, pdge);
   const std::shared_ptr<Model> model = open_model(flags, desc);
   const ErrorParameterisation param(model->description(), choice, model->parameters());
@@ -76,6 +83,8 @@ int verb_identify(const Args& args) {
   io.rank_tolerance = rank_tol;
   io.fixed = fixed;
   const IdentifyResult r = Identification(io).run(*model, param, points);
+  const CompTable comp_table =
+      comp.path.empty() ? CompTable{} : axis_comp_table(*model, param, r.theta, comp.options);
   std::cout << identify_text(*model, param, r, points);
 
   nlohmann::json j = identify_json(*model, param, r, data);
@@ -102,6 +111,7 @@ int verb_identify(const Args& args) {
     std::cout << "\nwrote " << emit << "\n";
   }
   if (!json_path.empty()) write_file_atomically(json_path, j.dump(2) + "\n");
+  if (!comp.path.empty()) std::cout << "\n" << write_comp_table(comp, comp_table);
   return 0;
 }
 

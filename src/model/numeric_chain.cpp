@@ -185,4 +185,24 @@ std::array<double, 6> NumericChain::deviation(const std::vector<double>& axes,
   return {dp[0], dp[1], dp[2], w[0], w[1], w[2]};
 }
 
+Eigen::Matrix<double, 6, Eigen::Dynamic> NumericChain::nominal_jacobian(
+    const std::vector<double>& axes) const {
+  const std::vector<double> zero(desc_.errors.size(), 0.0);
+  const double h = 1e-3;
+  Eigen::Matrix<double, 6, Eigen::Dynamic> j(6, static_cast<Eigen::Index>(axes.size()));
+  for (std::size_t a = 0; a < axes.size(); ++a) {
+    std::vector<double> up = axes, down = axes;
+    up[a] += h;
+    down[a] -= h;
+    const Eigen::Matrix4d tu = tool_in_workpiece(up, zero);
+    const Eigen::Matrix4d td = tool_in_workpiece(down, zero);
+    const Eigen::Matrix3d r = tu.block<3, 3>(0, 0) * td.block<3, 3>(0, 0).transpose();
+    const auto col = static_cast<Eigen::Index>(a);
+    j.block<3, 1>(0, col) = (tu.block<3, 1>(0, 3) - td.block<3, 1>(0, 3)) / (2 * h);
+    j.block<3, 1>(3, col) =
+        0.5 * Eigen::Vector3d(r(2, 1) - r(1, 2), r(0, 2) - r(2, 0), r(1, 0) - r(0, 1)) / (2 * h);
+  }
+  return j;
+}
+
 }  // namespace weilgen
