@@ -200,7 +200,9 @@ struct Description {
   std::vector<Derived> derived;           // in evaluation (file) order
   std::optional<OutputTransform> output;  // replaces W⁻¹·T when present
   std::string pdge_basis;                 // default identification basis of PDGEs ("poly:3")
-  SourceLoc pdge_basis_loc;
+  SourceLoc pdge_basis_loc;               //   of linear axes (prismatic joints)
+  std::string pdge_basis_revolute;        // ... of rotary axes (revolute joints)
+  SourceLoc pdge_basis_revolute_loc;
 
   // Index lookups; -1 when absent.
   int body_index(const std::string& name) const;
