@@ -4,8 +4,8 @@
 //   loader_topology.cpp  bodies, offsets, joints (axis form and twists), links, the body tree
 //   loader_errors.cpp    error components: ISO names, custom errors, aliases, groups
 //   loader_defaults.cpp  error_defaults (per group, per kind) and pdge_basis (per joint type)
-//   loader_chains.cpp    chain points, derived quantities, the output transform, tool,
-//                        workpiece and algebra
+//   loader_chains.cpp    chain points and directions, derived quantities, the output
+//                        transform, tool, workpiece and algebra
 //   yaml_loader.cpp      the public API (weilgen/machine/yaml_loader.hpp) and Loader::load
 #pragma once
 
@@ -46,10 +46,10 @@ inline Unit table_unit(const std::string& name) {
   return {name, f.to_base, f.angle};
 }
 
-const std::vector<std::string> kTopKeys = {"weilgen", "name",       "title",     "notes",
-                                           "algebra", "parameters", "groups",    "error_defaults",
-                                           "bodies",  "tool",       "workpiece", "points",
-                                           "derived", "output",     "pdge_basis"};
+const std::vector<std::string> kTopKeys = {"weilgen", "name",       "title",      "notes",
+                                           "algebra", "parameters", "groups",     "error_defaults",
+                                           "bodies",  "tool",       "workpiece",  "points",
+                                           "derived", "output",     "pdge_basis", "directions"};
 const std::vector<std::string> kBodyKeys = {"parent", "offset", "joint", "errors"};
 const std::vector<std::string> kOffsetKeys = {"translation", "rotation"};
 const std::vector<std::string> kRotationKeys = {"axis", "angle"};
@@ -68,6 +68,7 @@ const std::vector<std::string> kKindDefaultKeys = {"sigma", "normal", "uniform",
                                                    "unit"};
 const std::vector<std::string> kParameterKeys = {"value", "unit", "description"};
 const std::vector<std::string> kPointKeys = {"body", "point"};
+const std::vector<std::string> kDirectionKeys = {"body", "direction"};
 const std::vector<std::string> kAlgebraKeys = {"order", "relations"};
 const std::vector<std::string> kAliasKeys = {"name", "sign"};
 
@@ -258,6 +259,9 @@ class Loader {
 
   void read_points(const Field& f);
 
+  // Nominal body directions (`directions:`), after the bodies.
+  void read_directions(const Field& f);
+
   void read_derived(const Field& f);
 
   OutputTransform read_output(const Field& f) const;
@@ -321,6 +325,9 @@ class Loader {
   // ---- Tool, workpiece, algebra ---------------------------------------------------------------
 
   PointSpec read_point_spec(const Field& f) const;
+
+  // A body named in `body` (points, directions), as its index.
+  int body_ref(const Field& body) const;
 
   void read_algebra(const Field& f);
 

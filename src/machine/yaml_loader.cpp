@@ -47,6 +47,7 @@ Description Loader::load(const YAML::Node& root) {
   if (const Entry* e = top.find("error_defaults")) read_error_defaults(e->value);
   read_bodies(required(top, "bodies"));
   if (const Entry* e = top.find("points")) read_points(e->value);
+  if (const Entry* e = top.find("directions")) read_directions(e->value);
   if (const Entry* e = top.find("derived")) read_derived(e->value);
   if (const Entry* e = top.find("output")) {
     for (const char* key : {"tool", "workpiece"}) {
