@@ -21,7 +21,7 @@ namespace two_axis {
 inline constexpr const char* kMachineName = "two_axis";
 inline constexpr int kOrder = 1;
 // Machine-file text, order and weilgen version: identifies the model (weilgen/machine/model_key.hpp).
-inline constexpr const char* kModelKey = "e228966ee2c2736e";
+inline constexpr const char* kModelKey = "08e8c0af2795f48d";
 inline constexpr std::size_t kNumAxes = 2;
 inline constexpr std::size_t kNumErrors = 12;
 inline constexpr std::size_t kNumParams = 1;

@@ -24,7 +24,8 @@ int verb_identify(const Args& args) {
       "weilgen identify <machine> --data FILE [options]\n\n"
       "Fits the model's error parameters to point measurements (docs/data-format.md): each\n"
       "PIGE a constant, each PDGE a basis in its own axis position (the machine file's\n"
-      "pdge_basis / basis:, else poly:3; --pdge overrides). Linear least squares through the\n"
+      "pdge_basis / basis:, else poly:3 on a linear axis and fourier:2 with a one-turn period\n"
+      "on a rotary one; --pdge overrides). Linear least squares through the\n"
       "generated coefficient matrix (column-equilibrated SVD: minimum-norm solution, rank, the\n"
       "parameter combinations the data cannot identify); Gauss-Newton for order >= 2. Predicts\n"
       "other measurements (points, ballbar circles) and writes the parameters as a standalone\n"
@@ -38,9 +39,9 @@ int verb_identify(const Args& args) {
       "measurement CSV (poses + deviations); repeatable")(
       "pdge", po::value<std::vector<std::string>>(&pdge)->composing(),
       "basis of every PDGE (poly:3, fourier:2, legendre:4, chebyshev:4, fourier:2:20 = period "
-      "20 mm) or of one error (E_YY=fourier:3); repeatable, applied in order")(
-      "fix", po::value<std::vector<std::string>>(&fixed)->composing(),
-      "hold an error at zero (name or alias); repeatable")(
+      "20 mm, or 20 deg on a rotary axis) or of one error (E_YY=fourier:3); repeatable, applied "
+      "in order")("fix", po::value<std::vector<std::string>>(&fixed)->composing(),
+                  "hold an error at zero (name or alias); repeatable")(
       "rank-tol", po::value<double>(&rank_tol)->default_value(rank_tol, "1e-9"),
       "singular values below rank-tol x the largest (equilibrated columns) count as zero")(
       "predict", po::value<std::vector<std::string>>(&predict)->composing(),

@@ -109,6 +109,12 @@ Eigen::Matrix4d NumericChain::output_transform(std::map<std::string, double> val
         (branch(p.at, q_body, errors) - branch(p.at, q_body, none)).block<3, 1>(0, 3);
     for (int i = 0; i < 3; ++i) values[p.name + "." + static_cast<char>('x' + i)] = d[i];
   }
+  for (const ChainDirection& u : desc_.directions) {
+    PointSpec frame;
+    frame.body = u.body;
+    const Eigen::Vector3d r = branch(frame, q_body, none).block<3, 3>(0, 0) * vec(u.direction);
+    for (int i = 0; i < 3; ++i) values[u.name + "." + static_cast<char>('x' + i)] = r[i];
+  }
   for (const Derived& q : desc_.derived) values[q.name] = q.value.eval(values);
   auto vec3 = [&](const std::array<Expr, 3>& e) {
     return Eigen::Vector3d(e[0].eval(values), e[1].eval(values), e[2].eval(values));
