@@ -161,11 +161,10 @@ inline constexpr std::array<const char*, kNumOutputs> kOutputUnits = {{"mm", "mm
 // e.g. axes[axis::X], errors[error::E_A0Z454].
 namespace axis {
 inline constexpr std::size_t X = 0;
-inline constexpr std::size_t A12 = 1;
-inline constexpr std::size_t Y231 = 2;
-inline constexpr std::size_t A04 = 3;
-inline constexpr std::size_t Y451 = 4;
-inline constexpr std::size_t Z453 = 5;
+inline constexpr std::size_t Y231 = 1;
+inline constexpr std::size_t A04 = 2;
+inline constexpr std::size_t Y451 = 3;
+inline constexpr std::size_t Z453 = 4;
 }  // namespace axis
 namespace error {
 inline constexpr std::size_t E_XX = 0;
@@ -246,6 +245,8 @@ inline constexpr std::size_t L04 = 2;
 inline constexpr std::size_t L45 = 3;
 inline constexpr std::size_t LW = 4;
 inline constexpr std::size_t jaw_reach = 5;
+inline constexpr std::size_t grip_feed = 6;
+inline constexpr std::size_t grip_main = 7;
 }  // namespace param
 
 // Monomials of degree >= 2 with a non-zero coefficient: error indices, padded with -1.

@@ -21,7 +21,6 @@ static_assert(PIPE_CUTTER_NUM_PARAMS == model::kNumParams, "params: the C header
 static_assert(PIPE_CUTTER_NUM_OUTPUTS == model::kNumOutputs, "outputs: the C header does not match the model");
 static_assert(PIPE_CUTTER_ORDER == model::kOrder, "order: the C header does not match the model");
 static_assert(PIPE_CUTTER_AXIS_X == model::axis::X, "PIPE_CUTTER_AXIS_X");
-static_assert(PIPE_CUTTER_AXIS_A12 == model::axis::A12, "PIPE_CUTTER_AXIS_A12");
 static_assert(PIPE_CUTTER_AXIS_Y231 == model::axis::Y231, "PIPE_CUTTER_AXIS_Y231");
 static_assert(PIPE_CUTTER_AXIS_A04 == model::axis::A04, "PIPE_CUTTER_AXIS_A04");
 static_assert(PIPE_CUTTER_AXIS_Y451 == model::axis::Y451, "PIPE_CUTTER_AXIS_Y451");
@@ -102,6 +101,8 @@ static_assert(PIPE_CUTTER_PARAM_L04 == model::param::L04, "PIPE_CUTTER_PARAM_L04
 static_assert(PIPE_CUTTER_PARAM_L45 == model::param::L45, "PIPE_CUTTER_PARAM_L45");
 static_assert(PIPE_CUTTER_PARAM_LW == model::param::LW, "PIPE_CUTTER_PARAM_LW");
 static_assert(PIPE_CUTTER_PARAM_JAW_REACH == model::param::jaw_reach, "PIPE_CUTTER_PARAM_JAW_REACH");
+static_assert(PIPE_CUTTER_PARAM_GRIP_FEED == model::param::grip_feed, "PIPE_CUTTER_PARAM_GRIP_FEED");
+static_assert(PIPE_CUTTER_PARAM_GRIP_MAIN == model::param::grip_main, "PIPE_CUTTER_PARAM_GRIP_MAIN");
 
 template <std::size_t N>
 std::array<double, N> load(const double* from) noexcept {

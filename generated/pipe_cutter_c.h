@@ -17,21 +17,20 @@ extern "C" {
 #endif
 
 #define PIPE_CUTTER_MACHINE_NAME "pipe_cutter"
-#define PIPE_CUTTER_MODEL_KEY "1b15a044631652b2"
+#define PIPE_CUTTER_MODEL_KEY "36371f1531f4f117"
 enum {
   PIPE_CUTTER_ORDER = 1,
-  PIPE_CUTTER_NUM_AXES = 6,
+  PIPE_CUTTER_NUM_AXES = 5,
   PIPE_CUTTER_NUM_ERRORS = 70,
-  PIPE_CUTTER_NUM_PARAMS = 6,
+  PIPE_CUTTER_NUM_PARAMS = 8,
   PIPE_CUTTER_NUM_OUTPUTS = 6
 };
 enum pipe_cutter_axis {
   PIPE_CUTTER_AXIS_X = 0, /* mm */
-  PIPE_CUTTER_AXIS_A12 = 1, /* deg */
-  PIPE_CUTTER_AXIS_Y231 = 2, /* mm */
-  PIPE_CUTTER_AXIS_A04 = 3, /* deg */
-  PIPE_CUTTER_AXIS_Y451 = 4, /* mm */
-  PIPE_CUTTER_AXIS_Z453 = 5 /* mm */
+  PIPE_CUTTER_AXIS_Y231 = 1, /* mm */
+  PIPE_CUTTER_AXIS_A04 = 2, /* deg */
+  PIPE_CUTTER_AXIS_Y451 = 3, /* mm */
+  PIPE_CUTTER_AXIS_Z453 = 4 /* mm */
 };
 enum pipe_cutter_error {
   PIPE_CUTTER_ERROR_E_XX = 0, /* mm */
@@ -111,7 +110,9 @@ enum pipe_cutter_param {
   PIPE_CUTTER_PARAM_L04 = 2, /* mm */
   PIPE_CUTTER_PARAM_L45 = 3, /* mm */
   PIPE_CUTTER_PARAM_LW = 4, /* mm */
-  PIPE_CUTTER_PARAM_JAW_REACH = 5 /* mm */
+  PIPE_CUTTER_PARAM_JAW_REACH = 5, /* mm */
+  PIPE_CUTTER_PARAM_GRIP_FEED = 6, /* mm */
+  PIPE_CUTTER_PARAM_GRIP_MAIN = 7 /* mm */
 };
 
 /* What every function returns. */

@@ -17,7 +17,7 @@ extern "C" {
 #endif
 
 #define TWO_AXIS_MACHINE_NAME "two_axis"
-#define TWO_AXIS_MODEL_KEY "e228966ee2c2736e"
+#define TWO_AXIS_MODEL_KEY "08e8c0af2795f48d"
 enum {
   TWO_AXIS_ORDER = 1,
   TWO_AXIS_NUM_AXES = 2,
