@@ -623,7 +623,7 @@ TEST_CASE("iso230-2 CLI: bad input exits 3, bad flags exit 2, and nothing is wri
   unchanged();
   r = run(cli("iso230-2 " + (dir / "missing.csv").string() + " --json " + out));
   CHECK(r.status == 3);
-  CHECK(r.out.find("missing.csv: cannot read file") != std::string::npos);
+  CHECK(r.out.find("missing.csv: cannot read the data file: no such file") != std::string::npos);
   unchanged();
   r = run(cli("iso230-2 " + small_csv() + " --axis Q --json " + out));
   CHECK(r.status == 2);
@@ -631,7 +631,9 @@ TEST_CASE("iso230-2 CLI: bad input exits 3, bad flags exit 2, and nothing is wri
   unchanged();
   r = run(cli("iso230-2 " + small_csv() + " --alpha 1.5 --json " + out));
   CHECK(r.status == 2);
-  CHECK(r.out.rfind("weilgen iso230-2: --alpha must be in (0, 1)", 0) == 0);
+  CHECK(r.out.rfind(
+            "weilgen iso230-2: --alpha: '1.5' is out of range (allowed: a number in (0, 1))", 0) ==
+        0);
   r = run(cli("iso230-2 " + small_csv() + " --reference-cycle 9 --json " + out));
   CHECK(r.status == 2);
   unchanged();
