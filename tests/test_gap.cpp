@@ -316,9 +316,10 @@ TEST_CASE("gap: bad data get a message, not a verdict") {
     } catch (const InputError& e) {
       message = e.what();
     }
-    CHECK(message ==
-          "r.csv:13: column 'C' looks like radians: every value lies within ±2π (0 .. 5.5) while "
-          "C is in deg over [-360, 360] deg; write it in degrees");
+    CHECK(
+        message ==
+        "r.csv:13:13: column 'C' looks like radians: every value lies within ±2π (0 .. 5.5) while "
+        "C is in deg over [-360, 360] deg; write it in degrees");
   }
   CHECK_THROWS_WITH_AS(parse_holdout("weekly"),
                        "--holdout \"weekly\": unknown scheme 'weekly' (expected cycle[:K], "
@@ -450,7 +451,7 @@ std::string ballbar_synth(std::uint32_t seed, const EffectFn& extra, int cycles 
 
 }  // namespace
 
-TEST_CASE("gap: ballbar traces are dr observations; reversal on X is read from them") {
+TEST_CASE("gap: ballbar traces are dr observations, and reversal on X is read from them") {
   const MeasurementTable t = parse_measurements(ballbar_synth(21, none), "bb.csv");
   const GapData d = gap_data(t, vmc()->description());
   REQUIRE(d.circle);
@@ -493,8 +494,10 @@ TEST_CASE("gap: ballbar traces are dr observations; reversal on X is read from t
     return at;
   }();
   no_angle.erase(c4, no_angle.find(',', c4) - c4);
+  const std::string no_angle_message = "bb.csv:7:" + std::to_string(c4 - row7 + 1) +
+                                       ": column 'angle_deg' is empty but dr_um is measured";
   CHECK_THROWS_WITH(gap_data(parse_measurements(no_angle, "bb.csv"), vmc()->description()),
-                    "bb.csv:7: column 'angle_deg' is empty but dr_um is measured");
+                    no_angle_message.c_str());
 
   const MeasurementTable tr = parse_measurements(
       ballbar_synth(22,
@@ -612,7 +615,7 @@ std::string with_gross_readings(const std::string& csv, const std::vector<int>& 
 
 }  // namespace
 
-TEST_CASE("gap: five gross readings are reported and removed; the reversal is still named") {
+TEST_CASE("gap: five gross readings are reported and removed, and the reversal is still named") {
   const std::string clean = synth(1, [](const Row& w) {
     return std::array<double, 3>{2.0 * w.dir_X, 0, 0};  // B = 4 µm in dx
   });

@@ -316,7 +316,7 @@ TEST_CASE("identify: point data name the file and line of bad rows") {
         "p.csv:1: no deviation column (dx_um, dy_um, dz_um, da_urad, db_urad, dc_urad; "
         "columns: X, Y, Z, t_s)");
   CHECK(error_of("X,Y,Z,dx_um\n0,0,0,1\n0,,0,2\n") ==
-        "p.csv:3: column 'Y' is empty but a deviation is measured (every observation needs the "
+        "p.csv:3:3: column 'Y' is empty but a deviation is measured (every observation needs the "
         "machine's coordinates)");
   CHECK(error_of("X,Y,Z,dx_um\n0,0,0,\n") ==
         "p.csv: no observations (no row has a measured deviation)");

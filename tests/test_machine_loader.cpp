@@ -691,7 +691,8 @@ workpiece: {body: bed}
 TEST_CASE("bad: algebra order") {
   const std::string body =
       "weilgen: 1\nname: bad\nbodies: {bed: {}}\ntool: {body: bed}\nworkpiece: {body: bed}\n";
-  expect_error(body + "algebra: {order: 0}\n", "bad.yaml:6:18", {"algebra.order", ">= 1"});
+  expect_error(body + "algebra: {order: 0}\n", "bad.yaml:6:18", {"algebra.order", "from 1 to 20"});
+  expect_error(body + "algebra: {order: 21}\n", "bad.yaml:6:18", {"algebra.order", "from 1 to 20"});
   expect_error(body + "algebra: {order: 1.5}\n", "bad.yaml:6:18",
                {"algebra.order", "whole number"});
   expect_error(body + "algebra: {order: two}\n", "bad.yaml:6:18",
