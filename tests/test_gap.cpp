@@ -786,3 +786,19 @@ TEST_CASE("gap: on a tilting table, a spindle drift fixed in the machine frame i
   CHECK(std::abs(e->params.at("machine_z_um")) == doctest::Approx(8).epsilon(0.15));
   CHECK(std::abs(e->params.at("machine_x_um")) < 1);
 }
+
+TEST_CASE("gap: a basis term that vanishes at every sample is not fitted") {
+  // As in identify (test_identify.cpp): sin(2π·2·y/L) is rounding noise at the five Y positions.
+  // Each fold's equilibrated SVD used to count it in the rank (47) and fit it with ~1e16.
+  const std::filesystem::path dir = test::fresh_dir("gap_vanishing_term");
+  const std::string json = (dir / "g.json").string();
+  const test::Run ok = test::run(test::cli("gap vmc_3axis -q --pdge E_YY=fourier:3 --data " +
+                                           std::string(WEILGEN_SOURCE_DIR) +
+                                           "/examples/data/vmc_3axis_points.csv --json " + json));
+  REQUIRE_MESSAGE(ok.status == 0, ok.out);
+  std::ifstream in(json);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  CHECK(j["baseline"]["parameters"] == 78);
+  CHECK(j["baseline"]["rank"] == 46);
+  CHECK(j["baseline"]["heldout_rms_all_um"].get<double>() < 10);
+}
