@@ -9,6 +9,7 @@ packages=(
   libnlopt-cxx-dev time gnuplot-nox
   # LinuxCNC (halrun, halcompile, hal.h): the HAL compensation component's test (docs/controllers.md)
   linuxcnc-uspace linuxcnc-uspace-dev
+  clang libclang-rt-14-dev  # libFuzzer and the sanitizer runtimes (fuzz/, scripts/fuzz.sh)
 )
 missing=()
 for p in "${packages[@]}"; do

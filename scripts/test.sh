@@ -13,5 +13,8 @@ cmake --build "$BUILD_DIR" -j"$(nproc)"
 if [ -x scripts/build_example.sh ]; then
   bash scripts/build_example.sh "$BUILD_DIR"
 fi
-cd "$BUILD_DIR"
-ctest --output-on-failure -j"$(nproc)"
+(cd "$BUILD_DIR" && ctest --output-on-failure -j"$(nproc)")
+# A few seconds of fuzzing per input reader (fuzz/README.md), when clang's libFuzzer is present.
+if command -v clang++ >/dev/null 2>&1; then
+  bash scripts/fuzz.sh smoke
+fi

@@ -158,7 +158,7 @@ TEST_CASE("iso230-2 --comp-table: units, drift source, and bad flags refused bef
   refused("--comp-table " + out + " --comp-type 2 --json " + json, "--comp-type 2");
   refused("--comp-table " + out + " --comp-units cm --json " + json, "--comp-units cm");
   refused("--comp-table " + out + " --comp-source best --json " + json, "--comp-source best");
-  refused("--comp-table " + data + " --json " + json, "is also an input");
+  refused("--comp-table " + data + " --json " + json, "is the input");
   refused("--comp-table " + dir.string() + " --json " + json, "is a directory");
   refused("--comp-type 1 --json " + json, "--comp-type needs --comp-table");
   CHECK(test::read_text(data) == original);
@@ -264,5 +264,5 @@ TEST_CASE("identify --comp-table --axis on the VMC's measured points, and bad ax
   refused("--comp-table " + out + " --axis X --comp-at Y=5", "--comp-at");
   refused("--comp-table " + out + " --axis X --comp-at X=5", "--comp-at");
   refused("--axis X", "--axis needs --comp-table");
-  refused("--comp-table " + data + " --axis X", "is also an input");
+  refused("--comp-table " + data + " --axis X", "is the input");
 }

@@ -1,7 +1,8 @@
-// ISO 230-2 evaluation and the drift seed's thermal-drift elimination (weilgen/measure/iso230_2.hpp,
-// docs/iso230-2.md): a hand-computed example with every figure pinned, invariants on random
-// data, drift recovery on synthetic data, the seed's sqrt(2) Monte Carlo check, the anomaly
-// test's false-positive rate and power, grouping errors, and the CLI end to end.
+// ISO 230-2 evaluation and the drift seed's thermal-drift elimination
+// (weilgen/measure/iso230_2.hpp, docs/iso230-2.md): a hand-computed example with every figure
+// pinned, invariants on random data, drift recovery on synthetic data, the seed's sqrt(2) Monte
+// Carlo check, the anomaly test's false-positive rate and power, grouping errors, and the CLI end
+// to end.
 #include <doctest/doctest.h>
 
 #include <Eigen/Dense>
@@ -496,7 +497,7 @@ TEST_CASE("iso230-2: grouping of targets and bad runs name the file and line") {
         "(column dir or dir_<axis>)");
   CHECK(error_of(head + "0,1,1,\n") == "d.csv: no observations (no row has a measured deviation)");
   CHECK(error_of(head + "0,,1,2\n") ==
-        "d.csv:2: column 'dir' is empty but 'dx_um' is measured (every observation needs its "
+        "d.csv:2:3: column 'dir' is empty but 'dx_um' is measured (every observation needs its "
         "position, direction and cycle)");
   CHECK(error_of("X,cycle,dx_um\n0,1,2\n") ==
         "d.csv:1: missing column 'dir' or 'dir_X' (the approach direction, +1 or -1; columns: "
@@ -623,7 +624,7 @@ TEST_CASE("iso230-2 CLI: bad input exits 3, bad flags exit 2, and nothing is wri
   unchanged();
   r = run(cli("iso230-2 " + (dir / "missing.csv").string() + " --json " + out));
   CHECK(r.status == 3);
-  CHECK(r.out.find("missing.csv: cannot read file") != std::string::npos);
+  CHECK(r.out.find("missing.csv: cannot read the data file: no such file") != std::string::npos);
   unchanged();
   r = run(cli("iso230-2 " + small_csv() + " --axis Q --json " + out));
   CHECK(r.status == 2);
@@ -631,7 +632,9 @@ TEST_CASE("iso230-2 CLI: bad input exits 3, bad flags exit 2, and nothing is wri
   unchanged();
   r = run(cli("iso230-2 " + small_csv() + " --alpha 1.5 --json " + out));
   CHECK(r.status == 2);
-  CHECK(r.out.rfind("weilgen iso230-2: --alpha must be in (0, 1)", 0) == 0);
+  CHECK(r.out.rfind(
+            "weilgen iso230-2: --alpha: '1.5' is out of range (allowed: a number in (0, 1))", 0) ==
+        0);
   r = run(cli("iso230-2 " + small_csv() + " --reference-cycle 9 --json " + out));
   CHECK(r.status == 2);
   unchanged();

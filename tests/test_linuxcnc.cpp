@@ -109,6 +109,6 @@ TEST_CASE("weilgen linuxcnc refuses bad parameters, names and outputs, writing n
       test::run(test::cli("linuxcnc vmc_3axis --params " + inside + " --out " + same.string()));
   INFO(r.out);
   CHECK(r.status == 2);
-  CHECK(r.out.find("is also an input") != std::string::npos);
+  CHECK(r.out.find("is the input") != std::string::npos);
   CHECK(!fs::exists(same / "Makefile"));
 }

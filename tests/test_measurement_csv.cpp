@@ -202,6 +202,7 @@ TEST_CASE("measurement csv: read_measurements reads a file and names a missing o
     read_measurements((dir / "nope.csv").string());
     FAIL("no error");
   } catch (const InputError& e) {
-    CHECK(std::string(e.what()) == (dir / "nope.csv").string() + ": cannot read file");
+    CHECK(std::string(e.what()) ==
+          (dir / "nope.csv").string() + ": cannot read the data file: no such file");
   }
 }

@@ -35,6 +35,30 @@ struct Run {
   std::string out;
 };
 
+// `out` without what a sanitizer adds when the suite runs instrumented (scripts/sanitize.sh):
+// "==1234==..." lines and the "Suppressions used:" block between dashed lines. A real sanitizer
+// report also changes the exit status (scripts/sanitize.sh sets exitcode), so nothing is hidden.
+inline std::string without_sanitizer_banners(const std::string& out) {
+  std::string kept;
+  bool in_block = false;
+  std::size_t pos = 0;
+  while (pos < out.size()) {
+    std::size_t nl = out.find('\n', pos);
+    nl = nl == std::string::npos ? out.size() : nl + 1;
+    const std::string line = out.substr(pos, nl - pos);
+    pos = nl;
+    if (line.rfind("-----------------------------------------------------", 0) == 0) {
+      in_block = !in_block;
+      continue;
+    }
+    const bool banner = line.size() > 2 && line[0] == '=' && line[1] == '=' &&
+                        line.find("==", 2) != std::string::npos;
+    if (in_block || banner) continue;
+    kept += line;
+  }
+  return kept;
+}
+
 inline Run run(const std::string& cmd) {
   Run r;
   FILE* pipe = popen((cmd + " 2>&1").c_str(), "r");
@@ -43,6 +67,7 @@ inline Run run(const std::string& cmd) {
   while (std::fgets(buf, sizeof buf, pipe)) r.out += buf;
   const int status = pclose(pipe);
   r.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = without_sanitizer_banners(r.out);
   return r;
 }
 

@@ -171,7 +171,7 @@ PointData point_data(const MeasurementTable& table, const Description& desc) {
     for (std::size_t a = 0; a < names.size(); ++a) {
       const double v = (*coord[a])[r];
       if (!std::isfinite(v))
-        throw InputError(SourceLoc{table.file, table.lines[r], 0},
+        throw InputError(table.cell(r, names[a]),
                          "column '" + names[a] +
                              "' is empty but a deviation is measured (every "
                              "observation needs the machine's coordinates)");

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "weilgen/base/memory.hpp"
+
 namespace weilgen {
 
 LimitChoice parse_limit(const std::string& text) {
@@ -59,6 +61,13 @@ std::vector<SweepCase> ReliabilitySweep::run(
         throw std::invalid_argument(
             "--limit radial bounds |(dx,dy,dz)|: give its tolerance as dp=..., not " +
             std::string(output_name(t.output)));
+  // Results (each with dR/dmu, dR/dsigma per error) and one analysis's working memory.
+  check_memory(static_cast<double>(np * st.tolerances.size()) *
+                       (sizeof(SweepCase) + 48.0 * static_cast<double>(ne)) +
+                   reliability_memory_bytes(options, ne),
+               "--samples " + std::to_string(options.samples) + " at " + std::to_string(np) +
+                   (np == 1 ? " pose" : " poses"),
+               "lower --samples or the number of poses");
   std::vector<ModelData> work;
   for (unsigned t = 0; t < std::max(1u, st.threads); ++t) work.emplace_back(model);
   // Order 1: every component is exactly linear in the errors. Its linear form (deviation at zero

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "weilgen/base/memory.hpp"
 #include "weilgen/base/text.hpp"
 
 namespace weilgen {
@@ -30,7 +31,12 @@ void parse_sensitivity_method(const std::string& m, SensitivityOptions& o) {
 std::vector<OutputId> parse_output_list(const std::string& text) {
   std::vector<OutputId> out;
   for (const auto& item : split(text, ',')) {
-    const OutputId o = parse_output(trim(item));
+    OutputId o;
+    try {
+      o = parse_output(trim(item));
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(std::string("--outputs: ") + e.what());
+    }
     if (std::find(out.begin(), out.end(), o) != out.end())
       throw std::invalid_argument("--outputs: \"" + item + "\" given twice");
     out.push_back(o);
@@ -54,6 +60,14 @@ SensitivityResult SensitivityStudy::run(
   const Model& model = *st.model;
   const std::vector<OutputId>& outputs = options_.outputs;
   const std::size_t ne = model.num_errors(), np = st.poses.poses.size(), no = outputs.size();
+  // Refused before anything is allocated: the records and the Sobol' analysis of one pose.
+  const SobolOptions& so0 = options_.sobol_options;
+  check_memory(static_cast<double>(np * no * ne) * sizeof(SensitivityRecord) +
+                   (options_.sobol ? sobol_memory_bytes(so0, ne, no) : 0.0),
+               "--samples " + std::to_string(so0.samples) + ", --bootstrap " +
+                   std::to_string(so0.bootstrap) + " at " + std::to_string(np) +
+                   (np == 1 ? " pose" : " poses"),
+               "lower --samples, --bootstrap or the number of poses");
   SensitivityResult res;
   res.outputs = outputs;
   res.poses = np;

@@ -6,6 +6,7 @@
 #include "weilgen/base/text.hpp"
 #include "weilgen/base/units.hpp"
 #include "weilgen/codegen/generate.hpp"
+#include "weilgen/machine/algebra_size.hpp"
 #include "weilgen/machine/yaml_loader.hpp"
 #include "weilgen/model/builtin_models.hpp"
 #include "weilgen/model/model_loader.hpp"
@@ -45,7 +46,12 @@ std::vector<double> parse_params(const Description& d, const std::vector<std::st
 }  // namespace
 
 std::shared_ptr<Model> open_model(const StudyRequest& r, const Description& desc) {
-  if (r.order < 0) throw std::invalid_argument("--order must be >= 1");
+  if (r.order < 0 || r.order > kMaxAlgebraOrder)
+    throw std::invalid_argument("--order must be a whole number from 1 to " +
+                                std::to_string(kMaxAlgebraOrder));
+  // Too large: refused now; large: a warning when (and only when) the model is generated.
+  const std::string size_warning =
+      check_algebra_size(desc, r.order, "--order " + std::to_string(r.order));
   LoadOptions lo;
   lo.order = r.order;
   if (r.engine == "auto")
@@ -59,7 +65,10 @@ std::shared_ptr<Model> open_model(const StudyRequest& r, const Description& desc
                                 "'");
   lo.compiler = r.compiler;
   lo.builtins = builtin_models();
-  lo.generate = generate_for_loader;
+  lo.generate = [size_warning, log = r.log](const Description& d, int order) {
+    if (!size_warning.empty() && log) log(size_warning);
+    return generate_for_loader(d, order);
+  };
   lo.log = r.log;
   std::shared_ptr<Model> model = load_model(desc, lo);
   // Parameters are part of what the machine is: set before the model is shared.
@@ -70,6 +79,8 @@ std::shared_ptr<Model> open_model(const StudyRequest& r, const Description& desc
 Study open_study(const StudyRequest& r, bool need_tolerances) {
   if (r.machine.empty()) throw std::invalid_argument("no machine given");
   const Description desc = load_machine_file(resolve_machine(r.machine));
+  // A model too large to generate is refused before the other inputs are read.
+  if (r.order != 0) check_algebra_size(desc, r.order, "--order " + std::to_string(r.order));
   Study s;
   s.poses = parse_poses(desc, r.at, r.grid);
   s.inputs = error_distributions(desc, r.tolerance_files, r.set);

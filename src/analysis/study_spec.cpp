@@ -15,7 +15,7 @@ namespace {
 
 // "--grid: \"X=0:1000:0\"" : the prefix of every message about one flag value.
 std::string flag_context(const std::string& flag, const std::string& text) {
-  return flag + ": " + quoted(text);
+  return flag + ": " + quoted(abbreviated(text));
 }
 
 [[noreturn]] void fail(const std::string& context, const std::string& why) {
@@ -90,7 +90,7 @@ std::vector<std::pair<std::size_t, std::string>> axis_items(const Description& d
     if (item.empty()) fail(context, "empty item (expected " + form + ")");
     const std::size_t eq = item.find('=');
     if (eq == std::string::npos) {
-      fail(context, quoted(item) + " is not AXIS=value (expected " + form + ")");
+      fail(context, quoted(abbreviated(item)) + " is not AXIS=value (expected " + form + ")");
     }
     const std::string name = trim(item.substr(0, eq));
     std::size_t index = axes.size();
@@ -98,7 +98,8 @@ std::vector<std::pair<std::size_t, std::string>> axis_items(const Description& d
       if (axes[i].name == name) index = i;
     }
     if (index == axes.size()) {
-      fail(context, "unknown axis " + quoted(name) + " (" + axes_list(desc, axes) + ")");
+      fail(context,
+           "unknown axis " + quoted(abbreviated(name)) + " (" + axes_list(desc, axes) + ")");
     }
     for (const auto& [seen, value] : out) {
       if (seen == index) fail(context, "axis " + name + " is given twice");
@@ -122,7 +123,7 @@ std::size_t grid_count(const std::string& text, const std::string& context) {
   const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), n);
   if (t.empty() || ec != std::errc() || end != t.data() + t.size()) {
     if (!t.empty() && t[0] == '-') fail(context, "count must be >= 1, got " + t);
-    fail(context, "count must be a whole number >= 1, got " + quoted(t));
+    fail(context, "count must be a whole number >= 1, got " + quoted(abbreviated(t)));
   }
   if (n < 1) fail(context, "count must be >= 1");
   return n;
@@ -251,7 +252,7 @@ std::vector<OutputTolerance> parse_tolerances(const std::vector<std::string>& fl
       if (item.empty()) fail(context, "empty item (expected " + form + ")");
       const std::size_t eq = item.find('=');
       if (eq == std::string::npos) {
-        fail(context, quoted(item) + " is not OUTPUT=value (expected " + form + ")");
+        fail(context, quoted(abbreviated(item)) + " is not OUTPUT=value (expected " + form + ")");
       }
       OutputId id;
       try {
@@ -338,8 +339,8 @@ void apply_set_flag(const Description& desc, const std::string& flag,
   } else {
     const int index = desc.error_index(name);
     if (index < 0) {
-      fail(context, "unknown error " + quoted(name) + " (machine " + desc.name + " has " +
-                        join(error_names(desc)) + "; or group:<group>)");
+      fail(context, "unknown error " + quoted(abbreviated(name)) + " (machine " + desc.name +
+                        " has " + join(error_names(desc)) + "; or group:<group>)");
     }
     int sign = 1;
     for (const Alias& a : desc.errors[static_cast<std::size_t>(index)].aliases) {

@@ -339,7 +339,9 @@ ToleranceOverrides read_tolerance_text(const std::string& yaml, const std::strin
 
 ToleranceOverrides read_tolerance_file(const std::string& path, const Description& desc) {
   std::string text;
-  if (!read_file(path, text)) throw InputError({path, 0, 0}, "cannot read the tolerance file");
+  if (const std::string why = unreadable_reason(path); !why.empty() || !read_file(path, text))
+    throw InputError({path, 0, 0},
+                     "cannot read the tolerance file: " + (why.empty() ? "read error" : why));
   return read_tolerance_text(text, path, desc);
 }
 

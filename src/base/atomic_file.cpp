@@ -1,5 +1,7 @@
 #include "weilgen/base/atomic_file.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -12,6 +14,24 @@
 
 namespace weilgen {
 
+namespace {
+
+std::string error_text(int err) { return std::strerror(err); }
+
+// Opens a new temporary file; a stale one (a crashed run with the same pid) is replaced, and a
+// symbolic link planted in its place is never followed.
+int open_temporary(const std::string& tmp, unsigned mode) {
+  for (int attempt = 0; attempt < 2; ++attempt) {
+    const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC | O_NOFOLLOW,
+                          static_cast<mode_t>(mode));
+    if (fd >= 0 || errno != EEXIST) return fd;
+    ::unlink(tmp.c_str());
+  }
+  return -1;
+}
+
+}  // namespace
+
 std::string temporary_path_for(const std::string& path) {
   namespace fs = std::filesystem;
   const fs::path target(path);
@@ -21,47 +41,41 @@ std::string temporary_path_for(const std::string& path) {
   return (dir / ("." + target.filename().string() + ".tmp" + std::to_string(::getpid()))).string();
 }
 
-void write_file_atomically(const std::string& path, const std::string& contents) {
+void write_file_atomically(const std::string& path, const std::string& contents, unsigned mode) {
   namespace fs = std::filesystem;
-  const fs::path target(path);
-  const fs::path tmp = temporary_path_for(path);
-  std::error_code ec;
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw std::runtime_error(path + ": cannot write (" + std::strerror(errno) + ")");
-    out << contents;
-    out.flush();
-    if (!out) {
-      fs::remove(tmp, ec);
-      throw std::runtime_error(path + ": write failed");
+  const std::string tmp = temporary_path_for(path);
+  const int fd = open_temporary(tmp, mode);
+  if (fd < 0) throw std::runtime_error(path + ": cannot write (" + error_text(errno) + ")");
+  std::size_t done = 0;
+  while (done < contents.size()) {
+    const ssize_t n = ::write(fd, contents.data() + done, contents.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      const int err = errno;
+      ::close(fd);
+      ::unlink(tmp.c_str());
+      throw std::runtime_error(path + ": write failed (" + error_text(err) + ")");
     }
+    done += static_cast<std::size_t>(n);
   }
-  fs::rename(tmp, target, ec);
-  if (ec) {
-    fs::remove(tmp, ec);
-    throw std::runtime_error(path + ": cannot replace (" + ec.message() + ")");
+  if (::fsync(fd) != 0 || ::close(fd) != 0) {
+    const int err = errno;
+    ::unlink(tmp.c_str());
+    throw std::runtime_error(path + ": write failed (" + error_text(err) + ")");
   }
-}
-
-void check_output_target(const std::string& path, const std::vector<std::string>& inputs,
-                         const std::string& flag) {
-  namespace fs = std::filesystem;
-  const auto fail = [&](const std::string& why) {
-    throw std::invalid_argument(flag + " " + path + ": " + why);
-  };
-  if (path.empty()) throw std::invalid_argument(flag + ": an empty path");
-  std::error_code ec;
-  if (fs::is_directory(path, ec)) fail("is a directory; give a file name");
-  const fs::path canonical = fs::weakly_canonical(path, ec);
-  for (const std::string& in : inputs) {
-    std::error_code e1, e2;
-    if (fs::equivalent(path, in, e1) || (!ec && fs::weakly_canonical(in, e2) == canonical && !e2))
-      fail("is also an input (" + in + "); write the output to another file");
+  if (::rename(tmp.c_str(), path.c_str()) != 0) {
+    const int err = errno;
+    ::unlink(tmp.c_str());
+    throw std::runtime_error(path + ": cannot replace (" + error_text(err) + ")");
   }
-  fs::path dir = fs::absolute(path, ec).parent_path();
-  while (!dir.empty() && !fs::exists(dir, ec) && dir != dir.parent_path()) dir = dir.parent_path();
-  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec)) fail(dir.string() + " is not a directory");
-  if (::access(dir.c_str(), W_OK) != 0) fail("cannot write in " + dir.string());
+  // The rename itself reaches the disk with the directory.
+  const fs::path target(path);
+  const std::string dir = target.has_parent_path() ? target.parent_path().string() : ".";
+  const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dfd >= 0) {
+    ::fsync(dfd);
+    ::close(dfd);
+  }
 }
 
 bool read_file(const std::string& path, std::string& contents) {
@@ -69,8 +83,23 @@ bool read_file(const std::string& path, std::string& contents) {
   if (!in) return false;
   std::ostringstream ss;
   ss << in.rdbuf();
+  if (in.bad()) return false;  // e.g. a directory: opens, but reading fails
   contents = ss.str();
   return true;
+}
+
+std::string unreadable_reason(const std::string& path) {
+  struct stat st {};
+  if (path.empty()) return "no file name given";
+  if (::stat(path.c_str(), &st) != 0) {
+    if (errno == ENOENT) return "no such file";
+    return error_text(errno);
+  }
+  if (S_ISDIR(st.st_mode)) return "is a directory, not a file";
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return error_text(errno);
+  ::close(fd);
+  return "";
 }
 
 }  // namespace weilgen

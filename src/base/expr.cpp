@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "weilgen/base/text.hpp"
 
 namespace weilgen {
 namespace {
@@ -52,8 +53,8 @@ class Parser {
   static constexpr int kMaxDepth = 200;
 
   [[noreturn]] void fail(const std::string& what) const {
-    throw std::invalid_argument("expression '" + text_ + "': " + what + " at position " +
-                                std::to_string(pos_ + 1));
+    throw std::invalid_argument("expression '" + abbreviated(text_) + "': " + what +
+                                " at position " + std::to_string(pos_ + 1));
   }
 
   void skip_space() {
@@ -157,6 +158,11 @@ class Parser {
     const char* first = text_.data() + start;
     const char* last = text_.data() + pos_;
     const auto [end, ec] = std::from_chars(first, last, v);
+    if (ec == std::errc::result_out_of_range) {
+      pos_ = start;
+      fail("number '" + abbreviated(std::string(first, last)) +
+           "' is out of range (magnitudes from 2.2e-308 to 1.8e308, or 0)");
+    }
     if (ec != std::errc() || end != last) {
       pos_ = start;
       fail("malformed number");
@@ -285,7 +291,9 @@ std::string Expr::str() const {
     case Kind::Param:
       return name;
     case Kind::Neg:
-      return "-" + wrap(*a, precedence(*a) <= p);
+      // "--x", not "-(-x)": the parenthesised form nests twice as deep, and a long chain of
+      // signs printed that way no longer read back (kMaxDepth; found by fuzz_expression).
+      return "-" + wrap(*a, precedence(*a) < p);
     case Kind::Pow:
       // Right-associative: the base needs parentheses when it is itself a power or signed.
       return wrap(*a, precedence(*a) <= p) + "^" + wrap(*b, precedence(*b) < 3);

@@ -35,4 +35,11 @@ std::vector<std::string> split(const std::string& s, char sep) {
 
 std::string quoted(const std::string& s) { return "\"" + s + "\""; }
 
+std::string abbreviated(const std::string& s, std::size_t max) {
+  if (s.size() <= max) return s;
+  std::size_t cut = max;
+  while (cut > 0 && (static_cast<unsigned char>(s[cut]) & 0xC0) == 0x80) --cut;  // UTF-8
+  return s.substr(0, cut) + "...";
+}
+
 }  // namespace weilgen

@@ -66,7 +66,7 @@ UnitFactor parse_unit(const std::string& unit) {
   for (const NamedUnit& u : units()) {
     if (ascii == u.name) return u.factor;
   }
-  throw std::invalid_argument("unknown unit \"" + unit + "\" (" + known_units() + ")");
+  throw std::invalid_argument("unknown unit \"" + abbreviated(unit) + "\" (" + known_units() + ")");
 }
 
 Quantity parse_quantity_unit(const std::string& text, const std::string& default_unit,
@@ -75,8 +75,10 @@ Quantity parse_quantity_unit(const std::string& text, const std::string& default
   if (t.empty()) fail(what, "empty value (expected a number with an optional unit, e.g. 0.03mm)");
   std::string bare = lower(t);
   bare.erase(0, bare.find_first_not_of("+- \t"));
-  if (bare.compare(0, 3, "nan") == 0) fail(what, "\"" + t + "\" is not a number (NaN)");
-  if (bare.compare(0, 3, "inf") == 0) fail(what, "\"" + t + "\" is not a finite number");
+  if (bare.compare(0, 3, "nan") == 0)
+    fail(what, "\"" + abbreviated(t) + "\" is not a number (NaN)");
+  if (bare.compare(0, 3, "inf") == 0)
+    fail(what, "\"" + abbreviated(t) + "\" is not a finite number");
 
   // The unit is the trailing run of letters, '/' and µ; an expression ending in a name
   // ("2*pi") has none.
@@ -97,31 +99,31 @@ Quantity parse_quantity_unit(const std::string& text, const std::string& default
         expression = parse_expr(t).params().empty();
       } catch (const std::invalid_argument&) {
       }
-      if (!expression) fail(what, std::string(ex.what()) + " in \"" + t + "\"");
+      if (!expression) fail(what, std::string(ex.what()) + " in \"" + abbreviated(t) + "\"");
       number_text = t;
       unit_text.clear();
     }
   }
   if (!q.unit_given) {
     if (default_unit.empty()) {
-      fail(what, "\"" + t + "\" needs a unit (" + known_units() + ")");
+      fail(what, "\"" + abbreviated(t) + "\" needs a unit (" + known_units() + ")");
     }
     q.unit = parse_unit(default_unit);
     q.unit_name = default_unit;
   }
-  if (number_text.empty()) fail(what, "\"" + t + "\" has no number before the unit");
+  if (number_text.empty()) fail(what, "\"" + abbreviated(t) + "\" has no number before the unit");
   Expr e;
   try {
     e = parse_expr(number_text);
   } catch (const std::invalid_argument& ex) {
-    fail(what, "\"" + t + "\" is not a number or expression: " + ex.what());
+    fail(what, "\"" + abbreviated(t) + "\" is not a number or expression: " + ex.what());
   }
   if (!e.params().empty()) {
-    fail(what, "\"" + t + "\" is not a number: unknown name \"" + e.params().front() +
+    fail(what, "\"" + abbreviated(t) + "\" is not a number: unknown name \"" + e.params().front() +
                    "\" (expected a number or an expression such as 0.05/6, then a unit)");
   }
   q.number = e.eval({});
-  if (!std::isfinite(q.number)) fail(what, "\"" + t + "\" is not a finite number");
+  if (!std::isfinite(q.number)) fail(what, "\"" + abbreviated(t) + "\" is not a finite number");
   return q;
 }
 

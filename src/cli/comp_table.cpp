@@ -35,8 +35,7 @@ po::options_description comp_table_options(CompTableFlags& f, bool model_axis) {
   return o;
 }
 
-void check_comp_table_flags(const CompTableFlags& f, const po::variables_map& vm,
-                            const std::vector<std::string>& inputs, bool model_axis) {
+void check_comp_table_flags(const CompTableFlags& f, const po::variables_map& vm, bool model_axis) {
   if (f.path.empty()) {
     // iso230-2 has an --axis of its own (the data's coordinate column).
     const std::vector<const char*> own =
@@ -53,7 +52,6 @@ void check_comp_table_flags(const CompTableFlags& f, const po::variables_map& vm
     f.options.validate();
   else
     f.options.table.validate();
-  check_output_target(f.path, inputs, "--comp-table");
 }
 
 std::string write_comp_table(const CompTableFlags& f, const CompTable& table) {

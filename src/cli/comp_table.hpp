@@ -22,12 +22,11 @@ struct CompTableFlags {
 boost::program_options::options_description comp_table_options(CompTableFlags& flags,
                                                                bool model_axis);
 
-// Before any work: the options valid and the file a writable path that is none of `inputs`
-// (std::invalid_argument naming the flag). Nothing when --comp-table is not given; with
+// Before any work: the options valid (std::invalid_argument naming the flag); the verb checks the
+// file with its other outputs (check_output_paths). Nothing when --comp-table is not given; with
 // `model_axis`, --axis / --comp-points / --comp-at without --comp-table are refused.
 void check_comp_table_flags(const CompTableFlags& flags,
-                            const boost::program_options::variables_map& vm,
-                            const std::vector<std::string>& inputs, bool model_axis);
+                            const boost::program_options::variables_map& vm, bool model_axis);
 
 // Writes the COMP_FILE atomically; returns the summary for stdout.
 std::string write_comp_table(const CompTableFlags& flags, const CompTable& table);

@@ -7,9 +7,12 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "flags.hpp"
 #include "weilgen/base/atomic_file.hpp"
 #include "weilgen/base/format.hpp"
 #include "weilgen/base/text.hpp"
+#include "weilgen/machine/algebra_size.hpp"
+#include "weilgen/machine/yaml_loader.hpp"
 
 namespace po = boost::program_options;
 
@@ -17,7 +20,7 @@ namespace weilgen::cli {
 
 po::options_description model_options(StudyFlags& f) {
   po::options_description model("Model");
-  model.add_options()("order", po::value<int>(&f.order),
+  model.add_options()("order", ranged(&f.order, NumberRange::whole_numbers(1, kMaxAlgebraOrder)),
                       "algebra order r >= 1 overriding the machine file's (compiles a model)")(
       "engine", po::value<std::string>(&f.engine)->default_value("auto"),
       "auto (built-in, cached or compiled; numeric chain without a compiler) | compiled |\n"
@@ -60,12 +63,28 @@ void add_study_options(po::options_description& opts, StudyFlags& f, bool with_t
   out.add_options()("json", po::value<std::string>(&f.json), "write every number to FILE (JSON)")(
       "csv", po::value<std::string>(&f.csv), "write the result table to FILE (CSV)")(
       "plot", po::value<std::string>(&f.plot), "draw the result to FILE (.png or .svg, gnuplot)")(
-      "seed", po::value<std::uint64_t>(&f.seed)->default_value(1),
+      "seed",
+      ranged(&f.seed, NumberRange::whole_numbers(0, 18446744073709551615.0))->default_value(1),
       "seed of every sampled result (same seed, same numbers, any --threads)")(
-      "threads", po::value<unsigned>(&f.threads)->default_value(0),
+      "threads", ranged(&f.threads, thread_range())->default_value(0),
       "worker threads (0 = all cores)")("quiet,q", po::bool_switch(&f.quiet),
                                         "no progress or model messages on stderr");
   opts.add(model).add(where).add(out);
+}
+
+std::vector<PathArg> study_inputs(const StudyFlags& f) {
+  std::vector<PathArg> in;
+  try {
+    if (!f.machine.empty()) in.push_back({"machine file", resolve_machine(f.machine)});
+  } catch (const InputError&) {
+    // Reported when the study opens it.
+  }
+  for (const std::string& t : f.tolerance_files) in.push_back({"--tolerances", t});
+  return in;
+}
+
+std::vector<PathArg> study_outputs(const StudyFlags& f) {
+  return {{"--json", f.json}, {"--csv", f.csv}, {"--plot", f.plot}};
 }
 
 StudyRequest study_request(const StudyFlags& f) {
@@ -99,9 +118,9 @@ void add_reliability_options(po::options_description& opts, ReliabilityFlags& f)
                   "two-sided | one-sided | radial")(
       "method", po::value<std::string>(&f.method)->default_value(f.method),
       "auto | exact | form | is | mc")(
-      "samples", po::value<std::size_t>(&f.samples)->default_value(f.samples),
+      "samples", ranged(&f.samples, NumberRange::whole_numbers(1, 1e9))->default_value(f.samples),
       "importance-sampling lines or Monte Carlo samples per pose and output")(
-      "confidence", po::value<double>(&f.confidence)->default_value(f.confidence),
+      "confidence", ranged(&f.confidence, NumberRange::open(0, 1))->default_value(f.confidence),
       "confidence level of the intervals")(
       "sensitivities", po::value<std::string>(&f.sensitivities)->default_value(f.sensitivities),
       "dR/dmu, dR/dsigma by: auto (sampling for radial, else FORM; analytic when exact) |\n"

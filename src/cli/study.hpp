@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "flags.hpp"
 #include "weilgen/analysis/reliability_sweep.hpp"
 #include "weilgen/analysis/study.hpp"
 #include "weilgen/analysis/study_spec.hpp"
@@ -40,6 +41,11 @@ void add_study_options(boost::program_options::options_description& opts, StudyF
 boost::program_options::options_description model_options(StudyFlags& flags);
 // --plane, --centre, --radius, --feed: a ballbar circle over the file's header keys.
 boost::program_options::options_description ballbar_circle_options(BallbarFlags& circle);
+
+// The files the study flags read (the machine file, --tolerances) and write (--json, --csv,
+// --plot), for check_output_paths (flags.hpp).
+std::vector<PathArg> study_inputs(const StudyFlags& flags);
+std::vector<PathArg> study_outputs(const StudyFlags& flags);
 
 // The flags as a study request (model messages to stderr unless --quiet).
 StudyRequest study_request(const StudyFlags& flags);

@@ -32,14 +32,14 @@ int verb_allocate(const Args& args) {
   double min_target = 0.95, mean_target = 0.97, loosen = 4.0;
   std::size_t choose = 4, max_steps = 100;
   opts.add_options()("help,h", "show this help")(
-      "min", po::value<double>(&min_target)->default_value(min_target),
+      "min", ranged(&min_target, NumberRange::open(0, 1))->default_value(min_target),
       "target for the minimum reliability over the poses (per output)")(
-      "mean", po::value<double>(&mean_target)->default_value(mean_target),
+      "mean", ranged(&mean_target, NumberRange::open(0, 1))->default_value(mean_target),
       "target for the mean reliability over the poses (per output)")(
       "step", po::value<std::vector<std::string>>(&step_flags)->composing(),
       "spread decrement per step: 10% (of the starting sigma; default), 0.005/6mm (all length\n"
       "errors), 0.005/6000rad (all angular errors) or E_C0X=0.005/3000rad; repeatable")(
-      "choose", po::value<std::size_t>(&choose)->default_value(choose),
+      "choose", ranged(&choose, NumberRange::whole_numbers(1, 100000))->default_value(choose),
       "errors chosen per output that misses its targets")(
       "rank", po::value<std::string>(&rank)->default_value("scaled"),
       "how --choose ranks the errors: scaled (mean |dR/dsigma_i| sigma_i, unit-free) | raw\n"
@@ -47,14 +47,16 @@ int verb_allocate(const Args& args) {
       "angular errors because a rad is 1000 mm/m)")(
       "errors", po::value<std::string>(&errors_text),
       "explicit comma-separated choice of the errors to tighten (overrides --choose)")(
-      "max-steps", po::value<std::size_t>(&max_steps)->default_value(max_steps), "step limit")(
+      "max-steps",
+      ranged(&max_steps, NumberRange::whole_numbers(1, 100000))->default_value(max_steps),
+      "step limit")(
       "per-output",
       "tighten at each step only the errors chosen by outputs still missing a target")(
       "cost-aware", "also minimise sum w_i/sigma_i subject to the targets")(
       "weight", po::value<std::vector<std::string>>(&weight_flags)->composing(),
       "NAME=w cost weight of an error, in the unit of its spread (default: its starting\n"
       "spread, so that cost = sum sigma0_i/sigma_i); repeatable")(
-      "max-loosen", po::value<double>(&loosen)->default_value(loosen),
+      "max-loosen", ranged(&loosen, NumberRange::closed(1, 1e6))->default_value(loosen),
       "cost-aware bound: no spread above this factor times its starting value")(
       "save-tolerances", po::value<std::string>(&save),
       "write the step procedure's final spreads as a tolerance file");
@@ -82,6 +84,10 @@ int verb_allocate(const Args& args) {
   ao.weights = weight_flags;
   if (!errors_text.empty()) ao.errors = split(errors_text, ',');
 
+  if (!f.plot.empty()) return usage_error("allocate", "--plot: allocate draws no figure");
+  std::vector<PathArg> outputs = study_outputs(f);
+  outputs.push_back({"--save-tolerances", save});
+  check_output_paths(study_inputs(f), outputs);
   const Study st = open_study(f, true);
   const AllocationStudyResult out = AllocationStudy(ao).run(st);
   std::cout << allocation_text(st, ao, out);

@@ -4,6 +4,7 @@
 // the 6D line variant of the CSV: docs/data-format.md.
 #include <iostream>
 
+#include "flags.hpp"
 #include "verbs.hpp"
 #include "weilgen/base/atomic_file.hpp"
 #include "weilgen/measure/pdge_fit_study.hpp"
@@ -35,15 +36,17 @@ int verb_fit_pdge(const Args& args) {
       "poly|fourier|legendre|chebyshev, e.g. fourier:3,poly:7 or fourier:auto:auto")(
       "order", po::value<std::string>(&order)->default_value("auto"),
       "order of the bases given without one: a whole number, or auto (cross-validation)")(
-      "min-order", po::value<int>(&min_order)->default_value(0), "smallest order tried by auto")(
-      "max-order", po::value<int>(&max_order)->default_value(10), "largest order tried by auto")(
+      "min-order", ranged(&min_order, NumberRange::whole_numbers(0, 50))->default_value(0),
+      "smallest order tried by auto")(
+      "max-order", ranged(&max_order, NumberRange::whole_numbers(0, 50))->default_value(10),
+      "largest order tried by auto")(
       "period", po::value<std::string>(&period)->default_value("travel"),
       "Fourier period of the bases given without one: travel (b - a), a length in mm, or "
       "auto (searched: grid over 1/L, then Brent, on the training SSE at each order)")(
       "cv", po::value<std::string>(&cv)->default_value("blocks"),
       "cross-validation: blocks (contiguous stretches of positions; the end positions always "
       "train) or cycles (leave one cycle out; needs a cycle column)")(
-      "folds", po::value<int>(&folds)->default_value(10),
+      "folds", ranged(&folds, NumberRange::whole_numbers(2, 1000))->default_value(10),
       "number of blocks (--cv blocks; fewer when the data has fewer interior positions)")(
       "rule", po::value<std::string>(&rule)->default_value("1se"),
       "order choice: 1se (smallest order within one standard error of the least CV error) | "
@@ -68,6 +71,7 @@ int verb_fit_pdge(const Args& args) {
   if (auto stop = parse_args<std::string>("fit-pdge", args, opts, "data", 1, vm)) return *stop;
   if (!vm.count("data")) return usage_error("fit-pdge", "no data file given");
   const std::string data_path = vm["data"].as<std::string>();
+  check_output_paths({{"data file", data_path}}, {{"--json", json_path}, {"--plot", plot_path}});
   PdgeFitStudyOptions so;
   so.bases = basis_flags;
   so.order = order;
@@ -90,6 +94,7 @@ int verb_fit_pdge(const Args& args) {
   const PdgeFitStudy study(so);
   if (!plot_path.empty()) check_plot_target(plot_path);
   const PdgeFitStudyResult r = study.run(data_path);
+  for (const std::string& w : r.warnings) std::cerr << w << "\n";
   std::cout << pdge_fit_text(so, r, curves);
   if (!json_path.empty()) write_file_atomically(json_path, pdge_fit_json(so, r).dump(1) + "\n");
   if (!plot_path.empty())

@@ -40,14 +40,14 @@ int verb_gap(const Args& args) {
       "coordinates the data do not list, e.g. X=0,Y=0,Z=0 (mm, deg)")(
       "pdge", po::value<std::vector<std::string>>(&pdge)->composing(),
       "PDGE basis as for identify (poly:3, E_YY=fourier:3)")(
-      "alpha", po::value<double>(&alpha)->default_value(alpha),
+      "alpha", ranged(&alpha, NumberRange::open(0, 0.5))->default_value(alpha),
       "family-wise false-positive rate of each decision")(
       "json", po::value<std::string>(&json_path), "write the results as JSON to FILE")(
       "report", po::value<std::string>(&report_path), "write a Markdown report to FILE")(
       "plot", po::value<std::string>(&plot_dir),
       "draw residual-versus-coordinate and effect-ranking plots into DIR (PNG)")(
       "allow-unknown", "warn about unknown columns instead of failing")(
-      "threads", po::value<unsigned>(&threads)->default_value(0),
+      "threads", ranged(&threads, thread_range())->default_value(0),
       "worker threads (0 = all cores; the result is the same for any count)")(
       "quiet,q", po::bool_switch(&flags.quiet), "no model messages on stderr");
   BallbarFlags circle;
@@ -57,8 +57,11 @@ int verb_gap(const Args& args) {
   if (auto stop = parse_args<std::string>("gap", args, opts, "machine", 1, vm)) return *stop;
   if (!vm.count("machine")) return usage_error("gap", "no machine given");
   if (data.empty()) return usage_error("gap", "no --data file given");
-  if (!(alpha > 0 && alpha < 0.5)) return usage_error("gap", "--alpha must be in (0, 0.5)");
   flags.machine = vm["machine"].as<std::string>();
+  std::vector<PathArg> inputs = study_inputs(flags);
+  inputs.push_back({"--data", data});
+  check_output_paths(inputs, {{"--json", json_path}, {"--report", report_path}});
+  check_output_dir(inputs, {"--plot", plot_dir});
   GapOptions go;
   for (const std::string& e : effects)
     for (const std::string& n : split(e, ',')) go.effects.push_back(trim(n));

@@ -1,9 +1,11 @@
 #include <boost/program_options.hpp>
 #include <iostream>
 
+#include "flags.hpp"
 #include "verbs.hpp"
 #include "weilgen/base/atomic_file.hpp"
 #include "weilgen/codegen/generate.hpp"
+#include "weilgen/machine/algebra_size.hpp"
 #include "weilgen/machine/yaml_loader.hpp"
 
 namespace po = boost::program_options;
@@ -20,17 +22,26 @@ std::optional<int> parse_args(const std::string& verb, const Args& args,
                               const po::options_description& visible, const char* positional,
                               int max_positional, po::variables_map& vm) {
   po::options_description hidden;
-  hidden.add_options()(positional, po::value<Positional>(), "");
+  hidden.add_options()(positional, po::value<Positional>(), "")(
+      "unexpected-argument", po::value<std::vector<std::string>>(), "");
   po::options_description all;
   all.add(visible).add(hidden);
   po::positional_options_description pos;
   pos.add(positional, max_positional);
+  if (max_positional >= 0) pos.add("unexpected-argument", -1);  // named in the message
   try {
     po::store(po::command_line_parser(args).options(all).positional(pos).run(), vm);
     po::notify(vm);
   } catch (const po::error& e) {
     return usage_error(verb, e.what());
   }
+  if (vm.count("unexpected-argument"))
+    return usage_error(
+        verb,
+        "unexpected argument '" + vm["unexpected-argument"].as<std::vector<std::string>>().front() +
+            "' (this verb takes " +
+            (max_positional == 0 ? std::string("no file") : "one " + std::string(positional)) +
+            ")");
   if (vm.count("help")) {
     std::cout << visible << "\n";
     return 0;
@@ -50,12 +61,13 @@ int verb_generate(const Args& args) {
   po::options_description opts(
       "weilgen generate <machine>... [options]\n\n"
       "Builds each machine's error model over its Weil algebra and writes <out>/<name>.hpp\n"
-      "(standalone C++ header) and <out>/<name>.md (closed-form report). Files are written\n"
-      "atomically and only when every machine generated without error.\n\nOptions");
+      "(standalone C++ header) and <out>/<name>.md (closed-form report). Nothing is written\n"
+      "unless every machine generated without error; then each file is written atomically\n"
+      "(a run is atomic per file, not as a set: docs/robustness.md).\n\nOptions");
   int order = 0;
   std::string out = "generated";
   opts.add_options()("help,h", "show this help")(
-      "order", po::value<int>(&order),
+      "order", ranged(&order, NumberRange::whole_numbers(1, kMaxAlgebraOrder)),
       "truncation order r >= 1, overriding the file's algebra.order; the outputs are then\n"
       "named <name>_o<r>")("out", po::value<std::string>(&out)->default_value("generated"),
                            "output directory")(
@@ -69,11 +81,17 @@ int verb_generate(const Args& args) {
   if (auto stop = parse_args<std::vector<std::string>>("generate", args, opts, "machine", -1, vm))
     return *stop;
   if (!vm.count("machine")) return usage_error("generate", "no machine given");
-  if (vm.count("order") && order < 1) return usage_error("generate", "--order must be >= 1");
 
-  std::vector<gen::GeneratedFile> files;
+  // Every machine read and its size checked before anything is generated.
+  std::vector<Description> machines;
+  std::vector<PathArg> inputs;
   for (const auto& m : vm["machine"].as<std::vector<std::string>>()) {
-    const Description d = load_machine_file(resolve_machine(m));
+    inputs.push_back({"machine file", resolve_machine(m)});
+    machines.push_back(load_machine_file(inputs.back().path));
+    check_order(machines.back(), order, false);
+  }
+  std::vector<gen::GeneratedFile> files;
+  for (const Description& d : machines) {
     auto f = gen::generate_files(d, order, out, vm.count("c-api") > 0);
     files.insert(files.end(), f.begin(), f.end());
   }
@@ -89,6 +107,10 @@ int verb_generate(const Args& args) {
     std::cout << files.size() << " generated file(s) up to date\n";
     return 0;
   }
+  // Every file checked before the first is written; each is then written atomically.
+  std::vector<PathArg> outputs;
+  for (const auto& f : files) outputs.push_back({"--out", f.path});
+  check_output_paths(inputs, outputs);
   for (const auto& f : files) {
     std::string old;
     if (read_file(f.path, old) && old == f.contents) continue;  // keep mtime: no rebuilds

@@ -42,7 +42,7 @@ int verb_identify(const Args& args) {
       "20 mm, or 20 deg on a rotary axis) or of one error (E_YY=fourier:3); repeatable, applied "
       "in order")("fix", po::value<std::vector<std::string>>(&fixed)->composing(),
                   "hold an error at zero (name or alias); repeatable")(
-      "rank-tol", po::value<double>(&rank_tol)->default_value(rank_tol, "1e-9"),
+      "rank-tol", ranged(&rank_tol, NumberRange::open(0, 1))->default_value(rank_tol, "1e-9"),
       "singular values below rank-tol x the largest (equilibrated columns) count as zero")(
       "predict", po::value<std::vector<std::string>>(&predict)->composing(),
       "predict the deviations at the poses of a CSV (compared with its measured deviations "
@@ -62,14 +62,17 @@ int verb_identify(const Args& args) {
   if (auto stop = parse_args<std::string>("identify", args, opts, "machine", 1, vm)) return *stop;
   if (!vm.count("machine")) return usage_error("identify", "no machine given");
   if (data.empty()) return usage_error("identify", "no --data file given");
-  if (!(rank_tol > 0 && rank_tol < 1))
-    return usage_error("identify", "--rank-tol must be in (0, 1)");
   if (!predict_out.empty() && predict.empty())
     return usage_error("identify", "--predict-out needs a --predict file");
   flags.machine = vm["machine"].as<std::string>();
-  std::vector<std::string> inputs = data;
-  inputs.insert(inputs.end(), predict.begin(), predict.end());
-  check_comp_table_flags(comp, vm, inputs, true);
+  std::vector<PathArg> inputs = study_inputs(flags);
+  for (const std::string& d : data) inputs.push_back({"--data", d});
+  for (const std::string& p : predict) inputs.push_back({"--predict", p});
+  check_output_paths(inputs, {{"--json", json_path},
+                              {"--emit-params", emit},
+                              {"--predict-out", predict_out},
+                              {"--comp-table", comp.path}});
+  check_comp_table_flags(comp, vm, true);
 
   const Description desc = load_machine_file(resolve_machine(flags.machine));
   if (!comp.path.empty()) check_axis_comp_table(desc, comp.options);
@@ -92,6 +95,7 @@ int verb_identify(const Args& args) {
   j["predictions"] = nlohmann::json::array();
   for (std::size_t i = 0; i < predict.size(); ++i) {
     const MeasurementTable t = read_measurements(predict[i], ro);
+    for (const auto& w : t.warnings) std::cerr << w << "\n";
     if (is_ballbar_table(t)) {
       if (i + 1 == predict.size() && !predict_out.empty())
         throw std::invalid_argument("--predict-out: " + predict[i] +

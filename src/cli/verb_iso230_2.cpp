@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "comp_table.hpp"
+#include "flags.hpp"
 #include "verbs.hpp"
 #include "weilgen/base/atomic_file.hpp"
 #include "weilgen/measure/iso230_2_study.hpp"
@@ -24,20 +25,23 @@ int verb_iso230_2(const Args& args) {
       "and the deviation along the axis (dx_um for X ...); t_s gives the drift rate in um/h.\n"
       "docs/iso230-2.md, docs/data-format.md.\n\nOptions");
   std::string axis, column, json_path, plot_path;
-  double alpha = 0.01, tolerance = 1e-6;
+  double alpha = 0.01, tolerance = 1e-6, reference_position = 0;
+  long reference_cycle = 0;
   opts.add_options()("help,h", "show this help")(
       "axis", po::value<std::string>(&axis),
       "the coordinate column of the axis (default: '# axis:' header key, else the only coordinate "
       "column, else the only one that varies)")(
       "column", po::value<std::string>(&column),
       "the deviation column (default: dx_um for X, dy_um for Y, dz_um for Z, da_urad, db_urad, "
-      "dc_urad for A, B, C)")("reference-position", po::value<double>(),
+      "dc_urad for A, B, C)")("reference-position", ranged(&reference_position, NumberRange{}),
                               "drift elimination: the reference target (mm; default the lowest)")(
-      "reference-cycle", po::value<long>(),
+      "reference-cycle", ranged(&reference_cycle, NumberRange::whole_numbers(-1e15, 1e15)),
       "drift elimination: the reference cycle id (default the lowest; the seed suggests one "
-      "measured after at least 2 h)")("alpha", po::value<double>(&alpha)->default_value(alpha),
+      "measured after at least 2 h)")("alpha",
+                                      ranged(&alpha, NumberRange::open(0, 1))->default_value(alpha),
                                       "family-wise false-positive rate of the anomaly test")(
-      "target-tolerance", po::value<double>(&tolerance)->default_value(tolerance, "1e-6"),
+      "target-tolerance",
+      ranged(&tolerance, NumberRange::positive(1e3))->default_value(tolerance, "1e-6"),
       "positions closer than this (mm) are the same target")(
       "allow-unknown", "warn about unknown columns instead of failing")(
       "json", po::value<std::string>(&json_path), "write the results as JSON to FILE")(
@@ -48,20 +52,19 @@ int verb_iso230_2(const Args& args) {
   po::variables_map vm;
   if (auto stop = parse_args<std::string>("iso230-2", args, opts, "data", 1, vm)) return *stop;
   if (!vm.count("data")) return usage_error("iso230-2", "no data file given");
-  if (!(alpha > 0 && alpha < 1)) return usage_error("iso230-2", "--alpha must be in (0, 1)");
-  if (!(tolerance > 0)) return usage_error("iso230-2", "--target-tolerance must be > 0");
   const std::string data = vm["data"].as<std::string>();
+  check_output_paths({{"data file", data}},
+                     {{"--json", json_path}, {"--plot", plot_path}, {"--comp-table", comp.path}});
   if (!plot_path.empty()) check_plot_target(plot_path);
-  check_comp_table_flags(comp, vm, {data}, false);
+  check_comp_table_flags(comp, vm, false);
 
   Iso230_2StudyOptions so;
   so.axis = axis;
   so.column = column;
   so.target_tolerance_mm = tolerance;
   so.drift.alpha = alpha;
-  if (vm.count("reference-position"))
-    so.drift.reference_position_mm = vm["reference-position"].as<double>();
-  if (vm.count("reference-cycle")) so.drift.reference_cycle = vm["reference-cycle"].as<long>();
+  if (vm.count("reference-position")) so.drift.reference_position_mm = reference_position;
+  if (vm.count("reference-cycle")) so.drift.reference_cycle = reference_cycle;
   ReadOptions ro;
   ro.allow_unknown = vm.count("allow-unknown") > 0;
   const MeasurementTable table = read_measurements(data, ro);

@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <iostream>
 
+#include "flags.hpp"
 #include "verbs.hpp"
 #include "weilgen/analysis/tolerance_file.hpp"
 #include "weilgen/base/atomic_file.hpp"
@@ -60,9 +61,9 @@ int verb_linuxcnc(const Args& args) {
     }
   }
   const std::vector<gen::GeneratedFile> files = gen::linuxcnc_files(desc, o, out);
-  std::vector<std::string> inputs = {machine};
-  if (!params.empty()) inputs.push_back(params);
-  for (const auto& f : files) check_output_target(f.path, inputs, "--out");
+  std::vector<PathArg> outputs;
+  for (const auto& f : files) outputs.push_back({"--out", f.path});
+  check_output_paths({{"machine file", machine}, {"--params", params}}, outputs);
   for (const auto& f : files) {
     write_file_atomically(f.path, f.contents);
     std::cout << "wrote " << f.path << "\n";

@@ -24,9 +24,9 @@ int verb_reliability(const Args& args) {
   StudyFlags f;
   ReliabilityFlags rf;
   std::size_t top = 5;
-  opts.add_options()("help,h", "show this help")("top",
-                                                 po::value<std::size_t>(&top)->default_value(top),
-                                                 "sensitive errors listed per output");
+  opts.add_options()("help,h", "show this help")(
+      "top", ranged(&top, NumberRange::whole_numbers(0, 1e9))->default_value(top),
+      "sensitive errors listed per output");
   add_reliability_options(opts, rf);
   add_study_options(opts, f, true);
   po::variables_map vm;
@@ -34,6 +34,7 @@ int verb_reliability(const Args& args) {
     return *stop;
   if (vm.count("machine")) f.machine = vm["machine"].as<std::string>();
   const ReliabilitySettings settings = parse_reliability_flags(rf, f.seed);
+  check_output_paths(study_inputs(f), study_outputs(f));
   if (!f.plot.empty()) check_plot_target(f.plot);  // before a long run, not after
   const Study st = open_study(f, true);
   Progress progress("reliability", st.tolerances.size() * st.poses.poses.size(), f.quiet);

@@ -3,6 +3,7 @@
 // report/sensitivity_document; JSON schema and method: docs/sensitivity.md.
 #include <iostream>
 
+#include "flags.hpp"
 #include "study.hpp"
 #include "verbs.hpp"
 #include "weilgen/analysis/sensitivity_study.hpp"
@@ -33,16 +34,18 @@ int verb_sensitivity(const Args& args) {
       "local | sobol | exact | all")(
       "outputs", po::value<std::string>(&outputs_text)->default_value(outputs_text),
       "outputs to analyse, comma-separated")(
-      "samples", po::value<std::size_t>(&samples)->default_value(samples),
+      "samples",
+      ranged(&samples, NumberRange::whole_numbers(2, 4294967295.0))->default_value(samples),
       "Sobol' base sample size N (powers of two keep the Sobol' net property); N (k+2) model "
       "evaluations per pose")(
       "sampling", po::value<std::string>(&sampling)->default_value("qmc"),
       "qmc (Sobol' points with a seeded digital shift) | mc (pseudo-random)")(
-      "bootstrap", po::value<std::size_t>(&bootstrap)->default_value(bootstrap),
+      "bootstrap", ranged(&bootstrap, NumberRange::whole_numbers(0, 1e6))->default_value(bootstrap),
       "bootstrap resamples for the confidence intervals (0 = none)")(
-      "confidence", po::value<double>(&confidence)->default_value(confidence),
-      "confidence level of the intervals")("top", po::value<std::size_t>(&top)->default_value(top),
-                                           "rows per table on stdout (0 = all)");
+      "confidence", ranged(&confidence, NumberRange::open(0, 1))->default_value(confidence),
+      "confidence level of the intervals")(
+      "top", ranged(&top, NumberRange::whole_numbers(0, 1e9))->default_value(top),
+      "rows per table on stdout (0 = all)");
   add_study_options(opts, f, false);
   po::variables_map vm;
   if (auto stop = parse_args<std::string>("sensitivity", args, opts, "machine", 1, vm))
@@ -56,16 +59,13 @@ int verb_sensitivity(const Args& args) {
   } catch (const std::invalid_argument& e) {
     return usage_error("sensitivity", e.what());
   }
-  if (!(confidence > 0 && confidence < 1))
-    return usage_error("sensitivity", "--confidence must be in (0, 1)");
-  if (so.sobol && samples < 2)
-    return usage_error("sensitivity", "--samples must be >= 2, not " + std::to_string(samples));
   so.outputs = parse_output_list(outputs_text);
   so.sobol_options.samples = samples;
   so.sobol_options.seed = f.seed;
   so.sobol_options.bootstrap = bootstrap;
   so.sobol_options.confidence = confidence;
 
+  check_output_paths(study_inputs(f), study_outputs(f));
   if (!f.plot.empty()) check_plot_target(f.plot);  // before a long run, not after
   const Study st = open_study(f, false);
   Progress progress("sensitivity", st.poses.poses.size(), f.quiet);

@@ -1,8 +1,10 @@
 #include <boost/program_options.hpp>
 #include <iostream>
 
+#include "flags.hpp"
 #include "verbs.hpp"
 #include "weilgen/codegen/emit_report.hpp"
+#include "weilgen/machine/algebra_size.hpp"
 #include "weilgen/machine/yaml_loader.hpp"
 
 namespace po = boost::program_options;
@@ -21,7 +23,8 @@ int verb_show(const Args& args) {
       "format", po::value<std::string>(&format)->default_value("text"), "text | latex | json")(
       "notation", po::value<std::string>(&notation)->default_value("iso"),
       "iso (ISO 230-1 names) | alias (each error's first alias, e.g. the paper's symbols)")(
-      "order", po::value<int>(&order), "truncation order r >= 1 overriding the file's");
+      "order", ranged(&order, NumberRange::whole_numbers(1, kMaxAlgebraOrder)),
+      "truncation order r >= 1 overriding the file's");
   po::variables_map vm;
   if (auto stop = parse_args<std::string>("show", args, opts, "machine", 1, vm)) return *stop;
   if (!vm.count("machine")) return usage_error("show", "no machine given");
@@ -29,7 +32,6 @@ int verb_show(const Args& args) {
     return usage_error("show", "--format must be text, latex or json, not '" + format + "'");
   if (notation != "iso" && notation != "alias")
     return usage_error("show", "--notation must be iso or alias, not '" + notation + "'");
-  if (vm.count("order") && order < 1) return usage_error("show", "--order must be >= 1");
   int only = -1;
   if (!output.empty()) {
     for (int o = 0; o < kNumDeviationOutputs; ++o)
@@ -37,6 +39,7 @@ int verb_show(const Args& args) {
     if (only < 0) return usage_error("show", "unknown output '" + output + "' (dx dy dz da db dc)");
   }
   const Description d = load_machine_file(resolve_machine(vm["machine"].as<std::string>()));
+  check_order(d, order, false);
   const gen::SymbolicModel m = gen::build_model(d, order);
   const gen::Notation n = notation == "iso" ? gen::Notation::Iso : gen::Notation::Alias;
   if (format == "json") {

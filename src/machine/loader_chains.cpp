@@ -12,6 +12,7 @@
 #include "loader.hpp"
 #include "weilgen/base/format.hpp"
 #include "weilgen/base/text.hpp"
+#include "weilgen/machine/algebra_size.hpp"
 #include "weilgen/machine/derived.hpp"
 #include "weilgen/machine/pdge_basis.hpp"
 
@@ -124,9 +125,17 @@ int Loader::read_order(const Field& f) const {
   int order = 0;
   const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), order);
   if (ec != std::errc() || end != s.data() + s.size()) {
-    fail(f, "order must be a whole number >= 1, got '" + s + "'");
+    fail(f, "order must be a whole number from 1 to " + std::to_string(kMaxAlgebraOrder) +
+                ", got '" + s + "'");
   }
-  if (order < 1) fail(f, "order must be >= 1, got " + s);
+  if (order < 1 || order > kMaxAlgebraOrder)
+    fail(f, "order must be a whole number from 1 to " + std::to_string(kMaxAlgebraOrder) +
+                ", got " + s);
+  try {
+    check_algebra_size(d_, order, "order " + s);  // errors are read before the algebra
+  } catch (const std::invalid_argument& e) {
+    fail(f, e.what());
+  }
   return order;
 }
 

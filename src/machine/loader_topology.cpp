@@ -108,6 +108,11 @@ Joint Loader::read_joint(const Entry& e) {
   const Field& coordinate = required(m, "coordinate").value;
   j.coordinate = identifier(coordinate, "coordinate");
   claim_symbol(j.coordinate, "coordinate", coordinate);
+  // The generated code names the cosine and sine of an angle cos_<coordinate>, sin_<coordinate>.
+  claim_symbol("cos_" + j.coordinate, "cosine of coordinate " + j.coordinate + " (generated code)",
+               coordinate);
+  claim_symbol("sin_" + j.coordinate, "sine of coordinate " + j.coordinate + " (generated code)",
+               coordinate);
   const std::vector<std::string>& units =
       j.type == JointType::Prismatic ? kPrismaticUnits : kRevoluteUnits;
   std::optional<Unit> u = table_unit(units.front());

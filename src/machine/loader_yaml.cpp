@@ -12,6 +12,7 @@
 #include "loader.hpp"
 #include "weilgen/base/format.hpp"
 #include "weilgen/base/text.hpp"
+#include "weilgen/machine/cxx_names.hpp"
 #include "weilgen/machine/derived.hpp"
 #include "weilgen/machine/pdge_basis.hpp"
 
@@ -70,6 +71,9 @@ std::string Loader::identifier(const Field& f, const std::string& what) const {
   if (!is_identifier(s)) {
     fail(f, what + " '" + s + "' is not an identifier ([A-Za-z_][A-Za-z0-9_]*)");
   }
+  // The name becomes a C++ identifier in the generated header.
+  if (const std::string why = cxx_name_problem(s); !why.empty())
+    fail(f, what + " '" + s + "' " + why + "; choose another name");
   return s;
 }
 

@@ -16,6 +16,7 @@
 #include <utility>
 
 #include "loader.hpp"
+#include "weilgen/base/atomic_file.hpp"
 #include "weilgen/base/format.hpp"
 #include "weilgen/base/text.hpp"
 #include "weilgen/base/units.hpp"
@@ -107,15 +108,11 @@ Description load_machine_text(const std::string& yaml, const std::string& filena
 }
 
 Description load_machine_file(const std::string& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) {
-    throw InputError({path, 0, 0}, "is a directory, not a machine file");
-  }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError({path, 0, 0}, "cannot read the machine file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return load_machine_text(text.str(), path);
+  std::string text;
+  if (const std::string why = unreadable_reason(path); !why.empty() || !read_file(path, text))
+    throw InputError({path, 0, 0},
+                     "cannot read the machine file: " + (why.empty() ? "read error" : why));
+  return load_machine_text(text, path);
 }
 
 Distribution read_distribution_keys(const YAML::Node& mapping, const std::string& file,
@@ -144,6 +141,8 @@ std::string resolve_machine(const std::string& name_or_path) {
   const std::string dir = shipped_machines_dir();
   const fs::path shipped = fs::path(dir) / (name_or_path + ".yaml");
   if (is_identifier(name_or_path) && fs::is_regular_file(shipped, ec)) return shipped.string();
+  // Anything else that exists (a directory, a device): load_machine_file says what it is.
+  if (fs::exists(name_or_path, ec)) return name_or_path;
   std::vector<std::string> names;
   for (const auto& entry : fs::directory_iterator(dir, ec)) {
     if (entry.path().extension() == ".yaml") names.push_back(entry.path().stem().string());

@@ -578,7 +578,7 @@ std::vector<BallbarTrace> ballbar_traces(const MeasurementTable& table,
   for (std::size_t i = 0; i < table.rows(); ++i) {
     if (std::isnan(dr[i])) continue;  // not measured
     if (std::isnan(angle[i])) {
-      throw InputError(SourceLoc{table.file, table.lines[i], 0},
+      throw InputError(table.cell(i, "angle_deg"),
                        "ballbar: angle_deg is empty in a row with dr_um (every measured point "
                        "needs its angle)");
     }

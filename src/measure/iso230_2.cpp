@@ -62,11 +62,15 @@ double student_coverage_factor(std::size_t dof, double k_normal) {
 
 // ---- Grouping --------------------------------------------------------------------------------
 
-IsoRuns group_iso_runs(const std::vector<IsoObservation>& obs, const std::string& file,
+IsoRuns group_iso_runs(const std::vector<IsoObservation>& observations, const std::string& file,
                        double tolerance_mm) {
   auto fail = [&](int line, const std::string& msg) {
     return InputError(SourceLoc{file, line, 0}, msg);
   };
+  // Blanks (an empty deviation cell) only locate a missing observation.
+  std::vector<IsoObservation> obs, blanks;
+  for (const IsoObservation& o : observations)
+    (std::isnan(o.deviation) ? blanks : obs).push_back(o);
   if (obs.empty()) throw fail(0, "no observations (no row has a measured deviation)");
   IsoRuns runs;
   runs.file = file;
@@ -159,6 +163,15 @@ IsoRuns group_iso_runs(const std::vector<IsoObservation>& obs, const std::string
         runs.t[d][i][j] = obs[it->second].time_s;
         if (!std::isfinite(obs[it->second].time_s)) runs.has_time = false;
       }
+      for (const IsoObservation& b : blanks)
+        if ((b.direction > 0) == (d == kUp) &&
+            std::abs(b.position_mm - runs.positions_mm[i]) <= tolerance_mm &&
+            std::find(missing.begin(), missing.end(), b.cycle) != missing.end())
+          throw InputError(SourceLoc{file, b.line, b.column},
+                           "the deviation is empty, but it is the observation of target " +
+                               mm(runs.positions_mm[i]) + ", direction " + dir_name(d) +
+                               ", cycle " + std::to_string(b.cycle) +
+                               " (every target of a direction needs every cycle)");
       if (!missing.empty())
         throw fail(std::max(first_line[d][i], 0),
                    "target " + mm(runs.positions_mm[i]) + ", direction " + dir_name(d) +
@@ -260,11 +273,26 @@ std::vector<IsoObservation> iso_observations(const MeasurementTable& table, cons
   const std::vector<double>* time = c.time.empty() ? nullptr : &table.column(c.time);
   std::vector<IsoObservation> out;
   for (std::size_t r = 0; r < table.rows(); ++r) {
-    if (std::isnan(dev[r])) continue;  // not measured
     const int line = table.lines[r];
+    if (std::isnan(dev[r])) {
+      // Not measured. Kept as a blank when the row names its target, direction and cycle, so
+      // that a run missing that observation points at this empty cell.
+      if (!std::isnan(pos[r]) && !std::isnan(dir[r]) && !std::isnan(cyc[r]) &&
+          std::abs(cyc[r]) <= 1e15) {
+        IsoObservation blank;
+        blank.position_mm = pos[r];
+        blank.direction = dir[r] > 0 ? 1 : -1;
+        blank.cycle = static_cast<long>(cyc[r]);
+        blank.deviation = kNaN;
+        blank.line = line;
+        blank.column = table.cell(r, c.deviation).column;
+        out.push_back(blank);
+      }
+      continue;
+    }
     auto need = [&](double v, const std::string& name) {
       if (std::isnan(v))
-        throw InputError(SourceLoc{table.file, line, 0},
+        throw InputError(table.cell(r, name),
                          "column '" + name + "' is empty but '" + c.deviation +
                              "' is measured (every observation needs its position, direction "
                              "and cycle)");
@@ -273,7 +301,7 @@ std::vector<IsoObservation> iso_observations(const MeasurementTable& table, cons
     need(dir[r], c.direction);
     need(cyc[r], c.cycle);
     if (std::abs(cyc[r]) > 1e15)
-      throw InputError(SourceLoc{table.file, line, 0}, "column 'cycle': value out of range");
+      throw InputError(table.cell(r, c.cycle), "column 'cycle': value out of range");
     IsoObservation o;
     o.position_mm = pos[r];
     o.direction = dir[r] > 0 ? 1 : -1;

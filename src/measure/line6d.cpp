@@ -325,8 +325,7 @@ Line6dData line6d_from_table(const MeasurementTable& table, const Line6dOptions&
   const std::vector<double>& pos = table.column(axis);
   for (std::size_t i = 0; i < pos.size(); ++i) {
     if (std::isnan(pos[i])) {
-      throw InputError(SourceLoc{table.file, table.lines[i], 0},
-                       "line6d: the position '" + axis + "' is empty");
+      throw InputError(table.cell(i, axis), "line6d: the position '" + axis + "' is empty");
     }
   }
   const std::vector<std::string> iso = line6d_iso_errors(axis);
@@ -370,8 +369,7 @@ Line6dData line6d_from_table(const MeasurementTable& table, const Line6dOptions&
     const std::vector<double>& c = table.column("cycle");
     for (std::size_t i = 0; i < c.size(); ++i) {
       if (std::isnan(c[i]) || c[i] != std::floor(c[i])) {
-        throw InputError(SourceLoc{table.file, table.lines[i], 0},
-                         "line6d: the cycle must be a whole number");
+        throw InputError(table.cell(i, "cycle"), "line6d: the cycle must be a whole number");
       }
       d.cycle.push_back(static_cast<int>(c[i]));
     }

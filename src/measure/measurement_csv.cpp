@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "weilgen/base/atomic_file.hpp"
+#include "weilgen/base/format.hpp"
 #include "weilgen/base/text.hpp"
 
 namespace weilgen {
@@ -154,6 +155,14 @@ const std::vector<double>& MeasurementTable::column(const std::string& name) con
   return it->second;
 }
 
+SourceLoc MeasurementTable::cell(std::size_t row, const std::string& name) const {
+  SourceLoc at{file, row < lines.size() ? lines[row] : 0, 0};
+  for (std::size_t c = 0; c < columns.size(); ++c)
+    if (columns[c] == name && row < cell_columns.size() && c < cell_columns[row].size())
+      at.column = cell_columns[row][c];
+  return at;
+}
+
 const ColumnInfo& MeasurementTable::info_of(const std::string& name) const {
   for (std::size_t i = 0; i < columns.size(); ++i)
     if (columns[i] == name) return info[i];
@@ -173,6 +182,65 @@ std::string MeasurementTable::header_key(const std::string& key,
   const auto it = header_keys.find(key);
   return it == header_keys.end() ? fallback : it->second;
 }
+
+namespace {
+
+// The checks that need every row: the machine named in the header, values that cannot be real,
+// coordinates outside the travel (docs/data-format.md, "Checks on values").
+void check_values(MeasurementTable& t, const ReadOptions& o) {
+  const auto where = [&](std::size_t row, std::size_t c) {
+    return SourceLoc{t.file, t.lines[row], t.cell_columns[row][c]};
+  };
+  if (!o.machine.empty() && t.header_keys.count("machine") &&
+      t.header_keys.at("machine") != o.machine)
+    throw InputError(SourceLoc{t.file, t.header_key_lines.at("machine"), 0},
+                     "'# machine: " + t.header_keys.at("machine") + "', but the machine given is " +
+                         o.machine + ": these data were recorded on another machine");
+  std::size_t warned = 0, more = 0;
+  const auto warn = [&](const SourceLoc& at, const std::string& message) {
+    if (warned++ < 5)
+      t.warnings.push_back(at.str() + ": warning: " + message);
+    else
+      ++more;
+  };
+  for (std::size_t c = 0; c < t.columns.size(); ++c) {
+    const ColumnInfo& info = t.info[c];
+    const std::vector<double>& v = t.values.at(t.columns[c]);
+    const ReadOptions::Travel* travel = nullptr;
+    for (const auto& r : o.travel)
+      if (r.coordinate == t.columns[c] && r.min < r.max) travel = &r;
+    for (std::size_t row = 0; row < v.size(); ++row) {
+      const double x = v[row];
+      if (std::isnan(x)) continue;
+      const std::string cell = "column '" + t.columns[c] + "': " + format_short(x);
+      if ((info.role == ColumnRole::Deviation || info.role == ColumnRole::Radial) &&
+          std::fabs(x) > kImplausibleDeviation) {
+        if (std::fabs(x) > kImpossibleDeviation)
+          throw InputError(where(row, c), cell + " " + info.unit +
+                                              " is impossible for a machine-tool deviation "
+                                              "(more than 1 m or 1 rad): check the unit");
+        warn(where(row, c), cell + " " + info.unit +
+                                " is implausibly large for a deviation (more than 10 mm or "
+                                "10 mrad): check the unit");
+      }
+      if (info.role == ColumnRole::Coordinate && std::fabs(x) > kImpossibleCoordinate)
+        throw InputError(where(row, c), cell + " is impossible for a coordinate (more than " +
+                                            format_short(kImpossibleCoordinate) + " " + info.unit +
+                                            ")");
+      if (info.role == ColumnRole::Temperature && x < -273.15)
+        throw InputError(where(row, c), cell + " °C is below absolute zero");
+      if (travel && (x < travel->min || x > travel->max))
+        warn(where(row, c), cell + " " + travel->unit + " is outside the travel range [" +
+                                format_short(travel->min) + ", " + format_short(travel->max) +
+                                "] " + travel->unit + " of machine " + o.machine);
+    }
+  }
+  if (more > 0)
+    t.warnings.push_back(t.file + ": warning: " + std::to_string(more) +
+                         " more value(s) like those above");
+}
+
+}  // namespace
 
 MeasurementTable parse_measurements(const std::string& text, const std::string& filename,
                                     const ReadOptions& options) {
@@ -267,7 +335,8 @@ MeasurementTable parse_measurements(const std::string& text, const std::string& 
       if (!f.text.empty()) {
         std::string why;
         if (!parse_number(f.text, v, why))
-          throw fail(line_no, f.column, "column '" + name + "': '" + f.text + "' " + why);
+          throw fail(line_no, f.column,
+                     "column '" + name + "': '" + abbreviated(f.text) + "' " + why);
         const ColumnRole role = t.info[i].role;
         if (role == ColumnRole::Direction && v != 1.0 && v != -1.0)
           throw fail(line_no, f.column, "column '" + name + "': '" + f.text + "' must be +1 or -1");
@@ -278,16 +347,21 @@ MeasurementTable parse_measurements(const std::string& text, const std::string& 
       t.values[name].push_back(v);
     }
     t.lines.push_back(line_no);
+    t.cell_columns.emplace_back();
+    for (const Field& f : fields) t.cell_columns.back().push_back(f.column);
   }
   if (!header_seen)
     throw fail(0, 0, line_no == 0 ? "empty file" : "no header row (only comments and blank lines)");
   if (t.lines.empty()) throw fail(t.header_line, 0, "no data rows after the header");
+  check_values(t, options);
   return t;
 }
 
 MeasurementTable read_measurements(const std::string& path, const ReadOptions& options) {
   std::string text;
-  if (!read_file(path, text)) throw InputError(SourceLoc{path, 0, 0}, "cannot read file");
+  if (const std::string why = unreadable_reason(path); !why.empty() || !read_file(path, text))
+    throw InputError(SourceLoc{path, 0, 0},
+                     "cannot read the data file: " + (why.empty() ? "read error" : why));
   return parse_measurements(text, path, options);
 }
 
@@ -296,6 +370,11 @@ ReadOptions machine_read_options(const Description& desc, bool allow_unknown) {
   for (int b : desc.axes())
     ro.coordinates.push_back(desc.bodies[static_cast<std::size_t>(b)].joint.coordinate);
   ro.allow_unknown = allow_unknown;
+  ro.machine = desc.name;
+  for (int b : desc.axes()) {
+    const Joint& j = desc.bodies[static_cast<std::size_t>(b)].joint;
+    ro.travel.push_back({j.coordinate, j.unit, j.min, j.max});
+  }
   return ro;
 }
 

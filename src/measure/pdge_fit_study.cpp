@@ -3,13 +3,27 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <tuple>
 
+#include "weilgen/base/range.hpp"
 #include "weilgen/measure/line6d.hpp"
 #include "weilgen/measure/measurement_csv.hpp"
 
 namespace weilgen {
 
 namespace {
+
+// --travel a:b (mm), a < b.
+std::pair<double, double> parse_travel(const std::string& travel) {
+  const auto colon = travel.find(':');
+  if (colon == std::string::npos)
+    throw std::invalid_argument("--travel: \"" + travel + "\": expected a:b in mm");
+  const double a = parse_number_in(travel.substr(0, colon), NumberRange{}, "--travel");
+  const double b = parse_number_in(travel.substr(colon + 1), NumberRange{}, "--travel");
+  if (!(a < b))
+    throw std::invalid_argument("--travel: \"" + travel + "\": the start must be below the end");
+  return {a, b};
+}
 
 std::vector<std::string> split_list(const std::vector<std::string>& items) {
   std::vector<std::string> out;
@@ -56,11 +70,12 @@ std::vector<BasisSpec> parse_bases(const std::vector<std::string>& flags, const 
   } else if (period != "travel") {
     std::string p = period;
     if (p.size() > 2 && p.compare(p.size() - 2, 2, "mm") == 0) p.resize(p.size() - 2);
-    char* end = nullptr;
-    period_mm = std::strtod(p.c_str(), &end);
-    if (p.empty() || *end != '\0' || !std::isfinite(period_mm) || period_mm <= 0)
+    try {
+      period_mm = parse_number_in(p, NumberRange::positive(), "--period");
+    } catch (const std::invalid_argument&) {
       throw std::invalid_argument("--period: \"" + period +
                                   "\": expected a length > 0 in mm, auto or travel");
+    }
   }
   std::vector<BasisSpec> specs;
   for (const std::string& s : expanded) {
@@ -96,6 +111,7 @@ void PdgeFitStudyOptions::validate() const {
   if (min_order < 0 || max_order < min_order)
     throw std::invalid_argument("--min-order/--max-order: need 0 <= min <= max");
   if (folds < 2) throw std::invalid_argument("--folds must be >= 2");
+  if (!travel.empty()) parse_travel(travel);
 }
 
 PdgeFitStudy::PdgeFitStudy(PdgeFitStudyOptions options) : options_(std::move(options)) {
@@ -121,6 +137,7 @@ PdgeFitStudyResult PdgeFitStudy::run(const std::string& path) const {
     if (is_line6d(head)) {
       format = "line6d";
       const MeasurementTable table = read_measurements(path, line6d_read_options());
+      r.warnings = table.warnings;
       Line6dOptions lo;
       lo.remove_straightness_line = !o.keep_line;
       lo.angular = o.angular == "mean" ? AngularReference::Mean : AngularReference::None;
@@ -148,6 +165,7 @@ PdgeFitStudyResult PdgeFitStudy::run(const std::string& path) const {
       r.line6d_spelling = d.spelling;
     } else {
       const MeasurementTable table = read_measurements(path);
+      r.warnings = table.warnings;
       rows = table.rows();
       pos_name = o.axis.empty() ? head.header_key("axis") : o.axis;
       if (pos_name.empty()) {
@@ -209,15 +227,7 @@ PdgeFitStudyResult PdgeFitStudy::run(const std::string& path) const {
   double& b = r.travel_b;
   a = INFINITY, b = -INFINITY;
   if (!o.travel.empty()) {
-    const auto colon = o.travel.find(':');
-    char* e1 = nullptr;
-    char* e2 = nullptr;
-    const std::string sa = o.travel.substr(0, colon);
-    const std::string sb = colon == std::string::npos ? "" : o.travel.substr(colon + 1);
-    a = std::strtod(sa.c_str(), &e1);
-    b = std::strtod(sb.c_str(), &e2);
-    if (colon == std::string::npos || sa.empty() || sb.empty() || *e1 || *e2)
-      throw std::invalid_argument("--travel: \"" + o.travel + "\": expected a:b in mm");
+    std::tie(a, b) = parse_travel(o.travel);
   } else {
     for (const PdgeProfile& p : profiles)
       for (double v : p.x) a = std::min(a, v), b = std::max(b, v);

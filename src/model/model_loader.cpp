@@ -1,6 +1,7 @@
 #include "weilgen/model/model_loader.hpp"
 
 #include <dlfcn.h>
+#include <pwd.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -10,6 +11,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "model_cache.hpp"
 #include "weilgen/base/atomic_file.hpp"
 #include "weilgen/machine/model_key.hpp"
 
@@ -62,8 +64,7 @@ std::string compile_model(const Description& desc, int order, const std::string&
   const auto t0 = std::chrono::steady_clock::now();
   const GeneratedHeader header = options.generate(desc, order);
   std::error_code ec;
-  fs::create_directories(cache, ec);
-  if (ec) throw std::runtime_error("cannot create the model cache " + cache + ": " + ec.message());
+  model_cache::create_directory(cache);
   const fs::path work = fs::path(cache) / ("build-" + key + "-" + std::to_string(::getpid()));
   fs::create_directories(work, ec);
   if (ec) throw std::runtime_error("cannot create " + work.string() + ": " + ec.message());
@@ -106,8 +107,11 @@ std::string compile_model(const Description& desc, int order, const std::string&
                              text);
   }
   const fs::path target = fs::path(cache) / (desc.name + "-" + key + ".so");
-  fs::rename(so_tmp, target, ec);  // atomic: concurrent runs never see a partial object
-  if (ec) throw std::runtime_error("cannot move the compiled model to " + target.string());
+  std::string object;
+  if (!read_file(so_tmp.string(), object))
+    throw std::runtime_error("cannot read the compiled model " + so_tmp.string());
+  // With its checksum, fsync'ed, renamed into place: concurrent runs never see a partial object.
+  model_cache::store_entry(object, target.string());
   if (options.log) {
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::ostringstream msg;
@@ -124,7 +128,10 @@ std::string default_cache_dir() {
   if (const std::string d = env("WEILGEN_CACHE_DIR"); !d.empty()) return d;
   if (const std::string d = env("XDG_CACHE_HOME"); !d.empty()) return d + "/weilgen";
   if (const std::string h = env("HOME"); !h.empty()) return h + "/.cache/weilgen";
-  return (fs::temp_directory_path() / "weilgen-cache").string();
+  // No environment: the account's home, else a per-user directory in /tmp (checked like any).
+  if (const passwd* pw = ::getpwuid(::geteuid()); pw && pw->pw_dir && *pw->pw_dir)
+    return std::string(pw->pw_dir) + "/.cache/weilgen";
+  return "/tmp/weilgen-cache-" + std::to_string(::geteuid());
 }
 
 std::string find_compiler(const std::string& requested) {
@@ -154,8 +161,23 @@ std::shared_ptr<Model> load_model(const Description& desc, const LoadOptions& op
 
   const std::string cache = options.cache_dir.empty() ? default_cache_dir() : options.cache_dir;
   const fs::path cached = fs::path(cache) / (desc.name + "-" + key + ".so");
-  std::error_code ec;
-  if (fs::is_regular_file(cached, ec)) return open_shared_object(desc, cached, key, "cached");
+  // Nothing is loaded from a directory others could have written.
+  model_cache::check_directory(cache);
+  std::string damage;
+  switch (model_cache::check_entry(cached.string(), damage)) {
+    case model_cache::EntryState::Intact:
+      return open_shared_object(desc, cached, key, "cached");
+    case model_cache::EntryState::Damaged: {
+      std::error_code ec;
+      fs::remove(cached, ec);
+      if (options.log)
+        options.log("note: the cached model " + cached.string() + " " + damage +
+                    "; discarded, it is compiled again");
+      break;
+    }
+    case model_cache::EntryState::Missing:
+      break;
+  }
 
   const std::string compiler = find_compiler(options.compiler);
   if (compiler.empty()) {

@@ -101,6 +101,12 @@ void ReliabilityOptions::validate() const {
     throw std::invalid_argument("reliability: FORM needs max iterations >= 1 and a tolerance > 0");
 }
 
+double reliability_memory_bytes(const ReliabilityOptions& o, std::size_t inputs) {
+  // Importance sampling keeps, per block of 64 lines, two derivative vectors and its moments.
+  const double blocks = static_cast<double>(o.samples) / 64 + 1;
+  return blocks * (16 * static_cast<double>(inputs) + 128);
+}
+
 ReliabilityAnalysis::ReliabilityAnalysis(ReliabilityOptions options)
     : options_(std::move(options)) {
   options_.validate();

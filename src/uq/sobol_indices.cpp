@@ -93,6 +93,17 @@ void SobolOptions::validate() const {
     throw std::invalid_argument("Sobol' design: the sample size N must be below 2^32");
 }
 
+double sobol_memory_bytes(const SobolOptions& o, std::size_t inputs, std::size_t outputs) {
+  const double n = static_cast<double>(o.samples), k = static_cast<double>(inputs);
+  const double r = static_cast<double>(o.bootstrap), m = static_cast<double>(outputs);
+  return 16 * n * k                       // A and B
+         + 2 * (r + 1) * n                // resample multiplicities (uint16)
+         + 16 * n * m                     // f(A), f(B)
+         + 8 * m * (r + 1) * (2 + 2 * k)  // accumulators
+         + 8 * m * 2 * k * r              // bootstrap replicates
+         + 8 * 4096 * k * m;              // a tile of f(A_B^i)
+}
+
 SobolAnalysis::SobolAnalysis(SobolOptions options) : options_(std::move(options)) {
   options_.validate();
 }

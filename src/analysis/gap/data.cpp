@@ -37,8 +37,7 @@ PointData ballbar_points(const MeasurementTable& t, const Description& desc,
   for (std::size_t r = 0; r < t.rows(); ++r) {
     if (!std::isfinite(dr[r])) continue;
     if (!std::isfinite(angle[r]))
-      throw InputError(SourceLoc{t.file, t.lines[r], 0},
-                       "column 'angle_deg' is empty but dr_um is measured");
+      throw InputError(t.cell(r, "angle_deg"), "column 'angle_deg' is empty but dr_um is measured");
     p.poses[r] = ballbar_pose(machine, *circle, angle[r]);
     PointObservation ob;
     ob.row = r;
@@ -99,7 +98,7 @@ GapData gap_data(const MeasurementTable& table, const Description& desc,
         distinct(v) >= 5) {
       std::size_t r = 0;
       while (r < v.size() && !(std::isfinite(v[r]) && v[r] == hi)) ++r;
-      throw InputError(SourceLoc{t.file, r < v.size() ? t.lines[r] : t.header_line, 0},
+      throw InputError(r < v.size() ? t.cell(r, j.coordinate) : SourceLoc{t.file, t.header_line, 0},
                        "column '" + j.coordinate +
                            "' looks like radians: every value lies within "
                            "±2π (" +

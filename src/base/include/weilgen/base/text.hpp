@@ -2,6 +2,7 @@
 // Numbers are formatted in weilgen/base/format.hpp.
 #pragma once
 
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -17,5 +18,8 @@ std::string trim(const std::string& s);
 std::vector<std::string> split(const std::string& s, char sep);
 // "\"text\"" for messages.
 std::string quoted(const std::string& s);
+// `s` cut to at most `max` characters with "..." for messages that quote user text (a 200 kB
+// expression is shown by its start).
+std::string abbreviated(const std::string& s, std::size_t max = 60);
 
 }  // namespace weilgen

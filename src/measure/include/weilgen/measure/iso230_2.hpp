@@ -31,6 +31,7 @@ struct IsoObservation {
   double deviation = 0;    // x_ij = actual - target (um)
   double time_s = std::numeric_limits<double>::quiet_NaN();  // optional
   int line = 0;  // 1-based source line (messages), 0 when not from a file
+  int column = 0;  // 1-based source column of the deviation cell (messages), 0 when unknown
 };
 
 // Index of a direction in the per-direction arrays: 0 = up (+1), 1 = down (-1).
@@ -51,7 +52,8 @@ struct IsoRuns {
 // Groups observations: targets are position values equal within `tolerance_mm` (the target is
 // their mean). Throws InputError (file:line) for: a (target, direction, cycle) observed twice,
 // fewer than 2 cycles at a target in a direction, a target missing in one direction, cycles
-// missing at some targets of a direction, no observations.
+// missing at some targets of a direction, no observations. Observations with a NaN deviation
+// (blanks: an empty cell) count for nothing but locate a missing observation (file:line:column).
 IsoRuns group_iso_runs(const std::vector<IsoObservation>& observations, const std::string& file,
                        double tolerance_mm = 1e-6);
 
@@ -73,8 +75,9 @@ struct IsoColumns {
 IsoColumns iso_columns(const MeasurementTable& table, const std::string& axis = "",
                        const std::string& deviation_column = "");
 
-// The observations of `columns` (rows whose deviation cell is empty are "not measured" and
-// skipped); an empty position, direction or cycle cell is an InputError naming its line.
+// The observations of `columns`. A row whose deviation cell is empty is "not measured": a blank
+// (NaN deviation, for group_iso_runs' messages) when it names target, direction and cycle, else
+// skipped; an empty position, direction or cycle cell is an InputError naming its cell.
 std::vector<IsoObservation> iso_observations(const MeasurementTable& table,
                                              const IsoColumns& columns);
 

@@ -54,7 +54,24 @@ struct ReadOptions {
   // false: unknown columns are an InputError listing them and the known roles; true: each unknown
   // column is reported in MeasurementTable::warnings and kept in `values` (role Unknown).
   bool allow_unknown = false;
+  // The machine the data are read for (machine_read_options): a '# machine:' header naming
+  // another machine is an InputError; a coordinate outside its joint's travel range (in the
+  // joint's unit) is a warning naming the cell.
+  std::string machine;
+  struct Travel {
+    std::string coordinate, unit;
+    double min = 0, max = 0;
+  };
+  std::vector<Travel> travel;
 };
+
+// Plausibility limits of measured values (docs/data-format.md, "Checks on values"): a deviation
+// above kImplausibleDeviation (µm or µrad: 10 mm, 10 mrad) is a warning, above
+// kImpossibleDeviation (1 m, 1 rad: far outside any linear error model) an error; a coordinate
+// above kImpossibleCoordinate (mm or deg) and a temperature below absolute zero are errors.
+constexpr double kImplausibleDeviation = 1e4;
+constexpr double kImpossibleDeviation = 1e6;
+constexpr double kImpossibleCoordinate = 1e7;
 
 // The options of a verb that knows the machine: its independent coordinates are the coordinate
 // columns.
@@ -70,12 +87,16 @@ struct MeasurementTable {
   std::map<std::string, int> header_key_lines;        // key -> its 1-based source line
   int header_line = 0;                                // 1-based line of the header row
   std::vector<std::string> warnings;  // "file:line: unknown column 'foo' ..." (allow_unknown)
+  std::vector<std::vector<int>> cell_columns;  // per row, each cell's 1-based source column
 
   std::size_t rows() const { return lines.size(); }
   bool has(const std::string& column) const { return values.count(column) != 0; }
   // The column's values; throws InputError "file: missing column 'dx_um' (columns: X, dir, ...)"
   // when absent.
   const std::vector<double>& column(const std::string& name) const;
+  // Where the cell of `row` in `column` is: file:line:column (the column 0 when unknown), for
+  // messages about one cell, e.g. an empty one.
+  SourceLoc cell(std::size_t row, const std::string& column) const;
   // The classification of a column present in the table (throws like column()).
   const ColumnInfo& info_of(const std::string& name) const;
   // Names of the columns with this role, in file order.

@@ -62,6 +62,7 @@ struct PdgeFitStudyResult {
   std::vector<std::vector<PdgeFitResult>> results;
   std::vector<std::vector<std::string>> failures;
   std::size_t failed = 0;
+  std::vector<std::string> warnings;  // the reader's (implausible values), for stderr
 };
 
 class PdgeFitStudy {

@@ -86,6 +86,10 @@ struct ReliabilityOptions {
   void validate() const;
 };
 
+// Bytes one ReliabilityAnalysis::run of `inputs` inputs holds at once (per-block sums of the
+// importance-sampling lines and their derivatives): checked before a run.
+double reliability_memory_bytes(const ReliabilityOptions& options, std::size_t inputs);
+
 struct DesignPoint {
   // u and alpha are indexed like the inputs (0 for constant inputs); x holds every input.
   std::vector<double> u, x;

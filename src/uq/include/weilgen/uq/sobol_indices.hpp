@@ -27,6 +27,10 @@ struct SobolOptions {
   void validate() const;
 };
 
+// Bytes a SobolAnalysis of `inputs` inputs and `outputs` outputs holds at once with these options
+// (design, resample multiplicities, f(A), f(B), accumulators, replicates): checked before a run.
+double sobol_memory_bytes(const SobolOptions& options, std::size_t inputs, std::size_t outputs);
+
 // Matrices A and B (N x k each, row-major, already mapped through each input's quantile:
 // x = F^-1(u)). Built once and reused for many poses/outputs: evaluating a model is the cost,
 // not sampling.

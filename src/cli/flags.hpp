@@ -1,0 +1,97 @@
+// The CLI's checks of what a command line asks for, shared by every verb (and by verbs other
+// developers add): numeric flags read strictly and range-checked as they are parsed, output
+// paths that must not be inputs, the algebra order. Every refusal is a std::invalid_argument or
+// a boost::program_options error naming the flag: exit 2, before anything is computed or written.
+#pragma once
+
+#include <boost/program_options.hpp>
+#include <charconv>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "weilgen/base/range.hpp"
+#include "weilgen/machine/description.hpp"
+
+namespace weilgen::cli {
+
+// A numeric flag value: the whole token is the number (no "12abc"; "-1" is no unsigned), NaN and
+// infinities are refused, and the number must lie in `range`. A bad value stops the parse with
+// "--bootstrap: '-1' is out of range (allowed: a whole number from 0 to 100000)".
+template <typename T>
+class RangedValue : public boost::program_options::typed_value<T> {
+ public:
+  RangedValue(T* store, NumberRange range)
+      : boost::program_options::typed_value<T>(store), range_(range) {
+    if (std::is_integral_v<T>) range_.whole = true;
+  }
+
+  void xparse(boost::any& value_store, const std::vector<std::string>& tokens) const override {
+    namespace po = boost::program_options;
+    const std::string& text = po::validators::get_single_string(tokens);
+    try {
+      value_store = boost::any(read(text));
+    } catch (const std::invalid_argument& e) {
+      // Boost puts the flag's name in place of %canonical_option%.
+      throw po::error_with_option_name(e.what());
+    }
+  }
+
+ private:
+  T read(const std::string& text) const {
+    const char* what = "%canonical_option%";
+    if constexpr (std::is_integral_v<T>) {
+      T v{};
+      const char* first = text.data() + (text.size() > 1 && text[0] == '+' ? 1 : 0);
+      const auto [end, ec] = std::from_chars(first, text.data() + text.size(), v);
+      if (ec == std::errc() && end == text.data() + text.size() &&
+          range_.contains(static_cast<double>(v)))
+        return v;
+      // Out of range, or not a plain integer of T ("-1" unsigned, "1e3", "2.5", "abc"): read as
+      // a number (which says what is wrong), then keep it only when T holds it.
+      const double d = parse_number_in(text, range_, what);
+      if (d >= static_cast<double>(std::numeric_limits<T>::min()) &&
+          d < static_cast<double>(std::numeric_limits<T>::max()))
+        return static_cast<T>(d);
+      throw std::invalid_argument(std::string(what) + ": '" + text +
+                                  "' is out of range (allowed: " + range_.text() + ")");
+    } else {
+      return static_cast<T>(parse_number_in(text, range_, what));
+    }
+  }
+
+  NumberRange range_;
+};
+
+template <typename T>
+RangedValue<T>* ranged(T* store, NumberRange range) {
+  return new RangedValue<T>(store, range);
+}
+
+// --threads: 0 (every core) to 1024.
+NumberRange thread_range();
+
+// A file a command reads or writes, and the flag that names it ("" for a positional argument,
+// e.g. the machine or data file).
+struct PathArg {
+  std::string flag;  // "--json", "--data", "machine file"
+  std::string path;
+};
+
+// Refuses (std::invalid_argument, exit 2) an output that is one of the inputs or another output
+// (compared as canonical paths, so ./a.csv, a.csv and a symbolic link to it are the same file),
+// and an output that is an existing directory. Empty paths are skipped.
+void check_output_paths(const std::vector<PathArg>& inputs, const std::vector<PathArg>& outputs);
+
+// An output directory (gap --plot DIR): refused when it is an input or an existing file, or
+// cannot be created.
+void check_output_dir(const std::vector<PathArg>& inputs, const PathArg& dir);
+
+// The algebra order asked by --order (0 = the file's): refuses a model too large to generate
+// (exit 2, with the estimate of its terms) and prints a warning with the estimate for a large one
+// to stderr (unless quiet).
+void check_order(const Description& desc, int order, bool quiet);
+
+}  // namespace weilgen::cli
