@@ -4,10 +4,13 @@
 #include <iostream>
 
 #include "comp_table.hpp"
+#include "iso_flags.hpp"
 #include "verbs.hpp"
 #include "weilgen/base/atomic_file.hpp"
 #include "weilgen/measure/iso230_2_study.hpp"
 #include "weilgen/report/iso230_2_document.hpp"
+#include "weilgen/report/iso230_2_html.hpp"
+#include "weilgen/report/measurement_document.hpp"
 
 namespace po = boost::program_options;
 
@@ -45,6 +48,8 @@ int verb_iso230_2(const Args& args) {
       "draw the deviation charts to FILE.png or FILE.svg (gnuplot)");
   CompTableFlags comp;
   opts.add(comp_table_options(comp, false));
+  IsoFlags iso;
+  opts.add(iso_options(iso));
   po::variables_map vm;
   if (auto stop = parse_args<std::string>("iso230-2", args, opts, "data", 1, vm)) return *stop;
   if (!vm.count("data")) return usage_error("iso230-2", "no data file given");
@@ -53,6 +58,9 @@ int verb_iso230_2(const Args& args) {
   const std::string data = vm["data"].as<std::string>();
   if (!plot_path.empty()) check_plot_target(plot_path);
   check_comp_table_flags(comp, vm, {data}, false);
+  ImportOptions io;
+  io.read.allow_unknown = vm.count("allow-unknown") > 0;
+  io.axis = axis;
 
   Iso230_2StudyOptions so;
   so.axis = axis;
@@ -62,20 +70,25 @@ int verb_iso230_2(const Args& args) {
   if (vm.count("reference-position"))
     so.drift.reference_position_mm = vm["reference-position"].as<double>();
   if (vm.count("reference-cycle")) so.drift.reference_cycle = vm["reference-cycle"].as<long>();
-  ReadOptions ro;
-  ro.allow_unknown = vm.count("allow-unknown") > 0;
-  const MeasurementTable table = read_measurements(data, ro);
-  for (const auto& w : table.warnings) std::cerr << w << "\n";
-  const Iso230_2StudyResult r = Iso230_2Study(so).run(table);
+  apply_iso_flags(iso, vm, data, so, io);
+  const ImportResult imported = read_instrument_file(data, io);
+  for (const auto& w : imported.table.warnings) std::cerr << w << "\n";
+  const Iso230_2StudyResult r = Iso230_2Study(so).run(imported.table);
+  const std::string format = to_string(imported.format);
   const CompTable comp_table =
       comp.path.empty() ? CompTable{} : comp_table_from_iso(r, comp.options.table);
   // The plot first: the step most likely to fail; then JSON, then stdout.
   if (!plot_path.empty())
     write_plot(plot_path, iso230_2_panels(r), "ISO 230-2, " + r.columns.axis + ": " + data);
-  if (!json_path.empty()) write_file_atomically(json_path, iso230_2_json(data, r).dump(1) + "\n");
+  if (!json_path.empty())
+    write_file_atomically(json_path, iso230_2_json(data, r, format).dump(1) + "\n");
+  if (!iso.report.empty()) write_file_atomically(iso.report, iso230_2_html(data, r, format));
+  if (imported.format != InstrumentFormat::Tidy)
+    std::cout << import_summary(data, imported) << "\n";
   std::cout << iso230_2_text(data, r);
   if (!plot_path.empty()) std::cout << "wrote " << plot_path << "\n";
   if (!json_path.empty()) std::cout << "wrote " << json_path << "\n";
+  if (!iso.report.empty()) std::cout << "wrote " << iso.report << "\n";
   if (!comp.path.empty()) std::cout << write_comp_table(comp, comp_table);
   return 0;
 }

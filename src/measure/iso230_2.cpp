@@ -60,6 +60,14 @@ double student_coverage_factor(std::size_t dof, double k_normal) {
       boost::math::students_t_distribution<double>(static_cast<double>(dof)), p);
 }
 
+std::string axis_deviation_column(const std::string& axis) {
+  static const std::map<std::string, std::string> kDefault = {
+      {"X", "dx_um"}, {"U", "dx_um"},   {"Y", "dy_um"},   {"V", "dy_um"},  {"Z", "dz_um"},
+      {"W", "dz_um"}, {"A", "da_urad"}, {"B", "db_urad"}, {"C", "dc_urad"}};
+  const auto it = kDefault.find(axis);
+  return it == kDefault.end() ? std::string() : it->second;
+}
+
 // ---- Grouping --------------------------------------------------------------------------------
 
 IsoRuns group_iso_runs(const std::vector<IsoObservation>& obs, const std::string& file,
@@ -237,14 +245,10 @@ IsoColumns iso_columns(const MeasurementTable& table, const std::string& axis,
                                   "time, not a deviation");
     c.deviation = deviation_column;
   } else {
-    static const std::map<std::string, std::string> kDefault = {
-        {"X", "dx_um"}, {"U", "dx_um"},   {"Y", "dy_um"},   {"V", "dy_um"},  {"Z", "dz_um"},
-        {"W", "dz_um"}, {"A", "da_urad"}, {"B", "db_urad"}, {"C", "dc_urad"}};
-    const auto it = kDefault.find(c.axis);
-    if (it == kDefault.end())
+    c.deviation = axis_deviation_column(c.axis);
+    if (c.deviation.empty())
       throw std::invalid_argument("axis " + c.axis +
                                   " has no default deviation column: give one with --column");
-    c.deviation = it->second;
     table.column(c.deviation);  // throws "missing column" when absent
   }
   c.unit = table.info_of(c.deviation).unit;
@@ -281,6 +285,7 @@ std::vector<IsoObservation> iso_observations(const MeasurementTable& table, cons
     o.deviation = dev[r];
     o.time_s = time ? (*time)[r] : kNaN;
     o.line = line;
+    o.row = r;
     out.push_back(o);
   }
   return out;
