@@ -9,6 +9,8 @@ packages=(
   libnlopt-cxx-dev time gnuplot-nox
   # LinuxCNC (halrun, halcompile, hal.h): the HAL compensation component's test (docs/controllers.md)
   linuxcnc-uspace linuxcnc-uspace-dev
+  # headless chromium and PIL: the ISO 230-2 HTML report's browser test (tests/browser)
+  chromium fonts-dejavu-core python3-pil
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -4,12 +4,15 @@
 // rendering in a real browser is the CTest iso230_2_report_browser (tests/report/).
 #include <doctest/doctest.h>
 
+#include <algorithm>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 #include <regex>
 
 #include "test_support.hpp"
 #include "weilgen/base/atomic_file.hpp"
 #include "weilgen/base/format.hpp"
+#include "weilgen/base/text.hpp"
 #include "weilgen/measure/iso230_2_study.hpp"
 #include "weilgen/report/iso230_2_document.hpp"
 #include "weilgen/report/iso230_2_html.hpp"
@@ -176,4 +179,63 @@ TEST_CASE("iso230-2 --report: writes the HTML with the JSON; bad targets are ref
   CHECK(r.status == 0);
   CHECK(r.out.find("Normalised to 20 degC (ISO 1): expansion coefficient 11.5 um/(m K), material "
                    "temperature 20.00 degC [--material-temperature]") != std::string::npos);
+}
+
+TEST_CASE("iso230-2 --csv and --plot: the per-target table equals the JSON; refusals come first") {
+  const auto dir = test::fresh_dir("iso_csv_cli");
+  const std::string csv = (dir / "t.csv").string(), js = (dir / "t.json").string(),
+                    svg = (dir / "t.svg").string();
+  const std::string data = std::string(WEILGEN_SOURCE_DIR) + "/examples/data/carto_x.csv";
+  const bool plot = gnuplot_available();
+  test::Run r = run(cli("iso230-2 " + data + " --csv " + csv + " --json " + js +
+                        (plot ? " --plot " + svg : std::string())));
+  REQUIRE(r.status == 0);
+  CHECK(r.out.find("wrote " + csv) != std::string::npos);
+  const json j = json::parse(test::read_text(js));
+  const std::vector<std::string> lines = split(test::read_text(csv), '\n');
+  REQUIRE(lines.size() == 1 + 11 + 1);  // header, 11 targets, the final newline
+  const std::vector<std::string> header = split(lines[0], ',');
+  CHECK(lines[0] ==
+        "target_mm,mean_up_um,mean_down_um,s_up_um,s_down_um,B_i_um,R_i_up_um,R_i_down_um,R_i_um,"
+        "mean_bi_um,lower_up_um,upper_up_um,lower_down_um,upper_down_um,chart_up_um,s_star_up_um,"
+        "chart_down_um,s_star_down_um");
+  const json& d = j["drift_eliminated"];
+  for (std::size_t i = 0; i < 11; ++i) {
+    const std::vector<std::string> cells = split(lines[i + 1], ',');
+    REQUIRE(cells.size() == header.size());
+    auto at = [&](const std::string& name) {
+      const auto it = std::find(header.begin(), header.end(), name);
+      return std::stod(cells[static_cast<std::size_t>(it - header.begin())]);
+    };
+    // Written with format_number: the same doubles as the JSON.
+    CHECK(at("target_mm") == j["positions_mm"][i].get<double>());
+    for (const char* key : {"mean_up_um", "mean_down_um", "s_up_um", "s_down_um", "B_i_um",
+                            "R_i_up_um", "R_i_down_um", "R_i_um", "mean_bi_um"})
+      CHECK_MESSAGE(at(key) == j[key][i].get<double>(), key << " " << i);
+    CHECK(at("chart_up_um") == d["mean_up_um"][i].get<double>());
+    CHECK(at("s_star_down_um") == d["s_down_um"][i].get<double>());
+    // The band drawn on the chart: x̄ ± 2 s.
+    CHECK(at("lower_up_um") == doctest::Approx(at("mean_up_um") - 2 * at("s_up_um")));
+    CHECK(at("upper_down_um") == doctest::Approx(at("mean_down_um") + 2 * at("s_down_um")));
+  }
+  CHECK(test::read_text(csv).find("103.2,") != std::string::npos);  // targets as written
+  if (plot) CHECK(test::read_text(svg).find("<svg") != std::string::npos);
+  // A flag that cannot be honoured is refused before the work, and nothing is written.
+  const std::string keep = (dir / "keep.json").string();
+  const auto refused = [&](const std::string& flags) {
+    const test::Run x = run(cli("iso230-2 " + data + " --json " + keep + " " + flags));
+    CHECK_MESSAGE(x.status != 0, flags);
+    CHECK_MESSAGE(!std::filesystem::exists(keep), flags);
+    return x;
+  };
+  CHECK(refused("--plot " + (dir / "t.pdf").string()).out.find(".pdf") != std::string::npos);
+  CHECK(refused("--csv " + data).out.find("--csv") != std::string::npos);
+  CHECK(refused("--csv " + dir.string()).out.find("is a directory") != std::string::npos);
+  CHECK(refused("--plot " + data).status == 2);
+  // gnuplot missing: --plot is refused with the reason, not skipped.
+  const test::Run x = run("env PATH=/nonexistent " +
+                          cli("iso230-2 " + data + " --plot " + svg + "x.svg --json " + keep));
+  CHECK(x.status != 0);
+  CHECK(x.out.find("gnuplot not found") != std::string::npos);
+  CHECK_FALSE(std::filesystem::exists(keep));
 }

@@ -28,8 +28,8 @@ int main(int argc, char** argv) {
   }
   weilgen::bench::NormalDeviates rng(2302);
   std::fprintf(out,
-               "Renishaw XL-80 linear measurement - synthetic, bench/experiments/"
-               "make_carto_example.cpp\n"
+               "Renishaw XL-80 linear measurement (synthetic: bench/experiments/"
+               "make_carto_example.cpp)\n"
                "Machine,VMC 850 (synthetic)\n"
                "Serial Number,VM-20931\n"
                "Axis,X\n"

@@ -26,7 +26,7 @@ int verb_iso230_2(const Args& args) {
       "the drift per cycle. The CSV needs the axis column (mm), dir or dir_<axis> (+1/-1), cycle\n"
       "and the deviation along the axis (dx_um for X ...); t_s gives the drift rate in um/h.\n"
       "docs/iso230-2.md, docs/data-format.md.\n\nOptions");
-  std::string axis, column, json_path, plot_path;
+  std::string axis, column, json_path, plot_path, csv_path;
   double alpha = 0.01, tolerance = 1e-6;
   opts.add_options()("help,h", "show this help")(
       "axis", po::value<std::string>(&axis),
@@ -44,6 +44,8 @@ int verb_iso230_2(const Args& args) {
       "positions closer than this (mm) are the same target")(
       "allow-unknown", "warn about unknown columns instead of failing")(
       "json", po::value<std::string>(&json_path), "write the results as JSON to FILE")(
+      "csv", po::value<std::string>(&csv_path),
+      "write the per-target table to FILE (CSV; units in the column names)")(
       "plot", po::value<std::string>(&plot_path),
       "draw the deviation charts to FILE.png or FILE.svg (gnuplot)");
   CompTableFlags comp;
@@ -57,6 +59,9 @@ int verb_iso230_2(const Args& args) {
   if (!(tolerance > 0)) return usage_error("iso230-2", "--target-tolerance must be > 0");
   const std::string data = vm["data"].as<std::string>();
   if (!plot_path.empty()) check_plot_target(plot_path);
+  for (const auto& [flag, path] :
+       {std::pair{"--plot", plot_path}, {"--json", json_path}, {"--csv", csv_path}})
+    if (!path.empty()) check_output_target(path, {data}, flag);
   check_comp_table_flags(comp, vm, {data}, false);
   ImportOptions io;
   io.read.allow_unknown = vm.count("allow-unknown") > 0;
@@ -82,12 +87,14 @@ int verb_iso230_2(const Args& args) {
     write_plot(plot_path, iso230_2_panels(r), "ISO 230-2, " + r.columns.axis + ": " + data);
   if (!json_path.empty())
     write_file_atomically(json_path, iso230_2_json(data, r, format).dump(1) + "\n");
+  if (!csv_path.empty()) write_file_atomically(csv_path, iso230_2_csv(r));
   if (!iso.report.empty()) write_file_atomically(iso.report, iso230_2_html(data, r, format));
   if (imported.format != InstrumentFormat::Tidy)
     std::cout << import_summary(data, imported) << "\n";
   std::cout << iso230_2_text(data, r);
   if (!plot_path.empty()) std::cout << "wrote " << plot_path << "\n";
   if (!json_path.empty()) std::cout << "wrote " << json_path << "\n";
+  if (!csv_path.empty()) std::cout << "wrote " << csv_path << "\n";
   if (!iso.report.empty()) std::cout << "wrote " << iso.report << "\n";
   if (!comp.path.empty()) std::cout << write_comp_table(comp, comp_table);
   return 0;

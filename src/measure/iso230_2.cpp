@@ -86,23 +86,24 @@ IsoRuns group_iso_runs(const std::vector<IsoObservation>& obs, const std::string
     return obs[a].position_mm < obs[b].position_mm;
   });
   std::vector<std::size_t> target_of(obs.size());
-  std::vector<double> sum;
+  // Offsets from the cluster's first position, so a target read as the same number every time
+  // is that number exactly (a plain mean of 10 x 103.2 is 103.20000000000002).
+  std::vector<double> start, sum;
   std::vector<std::size_t> count;
-  double start = 0;
   for (std::size_t k = 0; k < order.size(); ++k) {
     const double p = obs[order[k]].position_mm;
-    if (k == 0 || p - start > tolerance_mm) {
-      start = p;
+    if (k == 0 || p - start.back() > tolerance_mm) {
+      start.push_back(p);
       sum.push_back(0);
       count.push_back(0);
     }
-    sum.back() += p;
+    sum.back() += p - start.back();
     ++count.back();
     target_of[order[k]] = sum.size() - 1;
   }
   const std::size_t m = sum.size();
   for (std::size_t i = 0; i < m; ++i)
-    runs.positions_mm.push_back(sum[i] / static_cast<double>(count[i]));
+    runs.positions_mm.push_back(start[i] + sum[i] / static_cast<double>(count[i]));
 
   // (direction, target, cycle) -> observation.
   std::array<std::map<std::pair<std::size_t, long>, std::size_t>, 2> cell;

@@ -445,6 +445,36 @@ nlohmann::json iso230_2_json(const std::string& data, const Iso230_2StudyResult&
   return j;
 }
 
+std::string iso230_2_csv(const Iso230_2StudyResult& res) {
+  const IsoFigures& F = res.classical.figures;
+  const std::vector<double>& P = res.runs.positions_mm;
+  const std::string u = "_" + res.columns.unit;
+  const std::optional<DriftResult>& D = res.drift;
+  std::ostringstream c;
+  c << "target_mm";
+  for (const char* name : {"mean_up", "mean_down", "s_up", "s_down", "B_i", "R_i_up", "R_i_down",
+                           "R_i", "mean_bi", "lower_up", "upper_up", "lower_down", "upper_down"})
+    c << "," << name << u;
+  if (D)
+    for (const char* name : {"chart_up", "s_star_up", "chart_down", "s_star_down"})
+      c << "," << name << u;
+  c << "\n";
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    c << csv_number(P[i]);
+    for (double v : {F.mean_up[i], F.mean_down[i], F.s_up[i], F.s_down[i], F.B_i[i], F.R_i_up[i],
+                     F.R_i_down[i], F.R_i[i], F.mean_bi[i], F.mean_up[i] - F.k_up * F.s_up[i],
+                     F.mean_up[i] + F.k_up * F.s_up[i], F.mean_down[i] - F.k_down * F.s_down[i],
+                     F.mean_down[i] + F.k_down * F.s_down[i]})
+      c << "," << csv_number(v);
+    if (D)
+      for (double v : {D->chart[kUp].value[i], D->chart[kUp].s[i], D->chart[kDown].value[i],
+                       D->chart[kDown].s[i]})
+        c << "," << csv_number(v);
+    c << "\n";
+  }
+  return c.str();
+}
+
 std::vector<Panel> iso230_2_panels(const Iso230_2StudyResult& res) {
   const IsoColumns& cols = res.columns;
   const IsoRuns& runs = res.runs;
