@@ -220,6 +220,15 @@ TEST_CASE("iso230-2 --csv and --plot: the per-target table equals the JSON; refu
   }
   CHECK(test::read_text(csv).find("103.2,") != std::string::npos);  // targets as written
   if (plot) CHECK(test::read_text(svg).find("<svg") != std::string::npos);
+  // The report's environment table: the recorded ranges in the units a lab reads (hPa, degC).
+  const std::string html = (dir / "t.html").string();
+  REQUIRE(run(cli("iso230-2 " + data + " --report " + html)).status == 0);
+  const std::string report = test::read_text(html);
+  CHECK(report.find("<table class=\"env\">") != std::string::npos);
+  CHECK(report.find("<td>Air pressure</td><td class=\"num\">1009.4</td><td class=\"num\">1009.6"
+                    "</td><td class=\"num\">1009.9</td><td>hPa</td>") != std::string::npos);
+  CHECK(report.find("<td class=\"num\">-17.551</td><td class=\"num\">-8.776</td>") !=
+        std::string::npos);  // the expansion correction, um (hand: -11.7 * 1.5 * 1 = -17.55)
   // A flag that cannot be honoured is refused before the work, and nothing is written.
   const std::string keep = (dir / "keep.json").string();
   const auto refused = [&](const std::string& flags) {

@@ -176,6 +176,52 @@ std::pair<double, double> y_range_of(const std::vector<const SvgChart*>& charts)
   return {lo - pad, hi + pad};
 }
 
+// The environment as recorded (min, mean, max of the rows) and the corrections made, one row per
+// known quantity; nothing when the file records no environment.
+void environment_table(std::ostream& o, const NormalisationResult& n) {
+  struct Row {
+    const char* name;
+    const ValueRange& v;
+    double scale;
+    int decimals;
+    const char* unit;
+    std::string source;
+  };
+  const std::string air_source =
+      n.air_applied ? "Edl\xC3\xA9n (Birch & Downs), " + num(n.wavelength_nm, 3) + " nm" : "";
+  const Row rows[] = {
+      {"Material temperature", n.material_temperature_C, 1, 2,
+       "\xC2\xB0"
+       "C",
+       n.material_source},
+      {"Air temperature", n.air_temperature_C, 1, 2,
+       "\xC2\xB0"
+       "C",
+       n.air_temperature_source},
+      {"Air pressure", n.air_pressure_Pa, 0.01, 1, "hPa", n.air_pressure_source},
+      {"Relative humidity", n.air_humidity_pct, 1, 1, "%", n.air_humidity_source},
+      {"Air refractivity (n \xE2\x88\x92 1) \xC3\x97 10\xE2\x81\xB6", n.air_refractivity, 1e6, 3,
+       "", air_source},
+      {"Air correction \xCE\xB4<sub>air</sub>", n.air_correction_um, 1, 3, "\xC2\xB5m", ""},
+      {"Expansion correction \xCE\xB4<sub>T</sub>", n.material_correction_um, 1, 3, "\xC2\xB5m",
+       n.material_applied
+           ? "\xCE\xB1 = " + num(n.expansion_ppm_per_K, 2) + " \xC2\xB5m/(m\xC2\xB7K)"
+           : ""}};
+  bool any = false;
+  for (const Row& r : rows) any |= !r.v.empty();
+  if (!any) return;
+  o << "<table class=\"env\"><tr><th>Quantity</th><th>Min</th><th>Mean</th><th>Max</th>"
+       "<th>Unit</th><th>Source</th></tr>\n";
+  for (const Row& r : rows) {
+    if (r.v.empty()) continue;
+    o << "<tr><td>" << r.name << "</td>";
+    for (double v : {r.v.min, r.v.mean, r.v.max})
+      o << "<td class=\"num\">" << num(v * r.scale, r.decimals) << "</td>";
+    o << "<td>" << r.unit << "</td><td>" << h(r.source) << "</td></tr>\n";
+  }
+  o << "</table>\n";
+}
+
 const char* kStyle = R"(
 body { font-family: Helvetica, Arial, sans-serif; font-size: 13px; color: #222; margin: 0;
        background: #fff; }
@@ -200,6 +246,7 @@ figcaption { color: #555; font-size: 12px; margin-top: 2px; }
 .fail { color: #c62828; font-weight: bold; }
 .verdict { font-size: 15px; margin: 8px 0; }
 ul.statements li { margin: 3px 0; }
+table.env { margin-bottom: 4px; }
 table.targets { font-size: 12px; }
 .signature { display: flex; gap: 40px; margin-top: 28px; }
 .signature div { flex: 1; border-top: 1px solid #444; padding-top: 4px; color: #444; }
@@ -276,8 +323,9 @@ std::string iso230_2_html(const std::string& data, const Iso230_2StudyResult& re
   }
   o << "</table></section>\n";
   // ---- Environment.
-  o << "<section id=\"environment\"><h2>Environment, normalisation and compensation</h2>\n"
-    << "<ul class=\"statements\">\n";
+  o << "<section id=\"environment\"><h2>Environment, normalisation and compensation</h2>\n";
+  environment_table(o, res.normalisation);
+  o << "<ul class=\"statements\">\n";
   for (const auto& line : iso230_2_normalisation_statement(res))
     o << "<li>" << h(pretty(line)) << "</li>\n";
   o << "</ul></section>\n";
