@@ -43,7 +43,8 @@ const std::map<std::string, Verb>& verbs() {
         "      tighten the most sensitive errors until the reliability targets hold"}},
       {"iso230-2",
        {weilgen::cli::verb_iso230_2,
-        "iso230-2 <data.csv> [--axis X] [--json FILE] [--csv FILE] [--plot FILE] [--report F.html]\n"
+        "iso230-2 <data.csv> [--axis X] [--json FILE] [--csv FILE] [--plot FILE]\n"
+        "         [--report F.html] [--tolerance SPEC] [--expansion PPM_PER_K] ...\n"
         "      ISO 230-2 positioning figures, with the thermal-drift-eliminated evaluation"}},
       {"import",
        {weilgen::cli::verb_import,
