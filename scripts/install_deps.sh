@@ -10,6 +10,8 @@ packages=(
   # LinuxCNC (halrun, halcompile, hal.h): the HAL compensation component's test (docs/controllers.md)
   linuxcnc-uspace linuxcnc-uspace-dev
   clang libclang-rt-14-dev  # libFuzzer and the sanitizer runtimes (fuzz/, scripts/fuzz.sh)
+  # headless chromium and PIL: the ISO 230-2 HTML report's browser test (tests/browser)
+  chromium fonts-dejavu-core python3-pil
 )
 missing=()
 for p in "${packages[@]}"; do
