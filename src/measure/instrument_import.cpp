@@ -875,9 +875,7 @@ ImportResult parse_instrument_text(const std::string& text, const std::string& f
 }
 
 ImportResult read_instrument_file(const std::string& path, const ImportOptions& o) {
-  std::string text;
-  if (!read_file(path, text)) throw InputError(SourceLoc{path, 0, 0}, "cannot read file");
-  return parse_instrument_text(text, path, o);
+  return parse_instrument_text(read_data_file(path), path, o);
 }
 
 }  // namespace weilgen

@@ -361,12 +361,16 @@ MeasurementTable parse_measurements(const std::string& text, const std::string& 
   return t;
 }
 
-MeasurementTable read_measurements(const std::string& path, const ReadOptions& options) {
+std::string read_data_file(const std::string& path) {
   std::string text;
   if (const std::string why = unreadable_reason(path); !why.empty() || !read_file(path, text))
     throw InputError(SourceLoc{path, 0, 0},
                      "cannot read the data file: " + (why.empty() ? "read error" : why));
-  return parse_measurements(text, path, options);
+  return text;
+}
+
+MeasurementTable read_measurements(const std::string& path, const ReadOptions& options) {
+  return parse_measurements(read_data_file(path), path, options);
 }
 
 ReadOptions machine_read_options(const Description& desc, bool allow_unknown) {

@@ -107,6 +107,9 @@ struct MeasurementTable {
 
 // Reads a file (InputError "path: cannot read file" when it cannot be opened).
 MeasurementTable read_measurements(const std::string& path, const ReadOptions& options = {});
+// The whole text of a data file; InputError "cannot read the data file: <why>" ("no such file",
+// "is a directory", ...) when it cannot be read.
+std::string read_data_file(const std::string& path);
 // Parses text; `filename` is used in messages and stored in MeasurementTable::file.
 MeasurementTable parse_measurements(const std::string& text, const std::string& filename,
                                     const ReadOptions& options = {});
