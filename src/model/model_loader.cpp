@@ -40,8 +40,11 @@ std::string shell_quote(const std::string& s) {
   return q + "'";
 }
 
+// A cached object built for an older ABI version gives nullptr when `stale_ok` (it is then
+// compiled again); any other mismatch is an error.
 std::shared_ptr<Model> open_shared_object(const Description& desc, const std::string& path,
-                                          const std::string& key, const std::string& how) {
+                                          const std::string& key, const std::string& how,
+                                          bool stale_ok = false) {
   void* handle = ::dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (!handle) throw std::runtime_error("cannot load " + path + ": " + ::dlerror());
   std::shared_ptr<void> keep(handle, [](void* h) { ::dlclose(h); });
@@ -49,6 +52,7 @@ std::shared_ptr<Model> open_shared_object(const Description& desc, const std::st
   auto entry = reinterpret_cast<Entry>(::dlsym(handle, "weilgen_model_abi"));
   if (!entry) throw std::runtime_error(path + " has no weilgen_model_abi entry point");
   const WeilgenModelAbi* abi = entry();
+  if (stale_ok && abi->abi_version != kWeilgenModelAbiVersion) return nullptr;
   if (abi->abi_version != kWeilgenModelAbiVersion || key != abi->key)
     throw std::runtime_error(path + " is not the model for this machine file (key mismatch)");
   return std::make_shared<Model>(desc, abi, ModelEngine::Compiled, how + " (" + path + ")",
@@ -155,7 +159,8 @@ std::shared_ptr<Model> load_model(const Description& desc, const LoadOptions& op
   const std::string cache = options.cache_dir.empty() ? default_cache_dir() : options.cache_dir;
   const fs::path cached = fs::path(cache) / (desc.name + "-" + key + ".so");
   std::error_code ec;
-  if (fs::is_regular_file(cached, ec)) return open_shared_object(desc, cached, key, "cached");
+  if (fs::is_regular_file(cached, ec))
+    if (auto model = open_shared_object(desc, cached, key, "cached", true)) return model;
 
   const std::string compiler = find_compiler(options.compiler);
   if (compiler.empty()) {
