@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs weilgen's build and test dependencies from Debian 12 packages (run as root).
-# Does nothing when everything is already installed.
+# Does nothing when everything is already installed. `--bench` adds the benchmarks' peer tools.
 set -euo pipefail
 packages=(
   build-essential cmake pkg-config git
@@ -13,6 +13,8 @@ packages=(
   # headless chromium and PIL: the ISO 230-2 HTML report's browser test (tests/browser)
   chromium fonts-dejavu-core python3-pil
 )
+# --bench: also the peer tools the benchmarks compare against (bench/openturns/run.sh).
+if [[ "${1:-}" == "--bench" ]]; then packages+=(python3-openturns python3-scipy); fi
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

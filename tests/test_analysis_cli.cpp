@@ -100,6 +100,59 @@ TEST_CASE("sensitivity CLI: coefficients, exact indices and QMC indices on the g
             doctest::Approx(std::pow(1000 * grinder_sigma("E_BX"), 2) / v).epsilon(1e-12));
 }
 
+TEST_CASE("sensitivity CLI: replicate intervals by default, the bootstrap on request, in JSON") {
+  const auto dir = test::fresh_dir("cli_sensitivity_intervals");
+  const std::string out = (dir / "s.json").string();
+  const std::string common =
+      "sensitivity gantry_grinder --at X=0,Y=1500,Z=600 --outputs dx --method all --samples 4096 "
+      "--quiet --json " +
+      out;
+  const Run r = run(cli(common));
+  REQUIRE(r.status == 0);
+  CHECK(r.out.find("Sobol' intervals: 95 % Student t over 8 independent randomised replicates") !=
+        std::string::npos);
+  json j = read_json(out);
+  CHECK(j["settings"]["intervals"] == "replicates");
+  CHECK(j["settings"]["replicates"] == 8);
+  CHECK(j["settings"]["bootstrap"] == 0);
+  CHECK(j["settings"]["evaluations"] == 4096 * 23);
+  // The grinder is linear at order 1: the replicate intervals are narrow and hold S_exact
+  // for nearly every acting error (95 % each; 14 intervals).
+  int inside = 0, acting = 0;
+  for (const auto& rec : j["results"]) {
+    const double ex = rec["S_exact"];
+    if (ex == 0) {
+      CHECK(rec["S"] == 0.0);
+      CHECK(rec["S_ci"][1] == 0.0);
+      continue;
+    }
+    acting += 2;
+    inside += rec["S_ci"][0] <= ex && ex <= rec["S_ci"][1];
+    inside += rec["ST_ci"][0] <= ex && ex <= rec["ST_ci"][1];
+    CHECK(rec["S_ci"][1].get<double>() - rec["S_ci"][0].get<double>() < 0.05);
+  }
+  CHECK(acting == 14);
+  CHECK(inside >= 11);
+  REQUIRE(run(cli(common + " --replicates 4")).status == 0);
+  CHECK(read_json(out)["settings"]["replicates"] == 4);
+  REQUIRE(run(cli(common + " --bootstrap 50")).status == 0);
+  j = read_json(out);
+  CHECK(j["settings"]["intervals"] == "bootstrap");
+  CHECK(j["settings"]["bootstrap"] == 50);
+  CHECK(j["settings"]["replicates"] == 1);
+  const Run none = run(cli(common + " --bootstrap 0"));
+  REQUIRE(none.status == 0);
+  CHECK(none.out.find("Sobol' intervals: none") != std::string::npos);
+  j = read_json(out);
+  for (const auto& rec : j["results"]) CHECK(rec["S_ci"][0].is_null());
+  // Without Sobol' indices there is no interval method.
+  REQUIRE(run(cli("sensitivity gantry_grinder --at X=0,Y=1500,Z=600 --method exact --quiet "
+                  "--json " +
+                  out))
+              .status == 0);
+  CHECK(read_json(out)["settings"]["intervals"].is_null());
+}
+
 TEST_CASE("sensitivity CLI: the same seed gives the same numbers with 1 or 2 threads") {
   const auto dir = test::fresh_dir("cli_sensitivity_seed");
   const std::string a = (dir / "a.csv").string(), b = (dir / "b.csv").string();
@@ -186,6 +239,16 @@ TEST_CASE("analysis CLI: bad arguments give one clear line, exit 2 and leave out
       {"sensitivity gantry_grinder --at X=0,Y=0,Z=600 --samples 1",
        "--samples: '1' is out of range"},
       {"sensitivity gantry_grinder --at X=0,Y=0,Z=600 --outputs dq", "dq"},
+      {"sensitivity gantry_grinder --at X=0,Y=0,Z=600 --replicates 1",
+       "--replicates must be in [2, 1024], not 1"},
+      {"sensitivity gantry_grinder --at X=0,Y=0,Z=600 --replicates -2", "not -2"},
+      {"sensitivity gantry_grinder --at X=0,Y=0,Z=600 --replicates 4 --bootstrap 10",
+       "give one of them"},
+      {"sensitivity gantry_grinder --at X=0,Y=0,Z=600 --bootstrap -1",
+       "--bootstrap must be in [0, 100000]"},
+      {"sensitivity gantry_grinder --at X=0,Y=0,Z=600 --samples 1001",
+       "--samples 1001 must be a multiple of --replicates 8"},
+      {"sensitivity gantry_grinder --at X=0,Y=0,Z=600 --seed 0", "--seed 0"},
       {"reliability gantry_grinder --at X=0,Y=0,Z=600 --tolerance dx=0mm", "dx"},
       {"reliability gantry_grinder --at X=0,Y=0,Z=600 --tolerance dx=-1um", "dx"},
       {"reliability gantry_grinder --at X=0,Y=0,Z=600", "--tolerance"},

@@ -2,6 +2,7 @@
 // numeric-chain fallback without a compiler; all engines agree.
 #include <doctest/doctest.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -56,6 +57,31 @@ double max_disagreement(const Model& a, const Model& b, double error_scale) {
   return worst;
 }
 
+// Model::deviation_batch gives exactly Model::deviation, point by point (37 points: not a
+// multiple of anything), with and without the orientation.
+bool batch_matches(const Model& m) {
+  std::mt19937 rng(11);
+  ModelData data(m);
+  const std::size_t ne = m.num_errors(), count = 37;
+  for (int trial = 0; trial < 5; ++trial) {
+    const auto q = test::random_pose(m.description(), rng);
+    std::vector<double> errors, pos(3 * count), ori(3 * count), only_pos(3 * count), one(6);
+    for (std::size_t j = 0; j < count; ++j) {
+      const auto e = test::scaled(test::random_direction(m.description(), rng), 1e-3);
+      errors.insert(errors.end(), e.begin(), e.end());
+    }
+    m.deviation_batch(data, q.data(), count, errors.data(), pos.data(), ori.data());
+    m.deviation_batch(data, q.data(), count, errors.data(), only_pos.data(), nullptr);
+    if (only_pos != pos) return false;
+    for (std::size_t j = 0; j < count; ++j) {
+      m.deviation(data, q.data(), errors.data() + j * ne, one.data());
+      for (std::size_t o = 0; o < 3; ++o)
+        if (one[o] != pos[3 * j + o] || one[3 + o] != ori[3 * j + o]) return false;
+    }
+  }
+  return true;
+}
+
 }  // namespace
 
 TEST_CASE("model loader: shipped machines are built in and match the exact chain") {
@@ -73,6 +99,8 @@ TEST_CASE("model loader: shipped machines are built in and match the exact chain
     CHECK(chain->engine() == ModelEngine::NumericChain);
     // Order 1 against the exact chain: errors of 1e-6 (mm, 1e-9 rad) agree to O(s^2).
     CHECK(max_disagreement(*model, *chain, 1e-6) < 1e-8);
+    CHECK(batch_matches(*model));
+    CHECK(batch_matches(*chain));
   }
 }
 
@@ -107,6 +135,37 @@ TEST_CASE("model loader: an edited machine is compiled once, then loaded from th
       load_model(load_machine_file(test::machine_path("vmc_3axis")), options_in(cache));
   CHECK(builtin->engine() == ModelEngine::BuiltIn);
   CHECK(max_disagreement(*compiled, *builtin, 1e-3) == 0.0);
+  CHECK(batch_matches(*compiled));
+}
+
+TEST_CASE("model loader: a cached model of an older ABI version is compiled again") {
+  const std::string dir = fresh_dir("loader_stale_abi");
+  const std::string cache = dir + "/cache";
+  fs::create_directories(cache);
+  std::string text = test::read_text(test::machine_path("two_axis"));
+  text += "\n# edited by test_model_loader (stale ABI)\n";
+  const Description d = load_machine_text(text, dir + "/two_axis_stale.yaml");
+  const std::string key = model_key(d.source_hash, d.algebra.order);
+  // An object from before the batch entry point: ABI version 1, the right key.
+  const std::string src = dir + "/old.cpp", so = cache + "/two_axis-" + key + ".so";
+  std::ofstream(src) << "#include <cstddef>\nstruct Abi1 { int v, order; const char *name, *key;"
+                        " std::size_t a, e, p; void *dev, *coeff; };\n"
+                        "static const Abi1 abi = {1, 1, \"two_axis\", \""
+                     << key
+                     << "\", 0, 0, 0, nullptr, nullptr};\n"
+                        "extern \"C\" const Abi1* weilgen_model_abi() { return &abi; }\n";
+  REQUIRE(std::system((std::string(WEILGEN_CXX) + " -shared -fPIC -o " + so + " " + src).c_str()) ==
+          0);
+  std::vector<std::string> log;
+  const auto model = load_model(d, options_in(cache, &log));
+  CHECK(model->engine() == ModelEngine::Compiled);
+  REQUIRE_FALSE(log.empty());
+  CHECK(log.front().find("compiling model two_axis") == 0);
+  CHECK(batch_matches(*model));
+  // The new object replaced the stale one: the next load is a cache hit.
+  std::vector<std::string> log2;
+  CHECK(load_model(d, options_in(cache, &log2))->origin().find("cached (") == 0);
+  CHECK(log2.empty());
 }
 
 TEST_CASE("model loader: order override compiles an order-2 model that converges as s^3") {

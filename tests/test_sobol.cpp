@@ -209,6 +209,7 @@ TEST_CASE("Sobol' indices of the Ishigami function (QMC, N = 2^14) within 0.01")
   CHECK(exact.total[2] == doctest::Approx(0.2437).epsilon(1e-3));
   SobolOptions o;
   o.samples = 1u << 14;
+  o.intervals = SobolIntervals::Bootstrap;
   o.bootstrap = 100;
   const SobolResult r = run_scalar(ishigami_inputs(), ishigami, o);
   REQUIRE(r.outputs.size() == 1);
@@ -233,7 +234,7 @@ TEST_CASE("Sobol' indices with a non-power-of-two QMC size (N = 20000, the pipe-
   const Analytic exact = ishigami_indices();
   SobolOptions o;
   o.samples = 20000;
-  o.bootstrap = 0;
+  o.intervals = SobolIntervals::None;
   const SobolResult r = run_scalar(ishigami_inputs(), ishigami, o);
   CHECK(r.samples == 20000);
   const SobolIndices& s = r.outputs[0];
@@ -251,7 +252,7 @@ TEST_CASE("Sobol' indices of the G-function against the analytic indices") {
   CHECK(exact.total[0] == doctest::Approx(0.7871).epsilon(1e-3));
   SobolOptions o;
   o.samples = 1u << 14;
-  o.bootstrap = 0;
+  o.intervals = SobolIntervals::None;
   const std::vector<InputDistribution> inputs(8, InputDistribution::uniform(0, 1));
   // Tolerance 0.005, 3x the QMC error: docs/experiments/sobol_convergence.md measures a max
   // error of 1.55e-3 at N = 2^14 for every one of 10 shifts (S_T2, a plateau from 2^12 to 2^15
@@ -265,7 +266,7 @@ TEST_CASE("Sobol' indices of the G-function against the analytic indices") {
     const SobolIndices& s = r.outputs[0];
     CAPTURE(seed);
     CHECK(max_error(s, exact) < 0.005);
-    CHECK(std::isnan(s.first_lo[0]));  // bootstrap = 0: no intervals
+    CHECK(std::isnan(s.first_lo[0]));  // no intervals
   }
 }
 
@@ -305,6 +306,7 @@ TEST_CASE("Sobol' indices of a linear function: estimator, closed form and boots
       o.samples = 1u << 12;
       o.sampling = sampling;
       o.seed = seed;
+      o.intervals = SobolIntervals::Bootstrap;
       o.bootstrap = 200;
       const SobolIndices s = run_scalar(inputs, linear_f, o).outputs[0];
       for (std::size_t i = 0; i < 2; ++i) {
@@ -332,6 +334,7 @@ TEST_CASE("Sobol' indices of a linear function: estimator, closed form and boots
 TEST_CASE("Sobol' indices: constant inputs are not perturbed and get exactly 0") {
   SobolOptions o;
   o.samples = 1u << 10;
+  o.intervals = SobolIntervals::Bootstrap;
   o.bootstrap = 50;
   const SobolResult ref = run_scalar(ishigami_inputs(), ishigami, o);
   // Same function with a constant input inserted second (ignored by the function): the varying
@@ -369,6 +372,7 @@ TEST_CASE("Sobol' indices: constant inputs are not perturbed and get exactly 0")
 TEST_CASE("Sobol' indices: zero-variance outputs give zeros, not NaN") {
   SobolOptions o;
   o.samples = 1u << 9;
+  o.intervals = SobolIntervals::Bootstrap;
   o.bootstrap = 20;
   const SobolDesign design(ishigami_inputs(), o);
   const SobolResult r = SobolAnalysis(o).run(design, 3, [](unsigned, const double* x, double* y) {
@@ -407,6 +411,7 @@ TEST_CASE("Sobol' indices are bit-identical for 1, 2 and 3 threads") {
       o.samples = 1u << 11;
       o.sampling = sampling;
       o.seed = 99;
+      o.intervals = SobolIntervals::Bootstrap;
       o.bootstrap = 70;
       o.threads = threads;
       const SobolDesign design(ishigami_inputs(), o);
@@ -440,6 +445,7 @@ TEST_CASE("Sobol' indices are bit-identical for 1, 2 and 3 threads") {
 TEST_CASE("Sobol' indices: resamples drawn by the design equal those drawn per estimate") {
   SobolOptions o;
   o.samples = 1u << 10;
+  o.intervals = SobolIntervals::Bootstrap;
   o.bootstrap = 40;
   o.seed = 5;
   const SobolDesign cached(ishigami_inputs(), o);  // draws the resamples for (5, 40)
@@ -466,6 +472,7 @@ TEST_CASE("Sobol' indices with plain Monte Carlo sampling converge (looser toler
   SobolOptions o;
   o.samples = 20000;  // any N is allowed for Monte Carlo
   o.sampling = Sampling::MonteCarlo;
+  o.intervals = SobolIntervals::Bootstrap;
   o.bootstrap = 100;
   // Tolerance 0.05: the Monte Carlo standard error of these estimators at N = 2e4 is about 0.01
   // for the Ishigami function (the bootstrap half-widths below say so too).

@@ -567,6 +567,7 @@ int run(const Options& opt) {
   so.samples = opt.samples;
   so.sampling = Sampling::Qmc;
   so.seed = 1;
+  so.intervals = SobolIntervals::Bootstrap;  // the seed paper's table: bootstrap intervals
   so.bootstrap = opt.bootstrap;
   so.threads = threads;
   auto t0 = std::chrono::steady_clock::now();

@@ -74,13 +74,15 @@ Problem g_problem() {
   return p;
 }
 
+// Max error of one run: a single design (replicates = 1) or R scrambled replicates of N/R.
 double error(const Problem& p, Sampling sampling, std::size_t n, std::uint64_t seed,
-             unsigned threads) {
+             unsigned threads, std::size_t replicates = 1) {
   SobolOptions o;
   o.samples = n;
   o.sampling = sampling;
   o.seed = seed;
-  o.bootstrap = 0;
+  o.intervals = replicates > 1 ? SobolIntervals::Replicates : SobolIntervals::None;
+  o.replicates = replicates;
   o.threads = threads;
   const SobolDesign design(p.inputs, o);
   const auto fn = p.f;
@@ -126,6 +128,10 @@ void timing(unsigned threads, int repeats) {
       for (std::size_t o = 0; o < m; ++o) acc[o] += c[i * m + o] * x[i];
     for (std::size_t o = 0; o < m; ++o) y[o] = acc[o];
   };
+  // The same model through the batch interface (one call per batch of points).
+  const BatchFunction batch = [&model](unsigned t, std::size_t count, const double* x, double* y) {
+    for (std::size_t j = 0; j < count; ++j) model(t, x + j * k, y + j * m);
+  };
   std::vector<InputDistribution> inputs;
   for (std::size_t i = 0; i < k; ++i)
     inputs.push_back(i % 2 ? InputDistribution::normal(0, 0.005)
@@ -145,16 +151,21 @@ void timing(unsigned threads, int repeats) {
       "stated):\n\n",
       repeats);
   std::printf(
-      "| N | evaluations | bare evaluations | design (R = 200) | estimate, no bootstrap | "
-      "estimate, bootstrap 200 | bootstrap 200, %u threads |\n"
-      "| --- | --- | --- | --- | --- | --- | --- |\n",
+      "| N | evaluations | bare evaluations | design | estimate, no intervals | estimate, 8 "
+      "replicates | design + estimate, bootstrap 200 | 8 replicates, %u threads |\n"
+      "| --- | --- | --- | --- | --- | --- | --- | --- |\n",
       threads);
   for (std::size_t n : {std::size_t{1} << 12, std::size_t{1} << 14, std::size_t{1} << 16}) {
-    SobolOptions o;
+    SobolOptions o;  // default: 8 replicates
     o.samples = n;
     o.threads = 1;
     const double t_design = best([&] { SobolDesign d(inputs, o); });
     const SobolDesign design(inputs, o);
+    SobolOptions o0 = o, ob = o;
+    o0.intervals = SobolIntervals::None;
+    ob.intervals = SobolIntervals::Bootstrap;
+    ob.bootstrap = 200;
+    const SobolDesign design0(inputs, o0);
     // The evaluations alone, in the engine's order, without storing anything.
     std::vector<double> x(k), y(m);
     double sink = 0;
@@ -173,18 +184,20 @@ void timing(unsigned threads, int repeats) {
         }
       }
     });
-    SobolResult r0, r1, rt;
-    SobolOptions o0 = o;
-    o0.bootstrap = 0;
-    const double t_est0 = best([&] { r0 = SobolAnalysis(o0).run(design, m, model); });
-    const double t_est1 = best([&] { r1 = SobolAnalysis(o).run(design, m, model); });
+    SobolResult r0, r1, rb, rt;
+    const double t_est0 = best([&] { r0 = SobolAnalysis(o0).run(design0, m, batch); });
+    const double t_est1 = best([&] { r1 = SobolAnalysis(o).run(design, m, batch); });
+    const double t_boot = best([&] {
+      const SobolDesign d(inputs, ob);
+      rb = SobolAnalysis(ob).run(d, m, batch);
+    });
     SobolOptions ot = o;
     ot.threads = threads;
-    const double t_estt = best([&] { rt = SobolAnalysis(ot).run(design, m, model); });
-    std::printf("| 2^%d | %zu | %.3f (%.0f ns each) | %.3f | %.3f | %.3f | %.3f |\n",
+    const double t_estt = best([&] { rt = SobolAnalysis(ot).run(design, m, batch); });
+    std::printf("| 2^%d | %zu | %.3f (%.0f ns each) | %.3f | %.3f | %.3f | %.3f | %.3f |\n",
                 static_cast<int>(std::log2(static_cast<double>(n))), r0.evaluations, t_bare,
                 1e9 * t_bare / static_cast<double>(r0.evaluations), t_design, t_est0, t_est1,
-                t_estt);
+                t_boot, t_estt);
     if (sink == 0.123456789 || r1.outputs[0].first_lo != rt.outputs[0].first_lo)
       std::printf("(thread counts disagree)\n");
   }
@@ -228,17 +241,17 @@ int main(int argc, char** argv) {
   std::printf("Mean (over %d seeds) of the max abs error over first and total indices:\n\n", seeds);
   for (const Problem& p : {ishigami_problem(), g_problem()}) {
     std::printf(
-        "%s\n\n| N | QMC mean | QMC worst | MC mean | MC worst | MC / QMC |\n"
-        "| --- | --- | --- | --- | --- | --- |\n",
+        "%s\n\n| N | QMC mean | QMC worst | MC mean | MC worst | MC / QMC | RQMC 8 replicates "
+        "mean | RQMC worst |\n| --- | --- | --- | --- | --- | --- | --- | --- |\n",
         p.name.c_str());
     std::vector<double> ns, qmc, mc;
     for (int e = 8; e <= 16; ++e) {
       const std::size_t n = std::size_t{1} << e;
-      double mean[2] = {0, 0}, worst[2] = {0, 0};
+      double mean[3] = {0, 0, 0}, worst[3] = {0, 0, 0};
       for (int s = 1; s <= seeds; ++s) {
-        for (int m = 0; m < 2; ++m) {
-          const double err = error(p, m == 0 ? Sampling::Qmc : Sampling::MonteCarlo, n,
-                                   static_cast<std::uint64_t>(s), threads);
+        for (int m = 0; m < 3; ++m) {
+          const double err = error(p, m == 1 ? Sampling::MonteCarlo : Sampling::Qmc, n,
+                                   static_cast<std::uint64_t>(s), threads, m == 2 ? 8 : 1);
           mean[m] += err / seeds;
           worst[m] = std::max(worst[m], err);
         }
@@ -246,11 +259,12 @@ int main(int argc, char** argv) {
       ns.push_back(static_cast<double>(n));
       qmc.push_back(mean[0]);
       mc.push_back(mean[1]);
-      std::printf("| 2^%d | %.2e | %.2e | %.2e | %.2e | %.1f |\n", e, mean[0], worst[0], mean[1],
-                  worst[1], mean[1] / mean[0]);
+      std::printf("| 2^%d | %.2e | %.2e | %.2e | %.2e | %.1f | %.2e | %.2e |\n", e, mean[0],
+                  worst[0], mean[1], worst[1], mean[1] / mean[0], mean[2], worst[2]);
       if (out) {
         out << p.name << ",qmc," << n << ',' << mean[0] << ',' << worst[0] << '\n';
         out << p.name << ",mc," << n << ',' << mean[1] << ',' << worst[1] << '\n';
+        out << p.name << ",rqmc8," << n << ',' << mean[2] << ',' << worst[2] << '\n';
       }
     }
     std::printf("\nlog-log slope of the mean error vs N: QMC %.2f, MC %.2f\n\n", slope(ns, qmc),

@@ -51,6 +51,39 @@ Sampling parse_sampling(const std::string& text) {
   throw std::invalid_argument("--sampling must be qmc or mc, not '" + text + "'");
 }
 
+void set_sobol_intervals(SobolOptions& o, const long long* replicates, const long long* bootstrap) {
+  if (replicates && bootstrap)
+    throw std::invalid_argument(
+        "--replicates and --bootstrap are two ways to get intervals: give one of them");
+  if (bootstrap) {
+    if (*bootstrap < 0 || *bootstrap > 100000)
+      throw std::invalid_argument(
+          "--bootstrap must be in [0, 100000] resamples (0 = no "
+          "intervals), not " +
+          std::to_string(*bootstrap));
+    o.intervals = SobolIntervals::Bootstrap;
+    o.bootstrap = static_cast<std::size_t>(*bootstrap);
+    return;
+  }
+  o.intervals = SobolIntervals::Replicates;
+  if (replicates) {
+    if (*replicates < 2 || *replicates > 1024)
+      throw std::invalid_argument("--replicates must be in [2, 1024], not " +
+                                  std::to_string(*replicates));
+    o.replicates = static_cast<std::size_t>(*replicates);
+  }
+  const std::size_t r = o.replicates;
+  if (o.samples % r != 0 || o.samples / r < 2)
+    throw std::invalid_argument(
+        "--samples " + std::to_string(o.samples) + " must be a multiple of --replicates " +
+        std::to_string(r) + " (each replicate has N/R >= 2 rows; e.g. --samples " +
+        std::to_string(std::max<std::size_t>(2, (o.samples + r - 1) / r) * r) + ")");
+  if (o.sampling == Sampling::Qmc && o.seed == 0)
+    throw std::invalid_argument(
+        "--seed 0 gives unrandomised Sobol' points, which cannot make independent replicates: "
+        "use a seed != 0, or --bootstrap B");
+}
+
 SensitivityStudy::SensitivityStudy(SensitivityOptions options) : options_(std::move(options)) {
   options_.validate();
 }
@@ -107,20 +140,36 @@ SensitivityResult SensitivityStudy::run(
 
   SobolOptions so = options_.sobol_options;
   so.threads = st.threads;
-  res.bootstrap = so.bootstrap;
-  const SobolDesign design(st.inputs, so);
+  res.intervals = so.intervals;
+  res.replicates = so.replicate_count();
+  res.bootstrap = so.intervals == SobolIntervals::Bootstrap ? so.bootstrap : 0;
+  // Stored when several poses reuse it; one pose makes each block of rows as it goes.
+  const SobolDesign design(st.inputs, so, np > 1);
   const SobolAnalysis analysis(so);
+  // Per thread: a model workspace and the batch's position and orientation; orientation only
+  // when an angular output is analysed, position only for dx, dy, dz, dp.
+  bool need_pos = false, need_ori = false;
+  for (OutputId o : outputs) (output_is_angle(o) ? need_ori : need_pos) = true;
   std::vector<ModelData> work;
+  std::vector<std::vector<double>> pos(st.threads, std::vector<double>(3 * kSobolMaxBatch)),
+      ori(pos);
   for (unsigned t = 0; t < st.threads; ++t) work.emplace_back(model);
   for (std::size_t p = 0; p < np; ++p) {
     const double* pose = st.poses.poses[p].data();
-    const VectorFunction fn = [&](unsigned t, const double* x, double* y) {
-      ModelData& w = work[t];
-      model.deviation(w, pose, x, w.out.data());
-      for (std::size_t o = 0; o < no; ++o)
-        y[o] = outputs[o] == OutputId::Dp
-                   ? std::sqrt(w.out[0] * w.out[0] + w.out[1] * w.out[1] + w.out[2] * w.out[2])
-                   : w.out[static_cast<std::size_t>(outputs[o])];
+    const BatchFunction fn = [&](unsigned t, std::size_t count, const double* x, double* y) {
+      const double* ps = pos[t].data();
+      const double* os = ori[t].data();
+      model.deviation_batch(work[t], pose, count, x, need_pos ? pos[t].data() : nullptr,
+                            need_ori ? ori[t].data() : nullptr);
+      for (std::size_t j = 0; j < count; ++j)
+        for (std::size_t o = 0; o < no; ++o) {
+          const auto id = static_cast<std::size_t>(outputs[o]);
+          const double* w = ps + 3 * j;
+          y[j * no + o] = outputs[o] == OutputId::Dp
+                              ? std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
+                          : id < 3 ? w[id]
+                                   : os[3 * j + id - 3];
+        }
     };
     const SobolResult r = analysis.run(design, no, fn);
     res.evaluations += r.evaluations;

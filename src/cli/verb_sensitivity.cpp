@@ -21,13 +21,15 @@ int verb_sensitivity(const Args& args) {
       "  local  the coefficient c_i of each error and its contribution c_i*sigma_i, ranked;\n"
       "  exact  Sobol' indices of the linear model, S_i = c_i^2 s_i^2 / sum_j c_j^2 s_j^2\n"
       "         (exact at order 1; the first-order reference at order >= 2; not for dp);\n"
-      "  sobol  first-order (Saltelli) and total (Jansen) indices by quasi-Monte Carlo on\n"
-      "         Sobol' points, with bootstrap confidence intervals.\n"
+      "  sobol  first-order (Saltelli) and total (Jansen) indices by randomised quasi-Monte\n"
+      "         Carlo on scrambled Sobol' points; intervals from R independent replicates\n"
+      "         (Student t), or the bootstrap with --bootstrap B.\n"
       "Outputs: dx dy dz (mm), da db dc (rad), dp = |(dx,dy,dz)| (mm, sampling only).\n\n"
       "Options");
   StudyFlags f;
   std::string method = "all", outputs_text = "dx,dy,dz,da,db,dc,dp", sampling = "qmc";
-  std::size_t samples = 1u << 14, bootstrap = 200, top = 10;
+  std::size_t samples = 1u << 14, top = 10;
+  long long replicates = 8, bootstrap = 200;
   double confidence = 0.95;
   opts.add_options()("help,h", "show this help")(
       "method", po::value<std::string>(&method)->default_value("all"),
@@ -40,10 +42,14 @@ int verb_sensitivity(const Args& args) {
       "evaluations per pose")(
       "sampling", po::value<std::string>(&sampling)->default_value("qmc"),
       "qmc (Sobol' points with a seeded digital shift) | mc (pseudo-random)")(
-      "bootstrap", ranged(&bootstrap, NumberRange::whole_numbers(0, 1e6))->default_value(bootstrap),
-      "bootstrap resamples for the confidence intervals (0 = none)")(
-      "confidence", ranged(&confidence, NumberRange::open(0, 1))->default_value(confidence),
-      "confidence level of the intervals")(
+      "replicates", ranged(&replicates, NumberRange::whole_numbers(2, 1024)),
+      "R independent randomised replicates of N/R rows each (default 8): each index is their "
+      "mean, its interval mean +- t sd/sqrt(R); N must be a multiple of R")(
+      "bootstrap", ranged(&bootstrap, NumberRange::whole_numbers(0, 1e6)),
+      "percentile bootstrap with B resamples instead of replicates (0 = no intervals); on QMC a "
+      "conservative bound")("confidence",
+                            ranged(&confidence, NumberRange::open(0, 1))->default_value(confidence),
+                            "confidence level of the intervals")(
       "top", ranged(&top, NumberRange::whole_numbers(0, 1e9))->default_value(top),
       "rows per table on stdout (0 = all)");
   add_study_options(opts, f, false);
@@ -62,8 +68,13 @@ int verb_sensitivity(const Args& args) {
   so.outputs = parse_output_list(outputs_text);
   so.sobol_options.samples = samples;
   so.sobol_options.seed = f.seed;
-  so.sobol_options.bootstrap = bootstrap;
   so.sobol_options.confidence = confidence;
+  if (so.sobol) try {
+      set_sobol_intervals(so.sobol_options, vm.count("replicates") ? &replicates : nullptr,
+                          vm.count("bootstrap") ? &bootstrap : nullptr);
+    } catch (const std::invalid_argument& e) {
+      return usage_error("sensitivity", e.what());
+    }
 
   check_output_paths(study_inputs(f), study_outputs(f));
   if (!f.plot.empty()) check_plot_target(f.plot);  // before a long run, not after

@@ -1,5 +1,6 @@
 #include "weilgen/model/model.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "weilgen/model/numeric_chain.hpp"
@@ -72,6 +73,19 @@ void Model::deviation(ModelData& data, const double* axes, const double* errors,
   data.chain_errors_.assign(errors, errors + num_errors());
   const std::array<double, 6> d = chain_->deviation(data.chain_axes_, data.chain_errors_);
   std::copy(d.begin(), d.end(), out6);
+}
+
+void Model::deviation_batch(ModelData& data, const double* axes, std::size_t count,
+                            const double* errors, double* position, double* orientation) const {
+  if (abi_) {
+    abi_->deviation_batch(axes, params_.data(), count, errors, position, orientation);
+    return;
+  }
+  for (std::size_t j = 0; j < count; ++j) {
+    deviation(data, axes, errors + j * num_errors(), data.out.data());
+    if (position) std::copy_n(data.out.begin(), 3, position + 3 * j);
+    if (orientation) std::copy_n(data.out.begin() + 3, 3, orientation + 3 * j);
+  }
 }
 
 void Model::coefficients(ModelData& data, const double* axes, double* coeff) const {

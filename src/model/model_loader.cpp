@@ -42,8 +42,11 @@ std::string shell_quote(const std::string& s) {
   return q + "'";
 }
 
+// A cached object built for an older ABI version gives nullptr when `stale_ok` (it is then
+// compiled again); any other mismatch is an error.
 std::shared_ptr<Model> open_shared_object(const Description& desc, const std::string& path,
-                                          const std::string& key, const std::string& how) {
+                                          const std::string& key, const std::string& how,
+                                          bool stale_ok = false) {
   void* handle = ::dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (!handle) throw std::runtime_error("cannot load " + path + ": " + ::dlerror());
   std::shared_ptr<void> keep(handle, [](void* h) { ::dlclose(h); });
@@ -51,6 +54,7 @@ std::shared_ptr<Model> open_shared_object(const Description& desc, const std::st
   auto entry = reinterpret_cast<Entry>(::dlsym(handle, "weilgen_model_abi"));
   if (!entry) throw std::runtime_error(path + " has no weilgen_model_abi entry point");
   const WeilgenModelAbi* abi = entry();
+  if (stale_ok && abi->abi_version != kWeilgenModelAbiVersion) return nullptr;
   if (abi->abi_version != kWeilgenModelAbiVersion || key != abi->key)
     throw std::runtime_error(path + " is not the model for this machine file (key mismatch)");
   return std::make_shared<Model>(desc, abi, ModelEngine::Compiled, how + " (" + path + ")",
@@ -166,7 +170,9 @@ std::shared_ptr<Model> load_model(const Description& desc, const LoadOptions& op
   std::string damage;
   switch (model_cache::check_entry(cached.string(), damage)) {
     case model_cache::EntryState::Intact:
-      return open_shared_object(desc, cached, key, "cached");
+      // An entry built for an older ABI version gives nullptr: compiled again and replaced.
+      if (auto model = open_shared_object(desc, cached, key, "cached", true)) return model;
+      break;
     case model_cache::EntryState::Damaged: {
       std::error_code ec;
       fs::remove(cached, ec);

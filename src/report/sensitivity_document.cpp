@@ -27,6 +27,24 @@ std::string sensitivity_method_name(const SensitivityOptions& o) {
 
 const char* sampling_name(Sampling s) { return s == Sampling::Qmc ? "qmc" : "mc"; }
 
+std::string sobol_interval_text(const SensitivityResult& r) {
+  std::ostringstream os;
+  os << std::setprecision(3) << 100 * r.confidence << " % ";
+  switch (r.intervals) {
+    case SobolIntervals::Replicates:
+      os << "Student t over " << r.replicates
+         << " independent randomised replicates (each index is their mean)";
+      break;
+    case SobolIntervals::Bootstrap:
+      if (r.bootstrap == 0) return "none (--bootstrap 0)";
+      os << "percentile bootstrap, " << r.bootstrap << " resamples";
+      break;
+    case SobolIntervals::None:
+      return "none";
+  }
+  return os.str();
+}
+
 std::string sensitivity_text(const Study& st, const SensitivityOptions& opt,
                              const SensitivityResult& r, std::size_t top) {
   std::ostringstream os;
@@ -40,6 +58,7 @@ std::string sensitivity_text(const Study& st, const SensitivityOptions& opt,
        << sampling_name(opt.sobol_options.sampling) << "), " << r.evaluations
        << " model evaluations";
   os << "\n";
+  if (opt.sobol) os << "Sobol' intervals: " << sobol_interval_text(r) << "\n";
   const bool per_pose = np <= 3;
   const std::size_t groups = per_pose ? np : 1;
   for (std::size_t g = 0; g < groups; ++g) {
@@ -162,7 +181,10 @@ nlohmann::json sensitivity_json(const Study& st, const SensitivityOptions& opt,
             {"samples", opt.sobol ? nlohmann::json(so.samples) : nlohmann::json()},
             {"sampling", sampling_name(so.sampling)},
             {"seed", so.seed},
-            {"bootstrap", so.bootstrap},
+            {"intervals",
+             opt.sobol ? nlohmann::json(interval_method_name(r.intervals)) : nlohmann::json()},
+            {"replicates", opt.sobol ? nlohmann::json(r.replicates) : nlohmann::json()},
+            {"bootstrap", r.bootstrap},
             {"confidence", so.confidence},
             {"evaluations", r.evaluations}}},
           {"inputs", inputs_json(model, st.inputs)},
@@ -216,7 +238,7 @@ std::vector<Panel> sensitivity_panels(const Study& st, const SensitivityOptions&
       x.value.push_back(vx);
     }
     if (opt.sobol) {
-      if (np > 1 || opt.sobol_options.bootstrap == 0)
+      if (np > 1 || !std::isfinite(r.at(0, o, 0).S_lo))
         s.lo.clear(), s.hi.clear(), t.lo.clear(), t.hi.clear();
       b.series.push_back(s);
       b.series.push_back(t);

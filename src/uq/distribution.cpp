@@ -1,5 +1,6 @@
 #include "weilgen/uq/distribution.hpp"
 
+#include <algorithm>
 #include <boost/math/distributions/normal.hpp>
 #include <cmath>
 #include <limits>
@@ -26,12 +27,6 @@ double normal_cdf(double z) {
   if (z == kInf) return 1.0;
   if (z == -kInf) return 0.0;
   return boost::math::cdf(kStdNormal, z);
-}
-
-double normal_quantile(double p) {
-  if (p <= 0.0) return -kInf;
-  if (p >= 1.0) return kInf;
-  return boost::math::quantile(kStdNormal, p);
 }
 
 InputDistribution::InputDistribution(Kind kind, double a, double b, double lo, double hi)
@@ -138,6 +133,26 @@ double InputDistribution::quantile(double p) const {
     }
   }
   return 0;
+}
+
+void InputDistribution::quantiles(const double* p, double* x, std::size_t n) const {
+  if (is_constant()) {
+    std::fill(x, x + n, mean());
+    return;
+  }
+  switch (kind_) {
+    case Kind::Normal:
+      normal_quantiles(p, x, n);
+      for (std::size_t j = 0; j < n; ++j) x[j] = a_ + b_ * x[j];
+      return;
+    case Kind::Uniform:
+      for (std::size_t j = 0; j < n; ++j)
+        x[j] = lo_ + (hi_ - lo_) * std::min(1.0, std::max(0.0, p[j]));
+      return;
+    case Kind::TruncatedNormal:
+      for (std::size_t j = 0; j < n; ++j) x[j] = quantile(p[j]);
+      return;
+  }
 }
 
 double InputDistribution::from_standard_normal(double u) const {

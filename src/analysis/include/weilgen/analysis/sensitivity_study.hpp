@@ -18,7 +18,7 @@ namespace weilgen {
 struct SensitivityOptions {
   bool local = true, exact = true, sobol = true;  // which methods
   std::vector<OutputId> outputs = all_outputs();  // dp: sampling only
-  SobolOptions sobol_options;                     // samples, sampling, seed, bootstrap, ...
+  SobolOptions sobol_options;                     // samples, sampling, seed, intervals, ...
 
   // Throws std::invalid_argument naming the field: at least one method and one output, no
   // output twice, and the Sobol' options when sampling.
@@ -32,6 +32,13 @@ void parse_sensitivity_method(const std::string& text, SensitivityOptions& optio
 std::vector<OutputId> parse_output_list(const std::string& text);
 // "qmc" | "mc"; std::invalid_argument naming --sampling otherwise.
 Sampling parse_sampling(const std::string& text);
+// The interval flags into `options` (whose samples, sampling and seed are already set):
+// --bootstrap B (B >= 0; 0 = no intervals) selects the bootstrap, --replicates R (2..1024) the
+// randomised replicates, neither the replicates with their default R; both is an error. Checks
+// that N is a multiple of R with N/R >= 2 and that QMC replicates have a seed != 0; throws
+// std::invalid_argument naming the flag otherwise. Negative values are given as such.
+void set_sobol_intervals(SobolOptions& options, const long long* replicates,
+                         const long long* bootstrap);
 
 struct SensitivityRecord {  // one pose, output and error; NaN where not computed
   static constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -55,7 +62,9 @@ struct SensitivityResult {
   std::vector<SensitivitySummary> summary;  // [pose][output]
   std::size_t evaluations = 0;              // model evaluations for the Sobol' indices
   double confidence = 0.95;                 // of every interval
-  std::size_t bootstrap = 0;                // resamples behind the intervals (0: NaN intervals)
+  SobolIntervals intervals = SobolIntervals::Replicates;  // where the intervals come from
+  std::size_t replicates = 1;  // randomised replicates behind the Sobol' estimates
+  std::size_t bootstrap = 0;   // bootstrap resamples behind the intervals (0 unless bootstrap)
 
   const SensitivityRecord& at(std::size_t pose, std::size_t output, std::size_t error) const {
     return records[(pose * outputs.size() + output) * errors + error];

@@ -55,6 +55,11 @@ class Model {
   // (dx, dy, dz) in mm and (da, db, dc) in rad; axes in their units (mm, deg), errors in base
   // units (mm, rad).
   void deviation(ModelData& data, const double* axes, const double* errors, double* out6) const;
+  // `count` deviations at one pose in one call: errors row-major [count][num_errors()],
+  // position [count][3] (mm) and orientation [count][3] (rad), either may be null (not
+  // computed, where the engine allows). Compiled models loop inside the compiled code.
+  void deviation_batch(ModelData& data, const double* axes, std::size_t count, const double* errors,
+                       double* position, double* orientation) const;
   // d(output)/d(error) at zero error, row-major [6][num_errors] (mm or rad per base unit).
   void coefficients(ModelData& data, const double* axes, double* coeff) const;
 

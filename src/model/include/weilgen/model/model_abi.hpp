@@ -25,45 +25,66 @@ struct WeilgenModelAbi {
   // Row-major [output][error] first-order coefficients; either output may be null.
   void (*coefficients)(const double* axes, const double* params, double* position_coeff,
                        double* orientation_coeff);
+  // `count` deviations at one pose (ABI version 2): errors row-major [count][num_errors],
+  // position row-major [count][3] (dx, dy, dz) mm, orientation [count][3] (da, db, dc) rad;
+  // either may be null. One call per batch instead of one per point (Sobol' designs).
+  void (*deviation_batch)(const double* axes, const double* params, std::size_t count,
+                          const double* errors, double* position, double* orientation);
 };
 }
 
-inline constexpr int kWeilgenModelAbiVersion = 1;
+inline constexpr int kWeilgenModelAbiVersion = 2;
 
-#define WEILGEN_DEFINE_MODEL_ABI(ns, var)                                                      \
-  namespace var##_impl {                                                                       \
-    inline void deviation(const double* axes, const double* errors, const double* params,      \
-                          double* position, double* orientation) {                             \
-      std::array<double, ns::kNumAxes> a{};                                                    \
-      std::array<double, ns::kNumErrors> e{};                                                  \
-      std::array<double, ns::kNumParams> p{};                                                  \
-      std::copy_n(axes, ns::kNumAxes, a.begin());                                              \
-      std::copy_n(errors, ns::kNumErrors, e.begin());                                          \
-      std::copy_n(params, ns::kNumParams, p.begin());                                          \
-      std::array<double, 3> pos{}, ori{};                                                      \
-      ns::Deviation<double>(a, e, p, position ? &pos : nullptr, orientation ? &ori : nullptr); \
-      if (position) std::copy_n(pos.begin(), 3, position);                                     \
-      if (orientation) std::copy_n(ori.begin(), 3, orientation);                               \
-    }                                                                                          \
-    inline void coefficients(const double* axes, const double* params, double* position_coeff, \
-                             double* orientation_coeff) {                                      \
-      std::array<double, ns::kNumAxes> a{};                                                    \
-      std::array<double, ns::kNumParams> p{};                                                  \
-      std::copy_n(axes, ns::kNumAxes, a.begin());                                              \
-      std::copy_n(params, ns::kNumParams, p.begin());                                          \
-      std::array<double, 3 * ns::kNumErrors> pc{}, oc{};                                       \
-      ns::Coefficients<double>(a, p, position_coeff ? &pc : nullptr,                           \
-                               orientation_coeff ? &oc : nullptr);                             \
-      if (position_coeff) std::copy_n(pc.begin(), pc.size(), position_coeff);                  \
-      if (orientation_coeff) std::copy_n(oc.begin(), oc.size(), orientation_coeff);            \
-    }                                                                                          \
-  }                                                                                            \
-  const WeilgenModelAbi var = {kWeilgenModelAbiVersion,                                        \
-                               ns::kOrder,                                                     \
-                               ns::kMachineName,                                               \
-                               ns::kModelKey,                                                  \
-                               ns::kNumAxes,                                                   \
-                               ns::kNumErrors,                                                 \
-                               ns::kNumParams,                                                 \
-                               &var##_impl::deviation,                                         \
-                               &var##_impl::coefficients};
+#define WEILGEN_DEFINE_MODEL_ABI(ns, var)                                                        \
+  namespace var##_impl {                                                                         \
+    inline void deviation(const double* axes, const double* errors, const double* params,        \
+                          double* position, double* orientation) {                               \
+      std::array<double, ns::kNumAxes> a{};                                                      \
+      std::array<double, ns::kNumErrors> e{};                                                    \
+      std::array<double, ns::kNumParams> p{};                                                    \
+      std::copy_n(axes, ns::kNumAxes, a.begin());                                                \
+      std::copy_n(errors, ns::kNumErrors, e.begin());                                            \
+      std::copy_n(params, ns::kNumParams, p.begin());                                            \
+      std::array<double, 3> pos{}, ori{};                                                        \
+      ns::Deviation<double>(a, e, p, position ? &pos : nullptr, orientation ? &ori : nullptr);   \
+      if (position) std::copy_n(pos.begin(), 3, position);                                       \
+      if (orientation) std::copy_n(ori.begin(), 3, orientation);                                 \
+    }                                                                                            \
+    inline void coefficients(const double* axes, const double* params, double* position_coeff,   \
+                             double* orientation_coeff) {                                        \
+      std::array<double, ns::kNumAxes> a{};                                                      \
+      std::array<double, ns::kNumParams> p{};                                                    \
+      std::copy_n(axes, ns::kNumAxes, a.begin());                                                \
+      std::copy_n(params, ns::kNumParams, p.begin());                                            \
+      std::array<double, 3 * ns::kNumErrors> pc{}, oc{};                                         \
+      ns::Coefficients<double>(a, p, position_coeff ? &pc : nullptr,                             \
+                               orientation_coeff ? &oc : nullptr);                               \
+      if (position_coeff) std::copy_n(pc.begin(), pc.size(), position_coeff);                    \
+      if (orientation_coeff) std::copy_n(oc.begin(), oc.size(), orientation_coeff);              \
+    }                                                                                            \
+    inline void deviation_batch(const double* axes, const double* params, std::size_t count,     \
+                                const double* errors, double* position, double* orientation) {   \
+      std::array<double, ns::kNumAxes> a{};                                                      \
+      std::array<double, ns::kNumErrors> e{};                                                    \
+      std::array<double, ns::kNumParams> p{};                                                    \
+      std::copy_n(axes, ns::kNumAxes, a.begin());                                                \
+      std::copy_n(params, ns::kNumParams, p.begin());                                            \
+      std::array<double, 3> pos{}, ori{};                                                        \
+      for (std::size_t j = 0; j < count; ++j) {                                                  \
+        std::copy_n(errors + j * ns::kNumErrors, ns::kNumErrors, e.begin());                     \
+        ns::Deviation<double>(a, e, p, position ? &pos : nullptr, orientation ? &ori : nullptr); \
+        if (position) std::copy_n(pos.begin(), 3, position + 3 * j);                             \
+        if (orientation) std::copy_n(ori.begin(), 3, orientation + 3 * j);                       \
+      }                                                                                          \
+    }                                                                                            \
+  }                                                                                              \
+  const WeilgenModelAbi var = {kWeilgenModelAbiVersion,                                          \
+                               ns::kOrder,                                                       \
+                               ns::kMachineName,                                                 \
+                               ns::kModelKey,                                                    \
+                               ns::kNumAxes,                                                     \
+                               ns::kNumErrors,                                                   \
+                               ns::kNumParams,                                                   \
+                               &var##_impl::deviation,                                           \
+                               &var##_impl::coefficients,                                        \
+                               &var##_impl::deviation_batch};

@@ -15,6 +15,8 @@ namespace weilgen {
 // "local", "exact", "sobol" or "all"; "qmc" or "mc".
 std::string sensitivity_method_name(const SensitivityOptions& options);
 const char* sampling_name(Sampling sampling);
+// "95 % Student t over 8 independent randomised replicates ...": how the intervals were made.
+std::string sobol_interval_text(const SensitivityResult& result);
 
 // Per output, the errors ranked: per pose for up to 3 poses, else the mean over the grid; `top`
 // rows per table (0 = all).

@@ -7,6 +7,7 @@
 // work through.
 #pragma once
 
+#include <cstddef>
 #include <string>
 
 namespace weilgen {
@@ -38,6 +39,9 @@ class InputDistribution {
   double cdf(double x) const;
   // Inverse CDF for p in [0, 1]; infinite at the ends of a normal.
   double quantile(double p) const;
+  // quantile(p[j]) for j < n into x (may alias p): one pass per call, vectorised for normal
+  // and uniform inputs (the Sobol' design maps millions of points through it).
+  void quantiles(const double* p, double* x, std::size_t n) const;
 
   // x = F^-1(Phi(u)) and its inverse u = Phi^-1(F(x)).
   double from_standard_normal(double u) const;
@@ -62,9 +66,13 @@ class InputDistribution {
   double mass_ = 1;             // truncated normal: Phi(z_hi) - Phi(z_lo)
 };
 
-// Standard normal pdf, cdf and quantile (Boost.Math underneath).
+// Standard normal pdf and cdf (Boost.Math underneath).
 double normal_pdf(double z);
 double normal_cdf(double z);
+// Standard normal quantile Phi^-1(p) (Wichura's AS 241, relative error < 1e-15 over (0, 1));
+// -inf for p <= 0, +inf for p >= 1, NaN for NaN. The array form computes z[j] for j < n (z may
+// alias p), vectorising the central region.
 double normal_quantile(double p);
+void normal_quantiles(const double* p, double* z, std::size_t n);
 
 }  // namespace weilgen
