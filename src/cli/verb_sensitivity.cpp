@@ -53,18 +53,15 @@ int verb_sensitivity(const Args& args) {
   try {
     parse_sensitivity_method(method, so);
     so.sobol_options.sampling = parse_sampling(sampling);
+    so.outputs = parse_output_list(outputs_text);
+    so.sobol_options.samples = samples;
+    so.sobol_options.seed = f.seed;
+    so.sobol_options.bootstrap = bootstrap;
+    so.sobol_options.confidence = confidence;
+    so.validate();
   } catch (const std::invalid_argument& e) {
     return usage_error("sensitivity", e.what());
   }
-  if (!(confidence > 0 && confidence < 1))
-    return usage_error("sensitivity", "--confidence must be in (0, 1)");
-  if (so.sobol && samples < 2)
-    return usage_error("sensitivity", "--samples must be >= 2, not " + std::to_string(samples));
-  so.outputs = parse_output_list(outputs_text);
-  so.sobol_options.samples = samples;
-  so.sobol_options.seed = f.seed;
-  so.sobol_options.bootstrap = bootstrap;
-  so.sobol_options.confidence = confidence;
 
   if (!f.plot.empty()) check_plot_target(f.plot);  // before a long run, not after
   const Study st = open_study(f, false);
