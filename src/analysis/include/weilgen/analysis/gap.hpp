@@ -99,11 +99,11 @@ struct NoiseFloor {
 // `explained` the share of the residual's variation its bins explain: dimensions are ranked by
 // it; the region is the dimension's worst bin, widened over neighbours nearly as bad.
 struct GapRegion {
-  std::string by;      // "output", a coordinate, "t_s", "dir_X", "cycle", "T_3", "rpm"
-  std::string output;  // dx ... dc, dr
-  std::string unit;    // of from/to: the coordinate's (mm, deg), s, °C, 1/min; "" else
+  std::string by;           // "output", a coordinate, "t_s", "dir_X", "cycle", "T_3", "rpm"
+  std::string output;       // dx ... dc, dr
+  std::string unit;         // of from/to: the coordinate's (mm, deg), s, °C, 1/min; "" else
   std::vector<std::string> same_as;  // dimensions with the very same bins (dir_Y = dir_X ...)
-  double from = 0, to = 0;           // the region's range in `unit` (output: 0..0)
+  double from = 0, to = 0;  // the region's range in `unit` (output: 0..0)
   std::size_t n = 0;
   double rms_um = 0, excess_um = 0, p_value = 1;
   double explained = 0;  // between-bin share of the residual's sum of squares (dimensions)
