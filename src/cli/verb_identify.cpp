@@ -3,6 +3,7 @@
 // write the parameters as a controller header. docs/identify.md.
 #include <iostream>
 
+#include "comp_table.hpp"
 #include "study.hpp"
 #include "verbs.hpp"
 #include "weilgen/analysis/identify_request.hpp"
@@ -22,7 +23,8 @@ int verb_identify(const Args& args) {
       "weilgen identify <machine> --data FILE [options]\n\n"
       "Fits the model's error parameters to point measurements (docs/data-format.md): each\n"
       "PIGE a constant, each PDGE a basis in its own axis position (the machine file's\n"
-      "pdge_basis / basis:, else poly:3; --pdge overrides). Linear least squares through the\n"
+      "pdge_basis / basis:, else poly:3 on a linear axis and fourier:2 with a one-turn period\n"
+      "on a rotary one; --pdge overrides). Linear least squares through the\n"
       "generated coefficient matrix (column-equilibrated SVD: minimum-norm solution, rank, the\n"
       "parameter combinations the data cannot identify); Gauss-Newton for order >= 2. Predicts\n"
       "other measurements (points, ballbar circles) and writes the parameters as a standalone\n"
@@ -33,9 +35,9 @@ int verb_identify(const Args& args) {
       "measurement CSV (poses + deviations); repeatable")(
       "pdge", po::value<std::vector<std::string>>(&rq.pdge)->composing(),
       "basis of every PDGE (poly:3, fourier:2, legendre:4, chebyshev:4, fourier:2:20 = period "
-      "20 mm) or of one error (E_YY=fourier:3); repeatable, applied in order")(
-      "fix", po::value<std::vector<std::string>>(&rq.fixed)->composing(),
-      "hold an error at zero (name or alias); repeatable")(
+      "20 mm, or 20 deg on a rotary axis) or of one error (E_YY=fourier:3); repeatable, applied "
+      "in order")("fix", po::value<std::vector<std::string>>(&rq.fixed)->composing(),
+                  "hold an error at zero (name or alias); repeatable")(
       "rank-tol", po::value<double>(&rq.rank_tolerance)->default_value(rq.rank_tolerance, "1e-9"),
       "singular values below rank-tol x the largest (equilibrated columns) count as zero")(
       "predict", po::value<std::vector<std::string>>(&rq.predict)->composing(),
@@ -50,6 +52,8 @@ int verb_identify(const Args& args) {
       "quiet,q", po::bool_switch(&flags.quiet), "no model messages on stderr");
   opts.add(ballbar_circle_options(rq.circle));
   opts.add(model_options(flags));
+  CompTableFlags comp;
+  opts.add(comp_table_options(comp, true));
   po::variables_map vm;
   if (auto stop = parse_args<std::string>("identify", args, opts, "machine", 1, vm)) return *stop;
   fill_measurement_request(vm, flags, rq);
@@ -58,8 +62,15 @@ int verb_identify(const Args& args) {
   } catch (const std::invalid_argument& e) {
     return usage_error("identify", e.what());
   }
+  std::vector<std::string> inputs = rq.data;
+  inputs.insert(inputs.end(), rq.predict.begin(), rq.predict.end());
+  check_comp_table_flags(comp, vm, inputs, true);
+  if (!comp.path.empty()) check_axis_comp_table(rq.description(), comp.options);
 
   const IdentifyRun run = run_identify(rq);
+  const CompTable comp_table =
+      comp.path.empty() ? CompTable{}
+                        : axis_comp_table(*run.model, *run.param, run.result.theta, comp.options);
   std::cout << identify_text(run);
   if (!rq.predict_out.empty())
     write_file_atomically(rq.predict_out,
@@ -70,6 +81,7 @@ int verb_identify(const Args& args) {
     std::cout << "\nwrote " << emit << "\n";
   }
   if (!json_path.empty()) write_file_atomically(json_path, identify_json(run).dump(2) + "\n");
+  if (!comp.path.empty()) std::cout << "\n" << write_comp_table(comp, comp_table);
   return 0;
 }
 
