@@ -54,8 +54,9 @@ class Keywords {
   template <typename T>
   void set(const char* name, T& field) const;  // field = the value when given
 
+  std::string flag_name(const char* name) const;  // "--rank-tol" for rank_tol
+
  private:
-  std::string flag_name(const char* name) const;
   py::handle value(const char* name) const;
   std::string function_;
   py::dict kwargs_;

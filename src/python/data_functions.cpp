@@ -2,11 +2,13 @@
 // measurements. Keywords are the verbs' flags (docs/python.md); the requests, analyses and
 // documents are the ones the verbs use.
 #include "binding.hpp"
+#include "weilgen/analysis/axis_comp_table.hpp"
 #include "weilgen/analysis/gap_request.hpp"
 #include "weilgen/analysis/identify_request.hpp"
 #include "weilgen/base/atomic_file.hpp"
 #include "weilgen/measure/iso230_2_study.hpp"
 #include "weilgen/measure/pdge_fit_study.hpp"
+#include "weilgen/report/comp_table_document.hpp"
 #include "weilgen/report/gap_document.hpp"
 #include "weilgen/report/identify_document.hpp"
 #include "weilgen/report/iso230_2_document.hpp"
@@ -41,15 +43,47 @@ void measurement_keywords(py::handle machine, const Keywords& kw, MeasurementReq
   rq.warn = messages.warn();
 }
 
+// --comp-table FILE and its flags (docs/controllers.md), checked like the CLI checks them:
+// identify's table along --axis (`model_axis`), or iso230-2's from the evaluation.
+struct CompTableCall {
+  std::string path;
+  AxisCompTableOptions options;
+
+  CompTableCall(const Keywords& kw, bool model_axis, const std::vector<std::string>& inputs) {
+    kw.set("comp_table", path);
+    kw.set("comp_type", options.table.type);
+    kw.set("comp_units", options.table.linear_unit);
+    std::vector<const char*> names = {"comp_type", "comp_units"};
+    if (model_axis) {
+      kw.set("axis", options.axis);
+      kw.set("comp_points", options.points);
+      const std::vector<std::string> at = kw.items("comp_at", true);
+      if (!at.empty()) options.at = at.front();
+      names.insert(names.end(), {"axis", "comp_points", "comp_at"});
+    } else {
+      kw.set("comp_source", options.table.source);
+      names.push_back("comp_source");
+    }
+    std::vector<std::string> given;
+    for (const char* n : names)
+      if (kw.given(n)) given.push_back(kw.flag_name(n));
+    check_comp_table_flags(path, options, given, inputs, model_axis);
+  }
+  void write(const CompTable& table) const {
+    if (!path.empty()) write_file_atomically(path, linuxcnc_comp_file(table, options.table.type));
+  }
+};
+
 std::string data_path(py::handle data, const char* what) {
   if (data.is_none()) throw std::invalid_argument(std::string("no ") + what + " given");
   return value_text(data, what);
 }
 
 py::object iso230_2(py::handle data, const py::kwargs& kwargs) {
-  const Keywords kw("iso230_2", kwargs,
-                    {"axis", "column", "reference_position", "reference_cycle", "alpha",
-                     "target_tolerance", "allow_unknown", "plot"});
+  const Keywords kw(
+      "iso230_2", kwargs,
+      {"axis", "column", "reference_position", "reference_cycle", "alpha", "target_tolerance",
+       "allow_unknown", "plot", "comp_table", "comp_type", "comp_units", "comp_source"});
   const std::string path = data_path(data, "data file");
   Iso230_2StudyOptions so;
   kw.set("axis", so.axis);
@@ -63,14 +97,18 @@ py::object iso230_2(py::handle data, const py::kwargs& kwargs) {
   ro.allow_unknown = kw.flag("allow_unknown");
   std::string plot;
   kw.set("plot", plot);
+  if (!plot.empty()) check_plot_target(plot);
+  const CompTableCall comp(kw, false, {path});
   Messages messages(true);
   const nlohmann::json doc = without_gil([&] {
-    if (!plot.empty()) check_plot_target(plot);
     const MeasurementTable table = read_measurements(path, ro);
     for (const auto& w : table.warnings) messages.warn()(w);
     const Iso230_2StudyResult r = study.run(table);
+    const CompTable comp_table =
+        comp.path.empty() ? CompTable{} : comp_table_from_iso(r, comp.options.table);
     if (!plot.empty())
       write_plot(plot, iso230_2_panels(r), "ISO 230-2, " + r.columns.axis + ": " + path);
+    comp.write(comp_table);
     return iso230_2_json(path, r);
   });
   messages.issue();
@@ -111,7 +149,8 @@ py::object fit_pdge(py::handle data, const py::kwargs& kwargs) {
 py::object identify(py::handle machine, const py::kwargs& kwargs) {
   const Keywords kw(
       "identify", kwargs,
-      with_model({"data", "pdge", "fix", "rank_tol", "predict", "predict_out", "emit_params"}));
+      with_model({"data", "pdge", "fix", "rank_tol", "predict", "predict_out", "emit_params",
+                  "comp_table", "comp_type", "comp_units", "axis", "comp_points", "comp_at"}));
   IdentifyRequest rq;
   Messages messages(kw.flag("quiet"));
   measurement_keywords(machine, kw, rq, messages);
@@ -124,14 +163,22 @@ py::object identify(py::handle machine, const py::kwargs& kwargs) {
   std::string emit;
   kw.set("emit_params", emit);
   rq.validate();
+  std::vector<std::string> inputs = rq.data;
+  inputs.insert(inputs.end(), rq.predict.begin(), rq.predict.end());
+  const CompTableCall comp(kw, true, inputs);
   const nlohmann::json doc = without_gil([&] {
+    if (!comp.path.empty()) check_axis_comp_table(rq.description(), comp.options);
     const IdentifyRun run = run_identify(rq);
+    const CompTable comp_table =
+        comp.path.empty() ? CompTable{}
+                          : axis_comp_table(*run.model, *run.param, run.result.theta, comp.options);
     if (!rq.predict_out.empty())
       write_file_atomically(
           rq.predict_out, prediction_csv(*run.predictions.back().points, run.model->description()));
     if (!emit.empty())
       write_file_atomically(emit, params_header(*run.model, *run.param, run.result.theta,
                                                 identify_provenance(run.result)));
+    comp.write(comp_table);
     return identify_json(run);
   });
   messages.issue();
@@ -178,7 +225,7 @@ void register_data_functions(py::module_& m) {
 thermal-drift-eliminated evaluation.
 
 iso230_2(data, *, axis, column, reference_position, reference_cycle, alpha, target_tolerance,
-         allow_unknown, plot) -> dict: the document `weilgen iso230-2 --json` writes
+         allow_unknown, plot, comp_table, comp_type, comp_units, comp_source) -> dict: the document `weilgen iso230-2 --json` writes
 (docs/iso230-2.md). None: the CLI's default.)doc");
   m.def("fit_pdge", &fit_pdge, py::arg("data"),
         R"doc(weilgen fit-pdge: fits of position-dependent errors, order by cross-validation.
@@ -189,8 +236,9 @@ fit_pdge(data, *, basis, order, min_order, max_order, period, cv, folds, rule, c
   m.def("identify", &identify, py::arg("machine"),
         R"doc(weilgen identify: fit the error parameters to point measurements, and predict.
 
-identify(machine, *, data, pdge, fix, rank_tol, predict, predict_out, emit_params, plane,
-         centre, radius, feed, allow_unknown, order, engine, compiler, param, quiet) -> dict:
+identify(machine, *, data, pdge, fix, rank_tol, predict, predict_out, emit_params, comp_table,
+         comp_type, comp_units, axis, comp_points, comp_at, plane, centre, radius, feed,
+         allow_unknown, order, engine, compiler, param, quiet) -> dict:
 the document `weilgen identify --json` writes (docs/identify.md).)doc");
   m.def("gap", &gap, py::arg("machine"),
         R"doc(weilgen gap: where model and machine disagree, which unmodelled effect, how far

@@ -176,8 +176,9 @@ reliability(machine, *, tolerance, at, grid, limit, method, samples, confidence,
 
 The keywords are the flags of `weilgen reliability` (left out or None: the CLI's default).
 Returns the document `weilgen reliability --json` writes (docs/reliability.md).)doc");
-  m.def("allocate", &allocate, py::arg("machine"),
-        R"doc(weilgen allocate: tighten the most sensitive errors until the reliability targets hold.
+  m.def(
+      "allocate", &allocate, py::arg("machine"),
+      R"doc(weilgen allocate: tighten the most sensitive errors until the reliability targets hold.
 
 allocate(machine, *, tolerance, at, grid, min, mean, step, choose, rank, errors, max_steps,
          per_output, cost_aware, weight, max_loosen, save_tolerances, limit, method, samples,

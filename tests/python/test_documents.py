@@ -105,3 +105,17 @@ def test_gap_equals_cli(cli):
     same_document(weilgen.gap("vmc_3axis", data=POINTS, pdge="poly:2", quiet=True), want)
     want = cli.json("gap", "vmc_3axis", "-q", "--data", BALLBAR)
     same_document(weilgen.gap(weilgen.Model("vmc_3axis"), data=BALLBAR, quiet=True), want)
+
+
+def test_compensation_tables_equal_cli(cli, tmp_path):
+    """--comp-table (docs/controllers.md): the module writes the CLI's LinuxCNC file."""
+    data = source("examples", "data", "iso230_2_drift.csv")
+    cli.json("iso230-2", data, "--comp-table", str(tmp_path / "cli.tbl"), "--comp-source", "drift")
+    weilgen.iso230_2(data, comp_table=tmp_path / "module.tbl", comp_source="drift")
+    assert (tmp_path / "module.tbl").read_text() == (tmp_path / "cli.tbl").read_text()
+    cli.json("identify", "vmc_3axis", "-q", "--data", POINTS, "--comp-table",
+             str(tmp_path / "cli_x.tbl"), "--axis", "X", "--comp-points", "11", "--comp-at",
+             "Y=-200,Z=-150", "--comp-type", "1")
+    weilgen.identify("vmc_3axis", quiet=True, data=POINTS, comp_table=tmp_path / "module_x.tbl",
+                     axis="X", comp_points=11, comp_at={"Y": -200, "Z": -150}, comp_type=1)
+    assert (tmp_path / "module_x.tbl").read_text() == (tmp_path / "cli_x.tbl").read_text()

@@ -59,6 +59,13 @@ def test_bad_flags_carry_the_cli_message(cli):
                     "iso230-2", data, "--alpha", "1.5")
     raises_like_cli(cli, A, lambda: weilgen.fit_pdge(data, rule="max"),
                     "fit-pdge", data, "--rule", "max")
+    raises_like_cli(cli, A, lambda: weilgen.iso230_2(data, comp_type=1),
+                    "iso230-2", data, "--comp-type", "1")
+    raises_like_cli(cli, A, lambda: weilgen.identify("vmc_3axis", data=POINTS, axis="X"),
+                    "identify", "vmc_3axis", "--data", POINTS, "--axis", "X")
+    raises_like_cli(cli, A, lambda: weilgen.identify("vmc_3axis", data=POINTS, comp_table=POINTS,
+                                                     axis="X"),
+                    "identify", "vmc_3axis", "--data", POINTS, "--comp-table", POINTS, "--axis", "X")
     raises_like_cli(cli, A, lambda: weilgen.Model("gantry_grinder", engine="fast"),
                     "sensitivity", "gantry_grinder", "--at", "X=0,Z=600", "--engine", "fast")
 
