@@ -12,6 +12,7 @@ packages=(
   clang libclang-rt-14-dev  # libFuzzer and the sanitizer runtimes (fuzz/, scripts/fuzz.sh)
   # headless chromium and PIL: the ISO 230-2 HTML report's browser test (tests/browser)
   chromium fonts-dejavu-core python3-pil
+  python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest python3-matplotlib
 )
 # --bench: also the peer tools the benchmarks compare against (bench/openturns/run.sh).
 if [[ "${1:-}" == "--bench" ]]; then packages+=(python3-openturns python3-scipy); fi

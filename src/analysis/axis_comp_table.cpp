@@ -4,7 +4,9 @@
 #include <stdexcept>
 
 #include "weilgen/analysis/study_spec.hpp"
+#include "weilgen/base/atomic_file.hpp"
 #include "weilgen/base/format.hpp"
+#include "weilgen/base/output_paths.hpp"
 #include "weilgen/base/text.hpp"
 #include "weilgen/model/numeric_chain.hpp"
 
@@ -64,6 +66,22 @@ Line table_line(const Description& d, const AxisCompTableOptions& options) {
 }
 
 }  // namespace
+
+void check_comp_table_flags(const std::string& path, const AxisCompTableOptions& options,
+                            const std::vector<std::string>& given,
+                            const std::vector<std::string>& inputs, bool model_axis) {
+  if (path.empty()) {
+    if (!given.empty()) throw std::invalid_argument(given.front() + " needs --comp-table FILE");
+    return;
+  }
+  if (model_axis)
+    options.validate();
+  else
+    options.table.validate();
+  std::vector<PathArg> in;
+  for (const std::string& i : inputs) in.push_back({"", i});
+  check_output_paths(in, {{"--comp-table", path}});
+}
 
 void check_axis_comp_table(const Description& desc, const AxisCompTableOptions& options) {
   table_line(desc, options);

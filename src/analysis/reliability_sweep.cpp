@@ -42,6 +42,11 @@ ReliabilitySettings parse_reliability_settings(const std::string& method, const 
   return s;
 }
 
+ReliabilitySettings parse_reliability_flags(const ReliabilityFlags& f, std::uint64_t seed) {
+  return parse_reliability_settings(f.method, f.limit, f.sensitivities, f.samples, f.confidence,
+                                    seed);
+}
+
 ReliabilitySweep::ReliabilitySweep(ReliabilitySettings settings) : settings_(std::move(settings)) {
   settings_.options.validate();
 }

@@ -17,6 +17,12 @@ void SensitivityOptions::validate() const {
         outputs.begin() + static_cast<std::ptrdiff_t>(o))
       throw std::invalid_argument(std::string("--outputs: \"") + output_name(outputs[o]) +
                                   "\" given twice");
+  // Named by their flags before SobolOptions::validate names them by field.
+  if (!(sobol_options.confidence > 0 && sobol_options.confidence < 1))
+    throw std::invalid_argument("--confidence must be in (0, 1)");
+  if (sobol && sobol_options.samples < 2)
+    throw std::invalid_argument("--samples must be >= 2, not " +
+                                std::to_string(sobol_options.samples));
   if (sobol) sobol_options.validate();
 }
 

@@ -76,11 +76,9 @@ std::shared_ptr<Model> open_model(const StudyRequest& r, const Description& desc
   return model;
 }
 
-Study open_study(const StudyRequest& r, bool need_tolerances) {
-  if (r.machine.empty()) throw std::invalid_argument("no machine given");
-  const Description desc = load_machine_file(resolve_machine(r.machine));
-  // A model too large to generate is refused before the other inputs are read.
-  if (r.order != 0) check_algebra_size(desc, r.order, "--order " + std::to_string(r.order));
+namespace {
+// Poses, distributions, tolerances and threads: checked before a model is compiled.
+Study study_inputs(const StudyRequest& r, const Description& desc, bool need_tolerances) {
   Study s;
   s.poses = parse_poses(desc, r.at, r.grid);
   s.inputs = error_distributions(desc, r.tolerance_files, r.set);
@@ -88,9 +86,37 @@ Study open_study(const StudyRequest& r, bool need_tolerances) {
     if (r.tolerance.empty()) throw std::invalid_argument("no --tolerance given (e.g. dx=0.03mm)");
     s.tolerances = parse_tolerances(r.tolerance);
   }
-  s.model = open_model(r, desc);
   s.threads = resolve_threads(r.threads);
   return s;
+}
+}  // namespace
+
+Study open_study(const StudyRequest& r, bool need_tolerances) {
+  if (r.machine.empty()) throw std::invalid_argument("no machine given");
+  const Description desc = load_machine_file(resolve_machine(r.machine));
+  // A model too large to generate is refused before the other inputs are read.
+  if (r.order != 0) check_algebra_size(desc, r.order, "--order " + std::to_string(r.order));
+  Study s = study_inputs(r, desc, need_tolerances);
+  s.model = open_model(r, desc);
+  return s;
+}
+
+Study open_study(const StudyRequest& r, std::shared_ptr<const Model> model, bool need_tolerances) {
+  Study s = study_inputs(r, model->description(), need_tolerances);
+  s.model = std::move(model);
+  return s;
+}
+
+void MeasurementRequest::check_machine() const {
+  if (model.machine.empty() && !opened) throw std::invalid_argument("no machine given");
+}
+
+Description MeasurementRequest::description() const {
+  return opened ? opened->description() : load_machine_file(resolve_machine(model.machine));
+}
+
+std::shared_ptr<const Model> MeasurementRequest::open(const Description& desc) const {
+  return opened ? opened : open_model(model, desc);
 }
 
 }  // namespace weilgen

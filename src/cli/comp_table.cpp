@@ -36,22 +36,17 @@ po::options_description comp_table_options(CompTableFlags& f, bool model_axis) {
 }
 
 void check_comp_table_flags(const CompTableFlags& f, const po::variables_map& vm, bool model_axis) {
-  if (f.path.empty()) {
-    // iso230-2 has an --axis of its own (the data's coordinate column).
-    const std::vector<const char*> own =
-        model_axis ? std::vector<const char*>{"axis", "comp-points", "comp-at"}
-                   : std::vector<const char*>{"comp-source"};
-    std::vector<const char*> flags = {"comp-type", "comp-units"};
-    flags.insert(flags.end(), own.begin(), own.end());
-    for (const char* flag : flags)
-      if (vm.count(flag) && !vm[flag].defaulted())
-        throw std::invalid_argument(std::string("--") + flag + " needs --comp-table FILE");
-    return;
-  }
-  if (model_axis)
-    f.options.validate();
-  else
-    f.options.table.validate();
+  // iso230-2 has an --axis of its own (the data's coordinate column).
+  const std::vector<const char*> own =
+      model_axis ? std::vector<const char*>{"axis", "comp-points", "comp-at"}
+                 : std::vector<const char*>{"comp-source"};
+  std::vector<const char*> flags = {"comp-type", "comp-units"};
+  flags.insert(flags.end(), own.begin(), own.end());
+  std::vector<std::string> given;
+  for (const char* flag : flags)
+    if (vm.count(flag) && !vm[flag].defaulted()) given.push_back(std::string("--") + flag);
+  // The file itself is checked by the verb with its other outputs (check_output_paths).
+  weilgen::check_comp_table_flags(f.path, f.options, given, {}, model_axis);
 }
 
 std::string write_comp_table(const CompTableFlags& f, const CompTable& table) {

@@ -12,6 +12,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "weilgen/base/output_paths.hpp"
 #include "weilgen/base/range.hpp"
 #include "weilgen/machine/description.hpp"
 
@@ -72,22 +73,6 @@ RangedValue<T>* ranged(T* store, NumberRange range) {
 
 // --threads: 0 (every core) to 1024.
 NumberRange thread_range();
-
-// A file a command reads or writes, and the flag that names it ("" for a positional argument,
-// e.g. the machine or data file).
-struct PathArg {
-  std::string flag;  // "--json", "--data", "machine file"
-  std::string path;
-};
-
-// Refuses (std::invalid_argument, exit 2) an output that is one of the inputs or another output
-// (compared as canonical paths, so ./a.csv, a.csv and a symbolic link to it are the same file),
-// and an output that is an existing directory. Empty paths are skipped.
-void check_output_paths(const std::vector<PathArg>& inputs, const std::vector<PathArg>& outputs);
-
-// An output directory (gap --plot DIR): refused when it is an input or an existing file, or
-// cannot be created.
-void check_output_dir(const std::vector<PathArg>& inputs, const PathArg& dir);
 
 // The algebra order asked by --order (0 = the file's): refuses a model too large to generate
 // (exit 2, with the estimate of its terms) and prints a warning with the estimate for a large one

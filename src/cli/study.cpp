@@ -112,6 +112,14 @@ Study open_study(const StudyFlags& f, bool need_tolerances) {
   return weilgen::open_study(study_request(f), need_tolerances);
 }
 
+void fill_measurement_request(const po::variables_map& vm, StudyFlags& flags,
+                              MeasurementRequest& request) {
+  if (vm.count("machine")) flags.machine = vm["machine"].as<std::string>();
+  request.model = study_request(flags);
+  request.allow_unknown = vm.count("allow-unknown") > 0;
+  request.warn = [](const std::string& w) { std::cerr << w << "\n"; };
+}
+
 void add_reliability_options(po::options_description& opts, ReliabilityFlags& f) {
   po::options_description r("Reliability");
   r.add_options()("limit", po::value<std::string>(&f.limit)->default_value(f.limit),
@@ -126,11 +134,6 @@ void add_reliability_options(po::options_description& opts, ReliabilityFlags& f)
       "dR/dmu, dR/dsigma by: auto (sampling for radial, else FORM; analytic when exact) |\n"
       "form | sampling (importance sampling differentiating its own estimate)");
   opts.add(r);
-}
-
-ReliabilitySettings parse_reliability_flags(const ReliabilityFlags& f, std::uint64_t seed) {
-  return parse_reliability_settings(f.method, f.limit, f.sensitivities, f.samples, f.confidence,
-                                    seed);
 }
 
 void write_output(const std::string& path, const std::string& text) {

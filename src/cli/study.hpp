@@ -52,18 +52,15 @@ StudyRequest study_request(const StudyFlags& flags);
 // analysis/study.hpp's open_model and open_study over the flags.
 std::shared_ptr<Model> open_model(const StudyFlags& flags, const Description& desc);
 Study open_study(const StudyFlags& flags, bool need_tolerances);
+// After parsing, what `identify` and `gap` share: the machine (the positional argument), the
+// model flags, --allow-unknown, and the readers' warnings on stderr.
+void fill_measurement_request(const boost::program_options::variables_map& vm, StudyFlags& flags,
+                              MeasurementRequest& request);
 
 // The reliability flags shared by `reliability` and `allocate`: --limit --method --samples
-// --confidence --sensitivities.
-struct ReliabilityFlags {
-  std::string limit = "two-sided", method = "auto", sensitivities = "auto";
-  std::size_t samples = 1u << 14;
-  double confidence = 0.95;
-};
+// --confidence --sensitivities (ReliabilityFlags: analysis/reliability_sweep.hpp).
 void add_reliability_options(boost::program_options::options_description& opts,
                              ReliabilityFlags& flags);
-// Parsed and checked (std::invalid_argument naming the flag).
-ReliabilitySettings parse_reliability_flags(const ReliabilityFlags& flags, std::uint64_t seed);
 
 // Writes `text` to `path` atomically (temporary file, then rename).
 void write_output(const std::string& path, const std::string& text);

@@ -25,8 +25,7 @@ int verb_allocate(const Args& args) {
       "min R >= --min and mean R >= --mean over the poses for every output. With --cost-aware,\n"
       "also the spreads minimising sum w_i/sigma_i under the same targets.\n\nOptions");
   StudyFlags f;
-  ReliabilityFlags rf;
-  rf.samples = 1u << 13;
+  ReliabilityFlags rf = ReliabilityFlags::for_allocation();
   std::string errors_text, save, rank = "scaled";
   std::vector<std::string> step_flags, weight_flags;
   double min_target = 0.95, mean_target = 0.97, loosen = 4.0;

@@ -4,12 +4,11 @@
 #include <iostream>
 
 #include "comp_table.hpp"
+#include "flags.hpp"
 #include "study.hpp"
 #include "verbs.hpp"
-#include "weilgen/analysis/identify.hpp"
-#include "weilgen/analysis/prediction.hpp"
+#include "weilgen/analysis/identify_request.hpp"
 #include "weilgen/base/atomic_file.hpp"
-#include "weilgen/machine/yaml_loader.hpp"
 #include "weilgen/report/identify_document.hpp"
 #include "weilgen/report/params_header.hpp"
 #include "weilgen/report/prediction_document.hpp"
@@ -20,6 +19,7 @@ namespace weilgen::cli {
 
 int verb_identify(const Args& args) {
   StudyFlags flags;
+  IdentifyRequest rq;
   po::options_description opts(
       "weilgen identify <machine> --data FILE [options]\n\n"
       "Fits the model's error parameters to point measurements (docs/data-format.md): each\n"
@@ -30,92 +30,64 @@ int verb_identify(const Args& args) {
       "parameter combinations the data cannot identify); Gauss-Newton for order >= 2. Predicts\n"
       "other measurements (points, ballbar circles) and writes the parameters as a standalone\n"
       "controller header. docs/identify.md.\n\nOptions");
-  std::vector<std::string> data, pdge, fixed, predict;
-  std::string json_path, emit, predict_out;
-  BallbarFlags circle;
-  double rank_tol = 1e-9;
+  std::string json_path, emit;
   opts.add_options()("help,h", "show this help")(
-      "data", po::value<std::vector<std::string>>(&data)->composing(),
+      "data", po::value<std::vector<std::string>>(&rq.data)->composing(),
       "measurement CSV (poses + deviations); repeatable")(
-      "pdge", po::value<std::vector<std::string>>(&pdge)->composing(),
+      "pdge", po::value<std::vector<std::string>>(&rq.pdge)->composing(),
       "basis of every PDGE (poly:3, fourier:2, legendre:4, chebyshev:4, fourier:2:20 = period "
       "20 mm, or 20 deg on a rotary axis) or of one error (E_YY=fourier:3); repeatable, applied "
-      "in order")("fix", po::value<std::vector<std::string>>(&fixed)->composing(),
+      "in order")("fix", po::value<std::vector<std::string>>(&rq.fixed)->composing(),
                   "hold an error at zero (name or alias); repeatable")(
-      "rank-tol", ranged(&rank_tol, NumberRange::open(0, 1))->default_value(rank_tol, "1e-9"),
+      "rank-tol",
+      ranged(&rq.rank_tolerance, NumberRange::open(0, 1))->default_value(rq.rank_tolerance, "1e-9"),
       "singular values below rank-tol x the largest (equilibrated columns) count as zero")(
-      "predict", po::value<std::vector<std::string>>(&predict)->composing(),
+      "predict", po::value<std::vector<std::string>>(&rq.predict)->composing(),
       "predict the deviations at the poses of a CSV (compared with its measured deviations "
       "when present) or a ballbar trace (angle_deg, or a '# plane:' header); repeatable")(
-      "predict-out", po::value<std::string>(&predict_out),
+      "predict-out", po::value<std::string>(&rq.predict_out),
       "write the predictions of the last --predict file to FILE (CSV)")(
       "json", po::value<std::string>(&json_path), "write the results as JSON to FILE")(
       "emit-params", po::value<std::string>(&emit),
       "write the identified parameters as a standalone C++ header to FILE")(
       "allow-unknown", "warn about unknown columns instead of failing")(
       "quiet,q", po::bool_switch(&flags.quiet), "no model messages on stderr");
-  opts.add(ballbar_circle_options(circle));
+  opts.add(ballbar_circle_options(rq.circle));
   opts.add(model_options(flags));
   CompTableFlags comp;
   opts.add(comp_table_options(comp, true));
   po::variables_map vm;
   if (auto stop = parse_args<std::string>("identify", args, opts, "machine", 1, vm)) return *stop;
-  if (!vm.count("machine")) return usage_error("identify", "no machine given");
-  if (data.empty()) return usage_error("identify", "no --data file given");
-  if (!predict_out.empty() && predict.empty())
-    return usage_error("identify", "--predict-out needs a --predict file");
-  flags.machine = vm["machine"].as<std::string>();
+  fill_measurement_request(vm, flags, rq);
+  try {
+    rq.validate();
+  } catch (const std::invalid_argument& e) {
+    return usage_error("identify", e.what());
+  }
   std::vector<PathArg> inputs = study_inputs(flags);
-  for (const std::string& d : data) inputs.push_back({"--data", d});
-  for (const std::string& p : predict) inputs.push_back({"--predict", p});
+  for (const std::string& d : rq.data) inputs.push_back({"--data", d});
+  for (const std::string& p : rq.predict) inputs.push_back({"--predict", p});
   check_output_paths(inputs, {{"--json", json_path},
                               {"--emit-params", emit},
-                              {"--predict-out", predict_out},
+                              {"--predict-out", rq.predict_out},
                               {"--comp-table", comp.path}});
   check_comp_table_flags(comp, vm, true);
+  if (!comp.path.empty()) check_axis_comp_table(rq.description(), comp.options);
 
-  const Description desc = load_machine_file(resolve_machine(flags.machine));
-  if (!comp.path.empty()) check_axis_comp_table(desc, comp.options);
-  const PdgeBasisChoice choice = parse_pdge_flags(desc, pdge);
-  const std::shared_ptr<Model> model = open_model(flags, desc);
-  const ErrorParameterisation param(model->description(), choice, model->parameters());
-  const ReadOptions ro = machine_read_options(desc, vm.count("allow-unknown") > 0);
-  const PointData points =
-      merged_point_data(data, desc, ro, [](const std::string& w) { std::cerr << w << "\n"; });
-
-  IdentifyOptions io;
-  io.rank_tolerance = rank_tol;
-  io.fixed = fixed;
-  const IdentifyResult r = Identification(io).run(*model, param, points);
+  const IdentifyRun run = run_identify(rq);
   const CompTable comp_table =
-      comp.path.empty() ? CompTable{} : axis_comp_table(*model, param, r.theta, comp.options);
-  std::cout << identify_text(*model, param, r, points);
-
-  nlohmann::json j = identify_json(*model, param, r, data);
-  j["predictions"] = nlohmann::json::array();
-  for (std::size_t i = 0; i < predict.size(); ++i) {
-    const MeasurementTable t = read_measurements(predict[i], ro);
-    for (const auto& w : t.warnings) std::cerr << w << "\n";
-    if (is_ballbar_table(t)) {
-      if (i + 1 == predict.size() && !predict_out.empty())
-        throw std::invalid_argument("--predict-out: " + predict[i] +
-                                    " is a ballbar trace; the JSON carries its predicted trace");
-      const BallbarPrediction bp = predict_ballbar_table(*model, param, r.theta, t, circle);
-      std::cout << "\n" << ballbar_prediction_text(bp);
-      j["predictions"].push_back(ballbar_prediction_json(bp));
-      continue;
-    }
-    const Prediction pr = predict_table(*model, param, r.theta, t);
-    std::cout << "\n" << prediction_text(pr);
-    j["predictions"].push_back(prediction_json(pr));
-    if (i + 1 == predict.size() && !predict_out.empty())
-      write_file_atomically(predict_out, prediction_csv(pr, desc));
-  }
+      comp.path.empty() ? CompTable{}
+                        : axis_comp_table(*run.model, *run.param, run.result.theta, comp.options);
+  std::cout << identify_text(run);
+  if (!rq.predict_out.empty())
+    write_file_atomically(rq.predict_out,
+                          prediction_csv(*run.predictions.back().points, run.model->description()));
   if (!emit.empty()) {
-    write_file_atomically(emit, params_header(*model, param, r.theta, identify_provenance(r)));
+    write_file_atomically(emit, params_header(*run.model, *run.param, run.result.theta,
+                                              identify_provenance(run.result)));
     std::cout << "\nwrote " << emit << "\n";
   }
-  if (!json_path.empty()) write_file_atomically(json_path, j.dump(2) + "\n");
+  if (!json_path.empty()) write_file_atomically(json_path, identify_json(run).dump(2) + "\n");
   if (!comp.path.empty()) std::cout << "\n" << write_comp_table(comp, comp_table);
   return 0;
 }

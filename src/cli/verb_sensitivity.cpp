@@ -62,19 +62,17 @@ int verb_sensitivity(const Args& args) {
   try {
     parse_sensitivity_method(method, so);
     so.sobol_options.sampling = parse_sampling(sampling);
+    so.outputs = parse_output_list(outputs_text);
+    so.sobol_options.samples = samples;
+    so.sobol_options.seed = f.seed;
+    so.sobol_options.confidence = confidence;
+    if (so.sobol)
+      set_sobol_intervals(so.sobol_options, vm.count("replicates") ? &replicates : nullptr,
+                          vm.count("bootstrap") ? &bootstrap : nullptr);
+    so.validate();
   } catch (const std::invalid_argument& e) {
     return usage_error("sensitivity", e.what());
   }
-  so.outputs = parse_output_list(outputs_text);
-  so.sobol_options.samples = samples;
-  so.sobol_options.seed = f.seed;
-  so.sobol_options.confidence = confidence;
-  if (so.sobol) try {
-      set_sobol_intervals(so.sobol_options, vm.count("replicates") ? &replicates : nullptr,
-                          vm.count("bootstrap") ? &bootstrap : nullptr);
-    } catch (const std::invalid_argument& e) {
-      return usage_error("sensitivity", e.what());
-    }
 
   check_output_paths(study_inputs(f), study_outputs(f));
   if (!f.plot.empty()) check_plot_target(f.plot);  // before a long run, not after

@@ -1,5 +1,6 @@
 #include "weilgen/machine/yaml_loader.hpp"
 
+#include <dlfcn.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -130,6 +131,18 @@ std::string shipped_machines_dir() {
   if (!ec) {
     const fs::path installed = exe.parent_path().parent_path() / "share" / "weilgen" / "machines";
     if (fs::is_directory(installed, ec)) return installed.string();
+  }
+  // An installed module loaded by another program (the Python module in
+  // <prefix>/lib/python3.X/dist-packages): the prefix is a few levels above the module.
+  static const int anchor = 0;  // an address inside this module
+  Dl_info info{};
+  if (dladdr(&anchor, &info) != 0 && info.dli_fname) {
+    fs::path dir = fs::absolute(info.dli_fname, ec).parent_path();
+    for (int up = 0; up < 4 && dir.has_parent_path() && dir != dir.root_path(); ++up) {
+      dir = dir.parent_path();
+      const fs::path installed = dir / "share" / "weilgen" / "machines";
+      if (fs::is_directory(installed, ec)) return installed.string();
+    }
   }
   return WEILGEN_MACHINES_DIR;
 }

@@ -328,4 +328,15 @@ std::string gap_markdown(const GapResult& r, const Model& model, const std::stri
   return md;
 }
 
+std::vector<std::string> write_gap_plots(const std::string& dir, const GapData& gd,
+                                         const GapResult& r) {
+  std::filesystem::create_directories(dir);
+  std::vector<std::string> pngs;
+  for (const GapPlot& p : gap_plots(gd, r)) {
+    pngs.push_back(dir + "/" + p.stem + ".png");
+    write_plot(pngs.back(), p.panels, p.title);
+  }
+  return pngs;
+}
+
 }  // namespace weilgen

@@ -7,6 +7,7 @@
 #include "weilgen/base/format.hpp"
 #include "weilgen/base/version.hpp"
 #include "weilgen/report/json_common.hpp"
+#include "weilgen/report/prediction_document.hpp"
 
 namespace weilgen {
 
@@ -128,6 +129,22 @@ std::string identify_text(const Model& model, const ErrorParameterisation& param
       os << "  " << i + 1 << ". " << r.unidentifiable[i].str(param.parameters()) << "\n";
   }
   return os.str();
+}
+
+json identify_json(const IdentifyRun& run) {
+  json j = identify_json(*run.model, *run.param, run.result, run.files);
+  j["predictions"] = json::array();
+  for (const FilePrediction& p : run.predictions)
+    j["predictions"].push_back(p.ballbar ? ballbar_prediction_json(*p.ballbar)
+                                         : prediction_json(*p.points));
+  return j;
+}
+
+std::string identify_text(const IdentifyRun& run) {
+  std::string text = identify_text(*run.model, *run.param, run.result, run.points);
+  for (const FilePrediction& p : run.predictions)
+    text += "\n" + (p.ballbar ? ballbar_prediction_text(*p.ballbar) : prediction_text(*p.points));
+  return text;
 }
 
 }  // namespace weilgen

@@ -32,6 +32,15 @@ struct AxisCompTableOptions {
   void validate() const;
 };
 
+// The table flags of a verb before any work, for every front end: without a table (`path`
+// empty) each flag in `given` (written "--comp-type" ...) is refused as needing --comp-table;
+// with one, the options valid (all of them with `model_axis`, `identify`'s table; else the
+// table options, `iso230-2`'s) and `path` none of `inputs` (std::invalid_argument naming the
+// flag).
+void check_comp_table_flags(const std::string& path, const AxisCompTableOptions& options,
+                            const std::vector<std::string>& given,
+                            const std::vector<std::string>& inputs, bool model_axis);
+
 // Checks the options against the machine before any work: validate(), the axis a coordinate
 // of the model with a finite range, --comp-at naming the other axes within their ranges
 // (std::invalid_argument naming the flag).

@@ -42,6 +42,22 @@ ReliabilitySettings parse_reliability_settings(const std::string& method, const 
                                                std::size_t samples, double confidence,
                                                std::uint64_t seed);
 
+// Those flags as written, with the defaults of `weilgen reliability` (every front end fills
+// this and parses it with parse_reliability_flags, so the defaults have one home).
+struct ReliabilityFlags {
+  std::string limit = "two-sided", method = "auto", sensitivities = "auto";
+  std::size_t samples = 1u << 14;
+  double confidence = 0.95;
+  // `weilgen allocate`'s defaults: fewer samples per pose (it recomputes every step).
+  static ReliabilityFlags for_allocation() {
+    ReliabilityFlags f;
+    f.samples = 1u << 13;
+    return f;
+  }
+};
+// Parsed and checked (std::invalid_argument naming the flag).
+ReliabilitySettings parse_reliability_flags(const ReliabilityFlags& flags, std::uint64_t seed);
+
 // R of every (pose, toleranced output) of a study, for the given error distributions (the
 // study's own or an allocation's). Order-1 outputs go to ReliabilityAnalysis as exact linear
 // forms, dp and higher orders through the model. Cases ordered tolerance-major: all poses of

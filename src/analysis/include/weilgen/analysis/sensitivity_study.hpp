@@ -20,8 +20,8 @@ struct SensitivityOptions {
   std::vector<OutputId> outputs = all_outputs();  // dp: sampling only
   SobolOptions sobol_options;                     // samples, sampling, seed, intervals, ...
 
-  // Throws std::invalid_argument naming the field: at least one method and one output, no
-  // output twice, and the Sobol' options when sampling.
+  // Throws std::invalid_argument naming the flag: at least one method and one output, no
+  // output twice, --confidence in (0, 1), and the Sobol' options (--samples >= 2) when sampling.
   void validate() const;
 };
 

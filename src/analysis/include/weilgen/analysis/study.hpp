@@ -11,6 +11,7 @@
 
 #include "weilgen/analysis/study_spec.hpp"
 #include "weilgen/machine/description.hpp"
+#include "weilgen/measure/ballbar.hpp"
 #include "weilgen/model/model.hpp"
 #include "weilgen/uq/distribution.hpp"
 
@@ -44,5 +45,27 @@ std::shared_ptr<Model> open_model(const StudyRequest& request, const Description
 // Loads the machine and its model and parses poses, distributions and (when needed) tolerances.
 // Throws std::invalid_argument for bad inputs as written and InputError for bad files.
 Study open_study(const StudyRequest& request, bool need_tolerances);
+// The same for a model opened earlier (a front end that keeps models, such as the Python
+// module): the request's machine, order, engine, compiler and params are not used.
+Study open_study(const StudyRequest& request, std::shared_ptr<const Model> model,
+                 bool need_tolerances);
+
+// What the verbs that fit a model to measurements (identify, gap) share: the model, how files
+// are read, the ballbar circle of a trace. Their requests (identify_request.hpp,
+// gap_request.hpp) add their own flags.
+struct MeasurementRequest {
+  StudyRequest model;                            // machine, order, engine, compiler, params, log
+  std::shared_ptr<const Model> opened;           // a model opened earlier, used instead of `model`
+  bool allow_unknown = false;                    // --allow-unknown
+  BallbarFlags circle;                           // --plane --centre --radius --feed
+  std::function<void(const std::string&)> warn;  // the readers' warnings (may be empty)
+
+  // std::invalid_argument "no machine given" without a machine or an opened model.
+  void check_machine() const;
+  // The opened model's description, or the machine file's (InputError).
+  Description description() const;
+  // The opened model, or open_model(model, desc).
+  std::shared_ptr<const Model> open(const Description& desc) const;
+};
 
 }  // namespace weilgen

@@ -23,7 +23,8 @@ Description load_machine_text(const std::string& yaml, const std::string& filena
 // Throws InputError (loc.file = the argument) when neither exists.
 std::string resolve_machine(const std::string& name_or_path);
 // Where shipped machines live: $WEILGEN_MACHINES_DIR if set, else the source tree's machines/
-// when it exists, else <prefix>/share/weilgen/machines next to an installed executable.
+// when it exists, else <prefix>/share/weilgen/machines next to an installed executable, or
+// above an installed module (the Python module in <prefix>/lib/python3.X/dist-packages).
 std::string shipped_machines_dir();
 
 // The distribution keys of a machine file's error or error_defaults entry, for other files that

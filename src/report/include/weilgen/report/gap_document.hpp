@@ -26,5 +26,8 @@ struct GapPlot {
 // The residual along time, the trace angle, where the named effects act and the significant
 // regions, then the effect ranking.
 std::vector<GapPlot> gap_plots(const GapData& data, const GapResult& result);
+// Draws gap_plots into `dir` (created when missing) as <stem>.png; returns the paths written.
+std::vector<std::string> write_gap_plots(const std::string& dir, const GapData& data,
+                                         const GapResult& result);
 
 }  // namespace weilgen

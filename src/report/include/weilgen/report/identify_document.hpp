@@ -8,13 +8,20 @@
 #include <vector>
 
 #include "weilgen/analysis/identify.hpp"
+#include "weilgen/analysis/identify_request.hpp"
 
 namespace weilgen {
 
 std::string identify_text(const Model& model, const ErrorParameterisation& param,
                           const IdentifyResult& result, const PointData& data);
-// `files`: the --data files; the verb adds "predictions".
+// `files`: the --data files; without "predictions" (identify_json(run) adds them).
 nlohmann::json identify_json(const Model& model, const ErrorParameterisation& param,
                              const IdentifyResult& result, const std::vector<std::string>& files);
+
+// The document of a whole run (`weilgen identify --json`): identify_json of the run with
+// "predictions", one entry per --predict file (prediction_document.hpp).
+nlohmann::json identify_json(const IdentifyRun& run);
+// The text of a whole run: identify_text, then each prediction's text.
+std::string identify_text(const IdentifyRun& run);
 
 }  // namespace weilgen

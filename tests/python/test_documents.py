@@ -1,0 +1,121 @@
+"""Every analysis of the module returns the document the CLI's --json writes, number for number,
+on the shipped machines and examples; keywords in the CLI's text or as dicts give the same."""
+import weilgen
+from conftest import same_document, source
+
+GRID = "X=0,Y=-1500:1500:3,Z=600:1400:3"
+GRID_DICT = {"X": 0, "Y": (-1500, 1500, 3), "Z": "600:1400:3"}
+POINTS = source("examples", "data", "vmc_3axis_points.csv")
+BALLBAR = source("examples", "data", "vmc_3axis_ballbar.csv")
+
+
+def test_sensitivity_equals_cli(cli):
+    want = cli.json("sensitivity", "gantry_grinder", "--grid", GRID, "--samples", "1024",
+                    "--bootstrap", "50", "--seed", "7", "--quiet")
+    got = weilgen.sensitivity("gantry_grinder", grid=GRID, samples=1024, bootstrap=50, seed=7,
+                              quiet=True)
+    same_document(got, want)
+    # The grid as a dict, and a weilgen.Model instead of the name: the same document.
+    model = weilgen.Model("gantry_grinder")
+    same_document(weilgen.sensitivity(model, grid=GRID_DICT, samples=1024, bootstrap=50, seed=7),
+                  want)
+    # Large numeric arrays are numpy arrays; plain() gives the CLI's lists.
+    assert got["results"][0]["S_ci"].dtype.kind == "f"
+
+
+def test_sensitivity_options_equal_cli(cli):
+    want = cli.json("sensitivity", "vmc_3axis", "--at", "X=100,Y=-200,Z=-300", "--at",
+                    "X=0,Y=0,Z=0", "--method", "sobol", "--outputs", "dx,dp", "--sampling", "mc",
+                    "--samples", "512", "--bootstrap", "20", "--confidence", "0.9", "--set",
+                    "E_XX=sigma:5um", "--set", "group:angular=sigma:2urad", "--param",
+                    "tool_length=120", "--quiet")
+    got = weilgen.sensitivity("vmc_3axis", at=[{"X": 100, "Y": -200, "Z": -300}, "X=0,Y=0,Z=0"],
+                              method="sobol", outputs=["dx", "dp"], sampling="mc", samples=512,
+                              bootstrap=20, confidence=0.9,
+                              set={"E_XX": "sigma:5um", "group:angular": "sigma:2urad"},
+                              param={"tool_length": 120}, quiet=True)
+    same_document(got, want)
+
+
+def test_reliability_equals_cli(cli):
+    want = cli.json("reliability", "gantry_grinder", "--grid", GRID, "--tolerance", "dx=0.03mm",
+                    "--limit", "one-sided", "--quiet")
+    same_document(weilgen.reliability("gantry_grinder", grid=GRID, tolerance={"dx": "0.03mm"},
+                                      limit="one-sided", quiet=True), want)
+    # Sampled: importance sampling of the radial limit, same seed, same numbers.
+    want = cli.json("reliability", "gantry_grinder", "--grid", GRID, "--tolerance", "dp=0.045mm",
+                    "--limit", "radial", "--method", "is", "--samples", "2048", "--seed", "3",
+                    "--quiet")
+    same_document(weilgen.reliability("gantry_grinder", grid=GRID, tolerance="dp=0.045mm",
+                                      limit="radial", method="is", samples=2048, seed=3,
+                                      quiet=True), want)
+
+
+def test_allocate_equals_cli(cli, tmp_path):
+    args = ["--grid", "X=0,Y=-1500:1500:5,Z=600:1400:5", "--tolerance", "dx=0.03mm", "--limit",
+            "one-sided", "--step", "0.005/6mm", "--step", "0.005/6000rad", "--step",
+            "E_C0X=0.005/3000rad", "--rank", "raw", "--cost-aware", "--quiet"]
+    want = cli.json("allocate", "gantry_grinder", *args, "--save-tolerances",
+                    str(tmp_path / "cli.yaml"))
+    got = weilgen.allocate("gantry_grinder", grid="X=0,Y=-1500:1500:5,Z=600:1400:5",
+                           tolerance="dx=0.03mm", limit="one-sided",
+                           step=["0.005/6mm", "0.005/6000rad", "E_C0X=0.005/3000rad"],
+                           rank="raw", cost_aware=True, quiet=True,
+                           save_tolerances=tmp_path / "module.yaml")
+    same_document(got, want)
+    assert got["met"] is True
+    assert (tmp_path / "module.yaml").read_text() == (tmp_path / "cli.yaml").read_text()
+
+
+def test_iso230_2_equals_cli(cli):
+    for name in ("iso230_2_drift.csv", "iso230_2_small.csv"):
+        data = source("examples", "data", name)
+        same_document(weilgen.iso230_2(data), cli.json("iso230-2", data))
+    data = source("examples", "data", "iso230_2_drift.csv")
+    want = cli.json("iso230-2", data, "--alpha", "0.05", "--reference-cycle", "2")
+    same_document(weilgen.iso230_2(data, alpha=0.05, reference_cycle=2), want)
+
+
+def test_fit_pdge_equals_cli(cli):
+    data = source("examples", "data", "line6d_x.csv")
+    same_document(weilgen.fit_pdge(data), cli.json("fit-pdge", data))
+    want = cli.json("fit-pdge", data, "--basis", "fourier:auto,poly:5", "--cv", "blocks",
+                    "--folds", "5", "--column", "E_BX", "--column", "E_YX")
+    got = weilgen.fit_pdge(data, basis=["fourier:auto", "poly:5"], cv="blocks", folds=5,
+                           column=["E_BX", "E_YX"])
+    same_document(got, want)
+
+
+def test_identify_equals_cli(cli, tmp_path):
+    want = cli.json("identify", "vmc_3axis", "-q", "--data", POINTS, "--predict", BALLBAR,
+                    "--predict", POINTS, "--emit-params", str(tmp_path / "cli.hpp"))
+    got = weilgen.identify("vmc_3axis", quiet=True, data=POINTS, predict=[BALLBAR, POINTS],
+                           emit_params=str(tmp_path / "module.hpp"))
+    same_document(got, want)
+    assert got["rank"] == 46
+    assert (tmp_path / "module.hpp").read_text() == (tmp_path / "cli.hpp").read_text()
+    want = cli.json("identify", "vmc_3axis", "-q", "--data", POINTS, "--pdge", "E_XX=fourier:2",
+                    "--fix", "E_C0Y")
+    same_document(weilgen.identify("vmc_3axis", quiet=True, data=POINTS,
+                                   pdge={"E_XX": "fourier:2"}, fix="E_C0Y"), want)
+
+
+def test_gap_equals_cli(cli):
+    want = cli.json("gap", "vmc_3axis", "-q", "--data", POINTS, "--pdge", "poly:2")
+    same_document(weilgen.gap("vmc_3axis", data=POINTS, pdge="poly:2", quiet=True), want)
+    want = cli.json("gap", "vmc_3axis", "-q", "--data", BALLBAR)
+    same_document(weilgen.gap(weilgen.Model("vmc_3axis"), data=BALLBAR, quiet=True), want)
+
+
+def test_compensation_tables_equal_cli(cli, tmp_path):
+    """--comp-table (docs/controllers.md): the module writes the CLI's LinuxCNC file."""
+    data = source("examples", "data", "iso230_2_drift.csv")
+    cli.json("iso230-2", data, "--comp-table", str(tmp_path / "cli.tbl"), "--comp-source", "drift")
+    weilgen.iso230_2(data, comp_table=tmp_path / "module.tbl", comp_source="drift")
+    assert (tmp_path / "module.tbl").read_text() == (tmp_path / "cli.tbl").read_text()
+    cli.json("identify", "vmc_3axis", "-q", "--data", POINTS, "--comp-table",
+             str(tmp_path / "cli_x.tbl"), "--axis", "X", "--comp-points", "11", "--comp-at",
+             "Y=-200,Z=-150", "--comp-type", "1")
+    weilgen.identify("vmc_3axis", quiet=True, data=POINTS, comp_table=tmp_path / "module_x.tbl",
+                     axis="X", comp_points=11, comp_at={"Y": -200, "Z": -150}, comp_type=1)
+    assert (tmp_path / "module_x.tbl").read_text() == (tmp_path / "cli_x.tbl").read_text()
