@@ -32,7 +32,9 @@ const char* const kUsage = R"(weilgen_gap_synth: synthetic measurement sets for 
 
   weilgen_gap_synth --effect E --factor F --noise-um S --layout L --seed N --out DIR
                     [--machine vmc_3axis] [--missing E_AX] [--truth-degree 3] [--fit-degree 3]
-      one scenario: DIR/data.csv and DIR/truth.json
+                    [--observations N]
+      one scenario: DIR/data.csv and DIR/truth.json; --observations N repeats the layout's
+      cycles as often as needed and cuts it after N observations (the speed benchmark)
   weilgen_gap_synth --suite DIR [--quick] [--reps N] [--layouts grid,line,ballbar]
                     [--machine vmc_3axis] [--threads 2]
       the benchmark suite (fixed seeds): DIR/sNNNN/{data.csv,truth.json}, DIR/manifest.tsv
@@ -407,6 +409,8 @@ int main(int argc, char** argv) {
     spec.truth_degree = static_cast<int>(number("--truth-degree", args.get("--truth-degree", "3")));
     spec.fit_degree = static_cast<int>(number("--fit-degree", args.get("--fit-degree", "3")));
     spec.missing_error = args.get("--missing");
+    spec.observations = static_cast<int>(number("--observations", args.get("--observations", "0")));
+    if (spec.observations < 0) throw std::runtime_error("--observations must be >= 0");
     write_scenario(spec, args.get("--out"));
     return 0;
   } catch (const std::exception& e) {

@@ -277,6 +277,13 @@ void Synthesiser::build_layout(Rng& rng) {
   for (std::size_t k = 0; k < axes_.size(); ++k)
     home[k] = std::clamp(0.0, axes_[k].min, axes_[k].max);
   auto travel = [&](int k) { return axes_[k].max - axes_[k].min; };
+  // The layout's own number of cycles, or as many as --observations needs (one value a row at
+  // least; the rows beyond it are cut below).
+  auto cycles = [&](int own, std::size_t rows_per_cycle) {
+    if (spec_.observations <= 0) return own;
+    const auto n = static_cast<std::size_t>(spec_.observations);
+    return static_cast<int>(std::max<std::size_t>(1, (n + rows_per_cycle - 1) / rows_per_cycle));
+  };
   auto add_row = [&](Row r) {
     r.dir.resize(axes_.size(), 1);
     rows_.push_back(std::move(r));
@@ -318,7 +325,7 @@ void Synthesiser::build_layout(Rng& rng) {
       for (int k : linear) p[k] = axes_[k].min + s[k] * grid_step_[k];
       poses_.push_back(p);
     }
-    constexpr int kCycles = 3;
+    const int kCycles = cycles(3, seq.size());
     constexpr double kDwellS = 8;
     std::vector<int> dir(axes_.size(), 1);
     std::vector<double> prev = poses_[0];
@@ -351,7 +358,8 @@ void Synthesiser::build_layout(Rng& rng) {
     for (int k : linear)
       park[k] =
           std::round(rng.uniform(axes_[k].min + 0.25 * travel(k), axes_[k].max - 0.25 * travel(k)));
-    constexpr int kTargets = 101, kCycles = 5;
+    constexpr int kTargets = 101;
+    const int kCycles = cycles(5, 2 * kTargets);
     constexpr double kDwellS = 15;
     for (int i = 0; i < kTargets; ++i) {
       std::vector<double> p = park;
@@ -388,7 +396,8 @@ void Synthesiser::build_layout(Rng& rng) {
     copy_to(centre_, home);
     for (int k : linear) centre_[k] = std::round((axes_[k].min + axes_[k].max) / 2);
     radius_mm_ = 10 * std::floor(0.03 * std::min(travel(plane_a_), travel(plane_b_)));
-    constexpr int kPoints = 180, kCycles = 6;
+    constexpr int kPoints = 180;
+    const int kCycles = cycles(6, 2 * kPoints);
     constexpr double kPointS = 0.25, kCycleS = 1800;
     for (int i = 0; i < kPoints; ++i) {
       const double th = 2.0 * i * kPi / 180;
@@ -422,6 +431,10 @@ void Synthesiser::build_layout(Rng& rng) {
     columns_ = {"dr_um"};
     column_dim_ = {-1};
   }
+  if (spec_.observations > 0)
+    rows_.resize(std::min(
+        rows_.size(),
+        (static_cast<std::size_t>(spec_.observations) + columns_.size() - 1) / columns_.size()));
   for (std::size_t r = 0; r < rows_.size(); ++r) {
     for (std::size_t c = 0; c < columns_.size(); ++c) {
       obs_row_.push_back(static_cast<int>(r));

@@ -1,7 +1,7 @@
 // The truth generator of the sim-to-real gap benchmark (bench/gap/README.md): a shipped machine
 // with random geometric errors within its spreads, evaluated with the exact numeric chain
-// (weilgen/model/numeric_chain.hpp), plus exactly one effect withheld from the model (or none), sampled
-// in one measurement layout and written as a measurement CSV (docs/data-format.md) with a
+// (weilgen/model/numeric_chain.hpp), plus exactly one effect withheld from the model (or none),
+// sampled in one measurement layout and written as a measurement CSV (docs/data-format.md) with a
 // truth.json. Nothing here calls or mirrors the diagnosis code (src/cli/verb_gap.cpp): the only
 // shared pieces are the machine description, the exact chain and the CSV format.
 #pragma once
@@ -37,6 +37,10 @@ struct ScenarioSpec {
   int fit_degree = 3;    // degree of the model's PDGE bases that define "absorbable"
   // missing_error: the error left out of the model machine; empty = the machine's default.
   std::string missing_error;
+  // Size (the speed benchmark, bench/gap/speed.sh): 0 = the layout's own cycles; else the layout
+  // is repeated for as many cycles as needed and cut after the row that reaches this many
+  // observations.
+  int observations = 0;
 };
 
 // Deterministic uniform and normal deviates (Box-Muller on mt19937_64): the same numbers with
