@@ -125,6 +125,66 @@ inline constexpr std::array<ParamInfo, kNumParams> kParams = {{
 inline constexpr std::array<const char*, kNumOutputs> kOutputs = {{"dx", "dy", "dz", "da", "db", "dc"}};
 inline constexpr std::array<const char*, kNumOutputs> kOutputUnits = {{"mm", "mm", "mm", "rad", "rad", "rad"}};
 
+// Named indices into the axes, errors and params arrays (kAxes, kErrors, kParams order),
+// e.g. axes[axis::Y], errors[error::E_B0B].
+namespace axis {
+inline constexpr std::size_t Y = 0;
+inline constexpr std::size_t X = 1;
+inline constexpr std::size_t Z = 2;
+inline constexpr std::size_t C = 3;
+inline constexpr std::size_t B = 4;
+}  // namespace axis
+namespace error {
+inline constexpr std::size_t E_XY = 0;
+inline constexpr std::size_t E_YY = 1;
+inline constexpr std::size_t E_ZY = 2;
+inline constexpr std::size_t E_AY = 3;
+inline constexpr std::size_t E_BY = 4;
+inline constexpr std::size_t E_CY = 5;
+inline constexpr std::size_t E_XX = 6;
+inline constexpr std::size_t E_YX = 7;
+inline constexpr std::size_t E_ZX = 8;
+inline constexpr std::size_t E_AX = 9;
+inline constexpr std::size_t E_BX = 10;
+inline constexpr std::size_t E_CX = 11;
+inline constexpr std::size_t E_C0X = 12;
+inline constexpr std::size_t E_XZ = 13;
+inline constexpr std::size_t E_YZ = 14;
+inline constexpr std::size_t E_ZZ = 15;
+inline constexpr std::size_t E_AZ = 16;
+inline constexpr std::size_t E_BZ = 17;
+inline constexpr std::size_t E_CZ = 18;
+inline constexpr std::size_t E_A0Z = 19;
+inline constexpr std::size_t E_B0Z = 20;
+inline constexpr std::size_t E_XC = 21;
+inline constexpr std::size_t E_YC = 22;
+inline constexpr std::size_t E_ZC = 23;
+inline constexpr std::size_t E_AC = 24;
+inline constexpr std::size_t E_BC = 25;
+inline constexpr std::size_t E_CC = 26;
+inline constexpr std::size_t E_X0C = 27;
+inline constexpr std::size_t E_Y0C = 28;
+inline constexpr std::size_t E_A0C = 29;
+inline constexpr std::size_t E_B0C = 30;
+inline constexpr std::size_t E_C0C = 31;
+inline constexpr std::size_t E_XB = 32;
+inline constexpr std::size_t E_YB = 33;
+inline constexpr std::size_t E_ZB = 34;
+inline constexpr std::size_t E_AB = 35;
+inline constexpr std::size_t E_BB = 36;
+inline constexpr std::size_t E_CB = 37;
+inline constexpr std::size_t E_X0B = 38;
+inline constexpr std::size_t E_Z0B = 39;
+inline constexpr std::size_t E_A0B = 40;
+inline constexpr std::size_t E_C0B = 41;
+inline constexpr std::size_t E_B0B = 42;
+}  // namespace error
+namespace param {
+inline constexpr std::size_t tool_length = 0;
+inline constexpr std::size_t pivot_length = 1;
+inline constexpr std::size_t c_to_b = 2;
+}  // namespace param
+
 // Monomials of degree >= 2 with a non-zero coefficient: error indices, padded with -1.
 inline constexpr std::array<std::array<int, 1>, kNumHigherTerms> kHigherTerms = {{
 }};
