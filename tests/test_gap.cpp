@@ -420,7 +420,7 @@ namespace {
 // steps, ccw then cw, `cycles` cycles; dr = exact projection of the model's deviation with
 // random errors plus `extra` (µm, in dx dy dz), plus N(0, noise²).
 std::string ballbar_synth(std::uint32_t seed, const EffectFn& extra, int cycles = 4,
-                          double noise = 0.4) {
+                          double noise = 0.4, bool with_temperature = false) {
   Truth truth_machine(seed);
   const BallbarMachine bm = ballbar_machine(vmc()->description());
   BallbarFlags f;
@@ -430,7 +430,7 @@ std::string ballbar_synth(std::uint32_t seed, const EffectFn& extra, int cycles 
   const BallbarCircle circle = parse_ballbar_circle(f, bm);
   std::ostringstream s;
   s << "# plane: XY\n# centre: X=250, Y=-200, Z=-150\n# radius: 100 mm\n"
-    << "t_s,dir,dir_X,cycle,angle_deg,dr_um\n";
+    << "t_s,dir,dir_X,cycle,angle_deg," << (with_temperature ? "T_spindle," : "") << "dr_um\n";
   double t = 0;
   for (int cy = 1; cy <= cycles; ++cy)
     for (int feed : {1, -1})
@@ -441,12 +441,16 @@ std::string ballbar_synth(std::uint32_t seed, const EffectFn& extra, int cycles 
         // X moves toward +X on the way up when the feed's tangent has a positive x part.
         const double th = (a - feed * 1.0) * M_PI / 180;
         const double dir_x = -feed * std::sin(th) > 0 ? 1 : -1;
-        const Row r{q[1], q[0], q[2], t, dir_x, static_cast<double>(cy), 22};
+        // A spindle warming by 3 K with a time constant of a quarter of the run.
+        const double temp = 22 + 3 * (1 - std::exp(-t / (cycles * 180.0 * 0.25)));
+        const Row r{q[1], q[0], q[2], t, dir_x, static_cast<double>(cy), temp};
         const std::array<double, 6> dev = truth_machine.deviation(q.data());
         const std::array<double, 3> e = extra(r);
         double dr = noise * truth_machine.normal();
         for (std::size_t o = 0; o < 3; ++o) dr += u[o] * (dev[o] + e[o]);
-        s << t << "," << feed << "," << dir_x << "," << cy << "," << a << "," << dr << "\n";
+        s << t << "," << feed << "," << dir_x << "," << cy << "," << a << ",";
+        if (with_temperature) s << temp << ",";
+        s << dr << "\n";
         t += 0.5;
       }
   return s.str();
@@ -512,6 +516,29 @@ TEST_CASE("gap: ballbar traces are dr observations; reversal on X is read from t
   const EffectFit* e = effect(res, "reversal");
   REQUIRE(e);
   CHECK(std::abs(e->params.at("reversal_um")) == doctest::Approx(5.0).epsilon(0.1));
+  CHECK(res.final_rms[kRadialOutput] < 1.2 * 0.4);
+}
+
+TEST_CASE(
+    "gap: a thermal growth on a ballbar trace with a spindle sensor is named (no empty "
+    "variant: a growth along z that an XY trace cannot see)") {
+  // dx grows by 2 µm/K of T_spindle; the trace sees it through cos θ.
+  const MeasurementTable t =
+      parse_measurements(ballbar_synth(
+                             23,
+                             [](const Row& w) {
+                               return std::array<double, 3>{2.0 * (w.T - 22), 0, 0};
+                             },
+                             4, 0.4, true),
+                         "bb.csv");
+  PdgeBasisChoice c;
+  c.all = "poly:2";
+  const ErrorParameterisation p(vmc()->description(), c, vmc()->parameters());
+  const GapResult res = GapDiagnosis().run(*vmc(), p, gap_data(t, vmc()->description()),
+                                           *parse_holdout("cycle:4"), "test");
+  CHECK(res.verdict == "thermal_drift");
+  const EffectFit* e = effect(res, "thermal_drift");
+  REQUIRE(e);
   CHECK(res.final_rms[kRadialOutput] < 1.2 * 0.4);
 }
 

@@ -59,6 +59,9 @@ struct Evaluated {
 // norm before projection (`norm`): columns (nearly) inside the span would otherwise get huge
 // coefficients from rounding.
 std::optional<VectorXd> projected_fit(const MatrixXd& Eperp, VectorXd norm, const VectorXd& r) {
+  // A variant whose columns all vanish (a thermal growth along z seen by a ballbar in XY): Eigen's
+  // pivoting QR of an empty matrix reads past its buffers.
+  if (Eperp.cols() == 0 || Eperp.rows() == 0) return std::nullopt;
   for (Index k = 0; k < norm.size(); ++k)
     if (!(norm[k] > 0)) norm[k] = 1;
   const MatrixXd Es = Eperp * norm.cwiseInverse().asDiagonal();
