@@ -7,6 +7,8 @@ packages=(
   libginac-dev libeigen3-dev libboost-program-options-dev libboost-dev
   libyaml-cpp-dev nlohmann-json3-dev doctest-dev libbenchmark-dev
   libnlopt-cxx-dev time gnuplot-nox
+  # LinuxCNC (halrun, halcompile, hal.h): the HAL compensation component's test (docs/controllers.md)
+  linuxcnc-uspace linuxcnc-uspace-dev
 )
 missing=()
 for p in "${packages[@]}"; do

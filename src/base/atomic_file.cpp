@@ -43,6 +43,27 @@ void write_file_atomically(const std::string& path, const std::string& contents)
   }
 }
 
+void check_output_target(const std::string& path, const std::vector<std::string>& inputs,
+                         const std::string& flag) {
+  namespace fs = std::filesystem;
+  const auto fail = [&](const std::string& why) {
+    throw std::invalid_argument(flag + " " + path + ": " + why);
+  };
+  if (path.empty()) throw std::invalid_argument(flag + ": an empty path");
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) fail("is a directory; give a file name");
+  const fs::path canonical = fs::weakly_canonical(path, ec);
+  for (const std::string& in : inputs) {
+    std::error_code e1, e2;
+    if (fs::equivalent(path, in, e1) || (!ec && fs::weakly_canonical(in, e2) == canonical && !e2))
+      fail("is also an input (" + in + "); write the output to another file");
+  }
+  fs::path dir = fs::absolute(path, ec).parent_path();
+  while (!dir.empty() && !fs::exists(dir, ec) && dir != dir.parent_path()) dir = dir.parent_path();
+  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec)) fail(dir.string() + " is not a directory");
+  if (::access(dir.c_str(), W_OK) != 0) fail("cannot write in " + dir.string());
+}
+
 bool read_file(const std::string& path, std::string& contents) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return false;

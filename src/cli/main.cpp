@@ -17,7 +17,7 @@ const std::map<std::string, Verb>& verbs() {
   static const std::map<std::string, Verb> v = {
       {"generate",
        {weilgen::cli::verb_generate,
-        "generate <machine>... [--order r] [--out DIR] [--check]\n"
+        "generate <machine>... [--order r] [--out DIR] [--check] [--c-api]\n"
         "      multiply the error HTMs over the Weil algebra and write the C++ header\n"
         "      and the closed-form report (generated/<machine>.hpp, .md)"}},
 #ifndef WEILGEN_CODEGEN_ONLY
@@ -58,6 +58,10 @@ const std::map<std::string, Verb>& verbs() {
        {weilgen::cli::verb_gap,
         "gap <machine> --data FILE [--holdout ...] [--effects ...] [--json F] [--report F.md]\n"
         "      where model and machine disagree, which unmodelled effect, how far it shrinks"}},
+      {"linuxcnc",
+       {weilgen::cli::verb_linuxcnc,
+        "linuxcnc <machine> --out DIR [--params P] [--name NAME]\n"
+        "      a LinuxCNC HAL component compensating the machine's errors in the servo thread"}},
 #endif
   };
   return v;

@@ -3,6 +3,7 @@
 // write the parameters as a controller header. docs/identify.md.
 #include <iostream>
 
+#include "comp_table.hpp"
 #include "study.hpp"
 #include "verbs.hpp"
 #include "weilgen/analysis/identify.hpp"
@@ -23,7 +24,8 @@ int verb_identify(const Args& args) {
       "weilgen identify <machine> --data FILE [options]\n\n"
       "Fits the model's error parameters to point measurements (docs/data-format.md): each\n"
       "PIGE a constant, each PDGE a basis in its own axis position (the machine file's\n"
-      "pdge_basis / basis:, else poly:3; --pdge overrides). Linear least squares through the\n"
+      "pdge_basis / basis:, else poly:3 on a linear axis and fourier:2 with a one-turn period\n"
+      "on a rotary one; --pdge overrides). Linear least squares through the\n"
       "generated coefficient matrix (column-equilibrated SVD: minimum-norm solution, rank, the\n"
       "parameter combinations the data cannot identify); Gauss-Newton for order >= 2. Predicts\n"
       "other measurements (points, ballbar circles) and writes the parameters as a standalone\n"
@@ -37,9 +39,9 @@ int verb_identify(const Args& args) {
       "measurement CSV (poses + deviations); repeatable")(
       "pdge", po::value<std::vector<std::string>>(&pdge)->composing(),
       "basis of every PDGE (poly:3, fourier:2, legendre:4, chebyshev:4, fourier:2:20 = period "
-      "20 mm) or of one error (E_YY=fourier:3); repeatable, applied in order")(
-      "fix", po::value<std::vector<std::string>>(&fixed)->composing(),
-      "hold an error at zero (name or alias); repeatable")(
+      "20 mm, or 20 deg on a rotary axis) or of one error (E_YY=fourier:3); repeatable, applied "
+      "in order")("fix", po::value<std::vector<std::string>>(&fixed)->composing(),
+                  "hold an error at zero (name or alias); repeatable")(
       "rank-tol", po::value<double>(&rank_tol)->default_value(rank_tol, "1e-9"),
       "singular values below rank-tol x the largest (equilibrated columns) count as zero")(
       "predict", po::value<std::vector<std::string>>(&predict)->composing(),
@@ -54,6 +56,8 @@ int verb_identify(const Args& args) {
       "quiet,q", po::bool_switch(&flags.quiet), "no model messages on stderr");
   opts.add(ballbar_circle_options(circle));
   opts.add(model_options(flags));
+  CompTableFlags comp;
+  opts.add(comp_table_options(comp, true));
   po::variables_map vm;
   if (auto stop = parse_args<std::string>("identify", args, opts, "machine", 1, vm)) return *stop;
   if (!vm.count("machine")) return usage_error("identify", "no machine given");
@@ -63,8 +67,12 @@ int verb_identify(const Args& args) {
   if (!predict_out.empty() && predict.empty())
     return usage_error("identify", "--predict-out needs a --predict file");
   flags.machine = vm["machine"].as<std::string>();
+  std::vector<std::string> inputs = data;
+  inputs.insert(inputs.end(), predict.begin(), predict.end());
+  check_comp_table_flags(comp, vm, inputs, true);
 
   const Description desc = load_machine_file(resolve_machine(flags.machine));
+  if (!comp.path.empty()) check_axis_comp_table(desc, comp.options);
   const PdgeBasisChoice choice = parse_pdge_flags(desc, pdge);
   const std::shared_ptr<Model> model = open_model(flags, desc);
   const ErrorParameterisation param(model->description(), choice, model->parameters());
@@ -76,6 +84,8 @@ int verb_identify(const Args& args) {
   io.rank_tolerance = rank_tol;
   io.fixed = fixed;
   const IdentifyResult r = Identification(io).run(*model, param, points);
+  const CompTable comp_table =
+      comp.path.empty() ? CompTable{} : axis_comp_table(*model, param, r.theta, comp.options);
   std::cout << identify_text(*model, param, r, points);
 
   nlohmann::json j = identify_json(*model, param, r, data);
@@ -102,6 +112,7 @@ int verb_identify(const Args& args) {
     std::cout << "\nwrote " << emit << "\n";
   }
   if (!json_path.empty()) write_file_atomically(json_path, j.dump(2) + "\n");
+  if (!comp.path.empty()) std::cout << "\n" << write_comp_table(comp, comp_table);
   return 0;
 }
 

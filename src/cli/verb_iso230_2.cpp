@@ -3,6 +3,7 @@
 // the anomaly criterion and the JSON schema: docs/iso230-2.md; the CSV: docs/data-format.md.
 #include <iostream>
 
+#include "comp_table.hpp"
 #include "verbs.hpp"
 #include "weilgen/base/atomic_file.hpp"
 #include "weilgen/measure/iso230_2_study.hpp"
@@ -42,6 +43,8 @@ int verb_iso230_2(const Args& args) {
       "json", po::value<std::string>(&json_path), "write the results as JSON to FILE")(
       "plot", po::value<std::string>(&plot_path),
       "draw the deviation charts to FILE.png or FILE.svg (gnuplot)");
+  CompTableFlags comp;
+  opts.add(comp_table_options(comp, false));
   po::variables_map vm;
   if (auto stop = parse_args<std::string>("iso230-2", args, opts, "data", 1, vm)) return *stop;
   if (!vm.count("data")) return usage_error("iso230-2", "no data file given");
@@ -49,6 +52,7 @@ int verb_iso230_2(const Args& args) {
   if (!(tolerance > 0)) return usage_error("iso230-2", "--target-tolerance must be > 0");
   const std::string data = vm["data"].as<std::string>();
   if (!plot_path.empty()) check_plot_target(plot_path);
+  check_comp_table_flags(comp, vm, {data}, false);
 
   Iso230_2StudyOptions so;
   so.axis = axis;
@@ -63,6 +67,8 @@ int verb_iso230_2(const Args& args) {
   const MeasurementTable table = read_measurements(data, ro);
   for (const auto& w : table.warnings) std::cerr << w << "\n";
   const Iso230_2StudyResult r = Iso230_2Study(so).run(table);
+  const CompTable comp_table =
+      comp.path.empty() ? CompTable{} : comp_table_from_iso(r, comp.options.table);
   // The plot first: the step most likely to fail; then JSON, then stdout.
   if (!plot_path.empty())
     write_plot(plot_path, iso230_2_panels(r), "ISO 230-2, " + r.columns.axis + ": " + data);
@@ -70,6 +76,7 @@ int verb_iso230_2(const Args& args) {
   std::cout << iso230_2_text(data, r);
   if (!plot_path.empty()) std::cout << "wrote " << plot_path << "\n";
   if (!json_path.empty()) std::cout << "wrote " << json_path << "\n";
+  if (!comp.path.empty()) std::cout << write_comp_table(comp, comp_table);
   return 0;
 }
 

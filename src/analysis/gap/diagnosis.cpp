@@ -43,23 +43,28 @@ GapDiagnosis::GapDiagnosis(GapOptions options) : options_(std::move(options)) {
 
 namespace {
 
-// The shape degrees of freedom the data leave along coordinate `axis` in `output` beyond the
-// baseline design (its block factors F, rank rank0): the rank that one free value per distinct
-// position adds.
-std::size_t shape_dof_free(const BlockFactors& F, std::size_t rank0, const GapData& d, int axis,
-                           int output) {
+// The shape degrees of freedom the data leave along the coordinate of shape variant `v` beyond
+// the baseline design (its block factors F, rank rank0): the rank that one free value per
+// distinct position adds, each observation seeing it with the shaped error's sensitivity (or its
+// weight in the output).
+std::size_t shape_dof_free(const BlockFactors& F, std::size_t rank0, const GapData& d,
+                           const gap_detail::Variant& v) {
   const auto& obs = d.points.observations;
+  const auto axis = static_cast<std::size_t>(v.shape_axis);
+  auto weight = [&](std::size_t i) {
+    return v.shape_weight ? (*v.shape_weight)[static_cast<Index>(i)]
+                          : observation_weight(obs[i], v.shape_output);
+  };
   std::vector<double> levels;
-  for (const auto& o : obs)
-    if (observation_weight(o, output) != 0)
-      levels.push_back(d.points.poses[o.row][static_cast<std::size_t>(axis)]);
+  for (std::size_t i = 0; i < obs.size(); ++i)
+    if (weight(i) != 0) levels.push_back(d.points.poses[obs[i].row][axis]);
   std::sort(levels.begin(), levels.end());
   levels.erase(std::unique(levels.begin(), levels.end()), levels.end());
   MatrixXd G = MatrixXd::Zero(static_cast<Index>(obs.size()), static_cast<Index>(levels.size()));
   for (std::size_t i = 0; i < obs.size(); ++i) {
-    const double w = observation_weight(obs[i], output);
+    const double w = weight(i);
     if (w == 0) continue;
-    const double q = d.points.poses[obs[i].row][static_cast<std::size_t>(axis)];
+    const double q = d.points.poses[obs[i].row][axis];
     const auto l = std::lower_bound(levels.begin(), levels.end(), q) - levels.begin();
     G(static_cast<Index>(i), l) = w;
   }
@@ -115,9 +120,10 @@ void decide_verdict(GapResult& R, const GapOptions& opt, const std::vector<std::
         return unexplained(first.name + " removes " + pct(first.explained_fraction) +
                            " of the excess and needs " + R.explanation[k].name +
                            " along the same coordinate and output: a shape outside the library");
-  if (first.explained_fraction < 0.5)
-    return unexplained("the first effect, " + first.name + ", removes only " +
-                       pct(first.explained_fraction) + " of the excess held-out sum of squares");
+  // Two effects at once each remove about half: the accepted set is judged together.
+  if (explained < 0.5)
+    return unexplained("the accepted effects remove only " + pct(explained) +
+                       " of the excess held-out sum of squares");
   if (R.final_p_value < opt.alpha) {
     if (explained < opt.explain_fraction)
       return unexplained("the accepted effects remove " + pct(explained) +
@@ -284,13 +290,18 @@ GapResult GapDiagnosis::run(const Model& model, const ErrorParameterisation& par
   // Shape effects: free shape dof per (coordinate, output), and the dof the accepted ones use.
   const std::shared_ptr<const BlockFactors> F0 = e.factors;
   const std::size_t rank0 = e.full_rank;
-  std::map<std::pair<int, int>, std::size_t> dof_free, dof_used;
+  // Keyed by (coordinate, shaped error or output).
+  using ShapeKey = std::pair<int, std::string>;
+  auto shape_key = [](const gap_detail::Variant& v) {
+    return ShapeKey{v.shape_axis,
+                    v.shape_key.empty() ? std::to_string(v.shape_output) : v.shape_key};
+  };
+  std::map<ShapeKey, std::size_t> dof_free, dof_used;
   std::vector<std::pair<int, int>> accepted_shape;  // per accepted effect; (-1, -1) if none
   auto check_shape = [&](const gap_detail::Variant& v, EffectFit& fit) {
     if (v.shape_axis < 0) return;
-    const std::pair<int, int> key{v.shape_axis, v.shape_output};
-    if (!dof_free.count(key))
-      dof_free[key] = shape_dof_free(*F0, rank0, data, v.shape_axis, v.shape_output);
+    const ShapeKey key = shape_key(v);
+    if (!dof_free.count(key)) dof_free[key] = shape_dof_free(*F0, rank0, data, v);
     fit.shape_dof_free = dof_free[key];
     fit.shape_dof_used = dof_used[key] + fit.extra_parameters + v.refine.size();
     if (fit.shape_dof_used >= fit.shape_dof_free) {
@@ -352,10 +363,19 @@ GapResult GapDiagnosis::run(const Model& model, const ErrorParameterisation& par
     e.A = AE;
     e.refit();
     e.heldout(cur_r, cur_h);
+    // A regularised model's columns joined the design as fitted on all data, so the folds'
+    // refit would see held-out rows through them: its own held-out residual (each fold's columns
+    // fitted on that fold's training part) is the honest one, and the search ends with it.
+    if (pick->regularised) {
+      cur_r = pick->heldout;
+      R.explanation.push_back(fit);
+      accepted_shape.emplace_back(-1, -1);
+      break;
+    }
     R.explanation.push_back(fit);
     if (pick->variant.shape_axis >= 0) {
       accepted_shape.emplace_back(pick->variant.shape_axis, pick->variant.shape_output);
-      dof_used[accepted_shape.back()] = fit.shape_dof_used;
+      dof_used[shape_key(pick->variant)] = fit.shape_dof_used;
     } else {
       accepted_shape.emplace_back(-1, -1);
     }

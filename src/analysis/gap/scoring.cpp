@@ -173,6 +173,7 @@ Evaluated evaluate_one(const Candidate& c, const ScoringContext& sc,
     }
   }
   best.fit.name = c.name;
+  best.regularised = static_cast<bool>(c.fitted_columns);
   if (!std::isfinite(best_train)) return best;
   if (!have_after) {
     Score s = score(c, best.variant, sc, true);

@@ -17,6 +17,7 @@ struct Evaluated {
   VectorXd heldout;               // held-out residual after
   VectorXd coef;                  // full-data coefficients of the columns
   double heldout_sse = INFINITY;  // infinite: no usable variant
+  bool regularised = false;       // fitted_columns: columns fitted per training part
 };
 
 // What every candidate is scored against: the engine (its splits and fits), the baseline's
