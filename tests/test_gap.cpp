@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <random>
 #include <set>
@@ -158,7 +159,10 @@ TEST_CASE("gap: a periodic error along X: period and amplitude") {
   const EffectFit* e = effect(r, "periodic");
   REQUIRE(e);
   CHECK(e->params.at("period_mm") == doctest::Approx(125).epsilon(0.05));
-  CHECK(e->params.at("amplitude") == doctest::Approx(3.0).epsilon(0.15));
+  CHECK(e->params.at("amplitude_um") == doctest::Approx(3.0).epsilon(0.15));
+  // A shape of the straightness of X in y, through the kinematics.
+  CHECK(e->params.count("error_E_YX") == 1);
+  CHECK(e->summary.find("periodic E_YX of X: period 12") == 0);
   REQUIRE(e->region);
   CHECK(e->region->output == "dy");
 }
@@ -171,8 +175,8 @@ TEST_CASE("gap: thermal drift with a lagged sensor") {
   const EffectFit* e = effect(r, "thermal_drift");
   REQUIRE(e);
   CHECK(e->params.count("sensor_T_spindle") == 1);
-  CHECK(e->params.at("per_K_dx") == doctest::Approx(3.0).epsilon(0.1));
-  CHECK(e->params.at("per_K_dz") == doctest::Approx(-1.0).epsilon(0.1));
+  CHECK(e->params.at("drift_x_um_per_K") == doctest::Approx(3.0).epsilon(0.1));
+  CHECK(e->params.at("drift_z_um_per_K") == doctest::Approx(-1.0).epsilon(0.1));
   // What remains is noise: no significant gap against σ²(1 + h). The held-out RMS after exceeds
   // the noise (0.5 µm) by the leverage of the heating cycle, whose temperatures the other
   // cycles do not span.
@@ -406,8 +410,8 @@ TEST_CASE("gap: a bump between the samples of a coarse grid is found and resolve
   const EffectFit* e = effect(r, "pdge_shape");
   REQUIRE(e);
   CHECK(e->distinguishable);
-  CHECK(e->params.at("centre") == doctest::Approx(262).epsilon(0.03));
-  CHECK(e->params.at("width") == doctest::Approx(50).epsilon(0.15));
+  CHECK(e->params.at("centre_mm") == doctest::Approx(262).epsilon(0.03));
+  CHECK(e->params.at("width_mm") == doctest::Approx(50).epsilon(0.15));
   CHECK(e->params.at("positions_covered") >= 3);
 }
 
@@ -417,7 +421,7 @@ namespace {
 // steps, ccw then cw, `cycles` cycles; dr = exact projection of the model's deviation with
 // random errors plus `extra` (µm, in dx dy dz), plus N(0, noise²).
 std::string ballbar_synth(std::uint32_t seed, const EffectFn& extra, int cycles = 4,
-                          double noise = 0.4) {
+                          double noise = 0.4, bool with_temperature = false) {
   Truth truth_machine(seed);
   const BallbarMachine bm = ballbar_machine(vmc()->description());
   BallbarFlags f;
@@ -427,7 +431,7 @@ std::string ballbar_synth(std::uint32_t seed, const EffectFn& extra, int cycles 
   const BallbarCircle circle = parse_ballbar_circle(f, bm);
   std::ostringstream s;
   s << "# plane: XY\n# centre: X=250, Y=-200, Z=-150\n# radius: 100 mm\n"
-    << "t_s,dir,dir_X,cycle,angle_deg,dr_um\n";
+    << "t_s,dir,dir_X,cycle,angle_deg," << (with_temperature ? "T_spindle," : "") << "dr_um\n";
   double t = 0;
   for (int cy = 1; cy <= cycles; ++cy)
     for (int feed : {1, -1})
@@ -438,12 +442,16 @@ std::string ballbar_synth(std::uint32_t seed, const EffectFn& extra, int cycles 
         // X moves toward +X on the way up when the feed's tangent has a positive x part.
         const double th = (a - feed * 1.0) * M_PI / 180;
         const double dir_x = -feed * std::sin(th) > 0 ? 1 : -1;
-        const Row r{q[1], q[0], q[2], t, dir_x, static_cast<double>(cy), 22};
+        // A spindle warming by 3 K with a time constant of a quarter of the run.
+        const double temp = 22 + 3 * (1 - std::exp(-t / (cycles * 180.0 * 0.25)));
+        const Row r{q[1], q[0], q[2], t, dir_x, static_cast<double>(cy), temp};
         const std::array<double, 6> dev = truth_machine.deviation(q.data());
         const std::array<double, 3> e = extra(r);
         double dr = noise * truth_machine.normal();
         for (std::size_t o = 0; o < 3; ++o) dr += u[o] * (dev[o] + e[o]);
-        s << t << "," << feed << "," << dir_x << "," << cy << "," << a << "," << dr << "\n";
+        s << t << "," << feed << "," << dir_x << "," << cy << "," << a << ",";
+        if (with_temperature) s << temp << ",";
+        s << dr << "\n";
         t += 0.5;
       }
   return s.str();
@@ -511,6 +519,29 @@ TEST_CASE("gap: ballbar traces are dr observations, and reversal on X is read fr
   const EffectFit* e = effect(res, "reversal");
   REQUIRE(e);
   CHECK(std::abs(e->params.at("reversal_um")) == doctest::Approx(5.0).epsilon(0.1));
+  CHECK(res.final_rms[kRadialOutput] < 1.2 * 0.4);
+}
+
+TEST_CASE(
+    "gap: a thermal growth on a ballbar trace with a spindle sensor is named (no empty "
+    "variant: a growth along z that an XY trace cannot see)") {
+  // dx grows by 2 µm/K of T_spindle; the trace sees it through cos θ.
+  const MeasurementTable t =
+      parse_measurements(ballbar_synth(
+                             23,
+                             [](const Row& w) {
+                               return std::array<double, 3>{2.0 * (w.T - 22), 0, 0};
+                             },
+                             4, 0.4, true),
+                         "bb.csv");
+  PdgeBasisChoice c;
+  c.all = "poly:2";
+  const ErrorParameterisation p(vmc()->description(), c, vmc()->parameters());
+  const GapResult res = GapDiagnosis().run(*vmc(), p, gap_data(t, vmc()->description()),
+                                           *parse_holdout("cycle:4"), "test");
+  CHECK(res.verdict == "thermal_drift");
+  const EffectFit* e = effect(res, "thermal_drift");
+  REQUIRE(e);
   CHECK(res.final_rms[kRadialOutput] < 1.2 * 0.4);
 }
 
@@ -690,7 +721,7 @@ TEST_CASE("gap: a heat-up drift with a lag of 0.18 x the run is found under cycl
 TEST_CASE(
     "gap: on a rotary table, a reversal of C is named through the kinematics, with its size") {
   // five_axis_ac: an R-test-like layout (the tool over points off the table's centre, A and C
-  // turning), C approached alternately from both sides with 20 µrad of lost motion. The
+  // turning), C approached alternately from both sides with 6.2 µrad of lost motion. The
   // deviation reaches dx and dy rotated by C: a constant per output cannot describe it.
   const auto model = test::builtin_model("five_axis_ac");
   const Description& desc = model->description();
@@ -703,7 +734,7 @@ TEST_CASE(
   std::vector<std::string> names;
   for (int b : desc.axes())
     names.push_back(desc.bodies[static_cast<std::size_t>(b)].joint.coordinate);
-  const double B_urad = 20, B_deg = B_urad * 1e-6 * 180 / 3.14159265358979323846;
+  const double B_urad = 6.2, B_deg = B_urad * 1e-6 * 180 / 3.14159265358979323846;
   std::ostringstream csv;
   for (const std::string& a : names) csv << a << ",";
   csv << "dir_C,cycle,t_s,dx_um,dy_um,dz_um\n";
@@ -782,9 +813,212 @@ TEST_CASE("gap: on a tilting table, a spindle drift fixed in the machine frame i
   const EffectFit* e = effect(r, "thermal_drift");
   REQUIRE(e);
   INFO(e->summary);
-  REQUIRE(e->params.count("machine_z_um"));
-  CHECK(std::abs(e->params.at("machine_z_um")) == doctest::Approx(8).epsilon(0.15));
-  CHECK(std::abs(e->params.at("machine_x_um")) < 1);
+  // On a table machine the tool's frame is the machine's: the tool-side growth is the drift.
+  REQUIRE(e->params.count("drift_z_um"));
+  CHECK(e->params.count("frame_tool") == 1);
+  CHECK(std::abs(e->params.at("drift_z_um")) == doctest::Approx(8).epsilon(0.15));
+  CHECK(std::abs(e->params.at("drift_x_um")) < 1);
+}
+
+namespace {
+
+// Measurements of a shipped machine through its exact chain: random errors within the spreads
+// (seed), each row's deviation = tool point at the actual axes and errors minus the nominal one
+// (µm), plus N(0, noise²). `perturb` may change a row's actual axes, errors and add a tool-point
+// displacement (µm, workpiece frame) from the row's pose, time and directions.
+struct ChainRow {
+  std::vector<double> q;              // commanded axes (Description::axes() order)
+  std::map<std::string, double> dir;  // approach directions written as dir_<axis>
+  double t_s = 0;
+  int cycle = 1;
+};
+using Perturb = std::function<void(const ChainRow&, std::vector<double>& q_actual,
+                                   std::vector<double>& errors, Eigen::Vector3d& extra_um)>;
+
+std::string chain_csv(const Model& model, const std::vector<ChainRow>& rows, double noise,
+                      std::uint32_t seed, const Perturb& perturb,
+                      const std::string& extra_header = "",
+                      const std::function<std::string(const ChainRow&)>& extra = {}) {
+  const Description& desc = model.description();
+  NumericChain chain(desc);
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> n01(0, 1);
+  std::vector<double> base(desc.errors.size());
+  for (std::size_t i = 0; i < base.size(); ++i)
+    base[i] = desc.errors[i].distribution.b * desc.errors[i].to_base * n01(rng);
+  std::ostringstream csv;
+  for (int b : desc.axes()) csv << desc.bodies[static_cast<std::size_t>(b)].joint.coordinate << ",";
+  for (const auto& [a, d] : rows.front().dir) csv << "dir_" << a << ",";
+  csv << "cycle,t_s" << extra_header << ",dx_um,dy_um,dz_um\n";
+  const std::vector<double> zero(base.size(), 0.0);
+  for (const ChainRow& r : rows) {
+    std::vector<double> q = r.q, e = base;
+    Eigen::Vector3d extra_um = Eigen::Vector3d::Zero();
+    if (perturb) perturb(r, q, e, extra_um);
+    const Eigen::Vector3d d = chain.tool_in_workpiece(q, e).block<3, 1>(0, 3) -
+                              chain.tool_in_workpiece(r.q, zero).block<3, 1>(0, 3);
+    for (double v : r.q) csv << v << ",";
+    for (const auto& [a, v] : r.dir) csv << v << ",";
+    csv << r.cycle << "," << r.t_s;
+    if (extra) csv << "," << extra(r);
+    for (int o = 0; o < 3; ++o) csv << "," << 1000 * d[o] + extra_um[o] + noise * n01(rng);
+    csv << "\n";
+  }
+  return csv.str();
+}
+
+// vmc_3axis (axes Y, X, Z): X at 6 positions, Y at 11, Z at 2, X back and forth, 3 cycles, 60 s
+// per pose.
+std::vector<ChainRow> vmc_grid() {
+  std::vector<ChainRow> rows;
+  double t = 0;
+  for (int cy = 1; cy <= 3; ++cy)
+    for (double Z : {-250.0, -100.0})
+      for (int j = 0; j < 11; ++j)
+        for (int k = 0; k < 12; ++k) {
+          const bool up = k < 6;
+          const double X = 100.0 * (up ? k : 11 - k);
+          const double Y = cy % 2 ? -400 + 40.0 * j : -40.0 * j;
+          rows.push_back({{Y, X, Z}, {{"X", up ? 1.0 : -1.0}}, t, cy});
+          t += 60;
+        }
+  return rows;
+}
+
+int error_index(const Model& m, const std::string& name) {
+  const int k = m.description().error_index(name);
+  REQUIRE(k >= 0);
+  return k;
+}
+
+}  // namespace
+
+TEST_CASE("gap: a bump of E_YY along Y is named with its error and recovered at its centre") {
+  const auto model = vmc();
+  const int k = error_index(*model, "E_YY");
+  const double centre = -220, width = 45, height_um = 4;
+  const std::string csv = chain_csv(
+      *model, vmc_grid(), 0.3, 21,
+      [&](const ChainRow& r, std::vector<double>&, std::vector<double>& e, Eigen::Vector3d&) {
+        const double z = (r.q[0] - centre) / width;
+        e[static_cast<std::size_t>(k)] += height_um * 1e-3 * std::exp(-0.5 * z * z);
+      });
+  const GapResult r = diagnose(csv, model, "cycle:3", poly2());
+  CHECK(r.verdict == "pdge_shape");
+  const EffectFit* e = effect(r, "pdge_shape");
+  REQUIRE(e);
+  INFO(e->summary);
+  CHECK(e->params.count("error_E_YY") == 1);
+  CHECK(e->summary.find("bump of E_YY of Y") == 0);
+  CHECK(e->params.at("centre_mm") == doctest::Approx(centre).epsilon(0.03));
+  CHECK(std::abs(e->params.at("amplitude_um")) == doctest::Approx(height_um).epsilon(0.15));
+  REQUIRE_FALSE(r.where.empty());
+  CHECK(r.where.front().by == "Y");
+  CHECK(r.where.front().from <= centre);
+  CHECK(r.where.front().to >= centre);
+}
+
+TEST_CASE("gap: two effects at once, a reversal of X and a thermal drift, are both named") {
+  const auto model = vmc();
+  const int k = error_index(*model, "E_XX");
+  auto T = [](double t) { return 22 + 2.5 * (1 - std::exp(-t / 4000)); };
+  const std::string csv = chain_csv(
+      *model, vmc_grid(), 0.3, 22,
+      [&](const ChainRow& r, std::vector<double>&, std::vector<double>& e, Eigen::Vector3d& x) {
+        e[static_cast<std::size_t>(k)] += -r.dir.at("X") * 3e-3 / 2;  // B = 3 µm
+        x = Eigen::Vector3d(0, 2.0, -1.5) * (T(r.t_s) - 22);          // µm/K in dy, dz
+      },
+      ",T_spindle", [&](const ChainRow& r) { return std::to_string(T(r.t_s)); });
+  const GapResult r = diagnose(csv, model, "cycle:3", poly2());
+  std::set<std::string> named;
+  for (const EffectFit& f : r.explanation) named.insert(f.name);
+  INFO(r.verdict_reason);
+  CHECK((r.verdict == "reversal" || r.verdict == "thermal_drift"));
+  CHECK(named == std::set<std::string>{"reversal", "thermal_drift"});
+  const EffectFit* rev = effect(r, "reversal");
+  REQUIRE(rev);
+  CHECK(rev->summary.find("reversal of X") == 0);
+  CHECK(std::abs(rev->params.at("reversal_um")) == doctest::Approx(3).epsilon(0.1));
+  const EffectFit* th = effect(r, "thermal_drift");
+  REQUIRE(th);
+  INFO(th->summary);
+  REQUIRE(th->params.count("drift_y_um_per_K"));
+  CHECK(th->params.at("drift_y_um_per_K") == doctest::Approx(2.0).epsilon(0.1));
+  // dz: the offset and Z's scale are nearly collinear over Z = -250, -100 mm; their sum at the
+  // grid's mean Z is the growth.
+  const double scale_z =
+      th->params.count("scale_Z_um_per_m_per_K") ? th->params.at("scale_Z_um_per_m_per_K") : 0;
+  CHECK(th->params.at("drift_z_um_per_K") - 0.175 * scale_z == doctest::Approx(-1.5).epsilon(0.1));
+}
+
+namespace {
+
+// head_head_bc (axes Y, X, Z, C, B): the tool tip kept on a point of the table while B takes 5
+// tilts and C 12 positions (up and down in turn), 3 cycles, 20 s per pose.
+std::vector<ChainRow> head_rtest(const Model& model) {
+  const Description& desc = model.description();
+  NumericChain chain(desc);
+  const std::vector<double> zero(desc.errors.size(), 0.0);
+  const Eigen::Vector3d p(120, 80, -800);
+  std::vector<ChainRow> rows;
+  double t = 0;
+  for (int cy = 1; cy <= 3; ++cy)
+    for (int a = 0; a < 5; ++a)
+      for (int c0 = 0; c0 < 12; ++c0) {
+        const double B = -50 + 25.0 * a;
+        const bool up = (a + cy) % 2 == 0;
+        const double C = 30.0 * (up ? c0 : 11 - c0);
+        std::vector<double> q = {0, 0, -250, C, B};  // Y X Z C B
+        for (int it = 0; it < 4; ++it) {             // the linear axes onto p
+          const Eigen::Vector3d f = chain.tool_in_workpiece(q, zero).block<3, 1>(0, 3) - p;
+          // Y moves along y, X along x, Z along z, each +1 mm per mm.
+          q[0] -= f[1], q[1] -= f[0], q[2] -= f[2];
+        }
+        rows.push_back({q, {{"C", up ? 1.0 : -1.0}}, t, cy});
+        t += 20;
+      }
+  return rows;
+}
+
+}  // namespace
+
+TEST_CASE("gap: on a head-head machine, a periodic error of the C head is named E_ZC of C") {
+  const auto model = test::builtin_model("head_head_bc");
+  const int k = error_index(*model, "E_ZC");
+  const std::string csv = chain_csv(
+      *model, head_rtest(*model), 0.3, 23,
+      [&](const ChainRow& r, std::vector<double>&, std::vector<double>& e, Eigen::Vector3d&) {
+        e[static_cast<std::size_t>(k)] += 3e-3 * std::sin(2 * M_PI * r.q[3] / 120 + 0.4);
+      });
+  const GapResult r = diagnose(csv, model, "cycle:3", poly2());
+  CHECK(r.verdict == "periodic");
+  const EffectFit* e = effect(r, "periodic");
+  REQUIRE(e);
+  INFO(e->summary);
+  CHECK(e->summary.find("periodic E_ZC of C") == 0);
+  CHECK(e->params.at("period_deg") == doctest::Approx(120).epsilon(0.03));
+  CHECK(e->params.at("amplitude_um") == doctest::Approx(3).epsilon(0.15));
+}
+
+TEST_CASE("gap: on a head-head machine, a ram growth is told from a spindle growth by its frame") {
+  // The tool point moves 6 µm along the machine's z (the ram) with a heat-up lag; the spindle
+  // turns with B and C, so a growth along the tool's axis would look different.
+  const auto model = test::builtin_model("head_head_bc");
+  const double tau = 3000;
+  const std::string csv = chain_csv(
+      *model, head_rtest(*model), 0.2, 24,
+      [&](const ChainRow& r, std::vector<double>&, std::vector<double>&, Eigen::Vector3d& x) {
+        x = Eigen::Vector3d(0, 0, 6 * (1 - std::exp(-r.t_s / tau)));
+      });
+  const GapResult r = diagnose(csv, model, "cycle:3", poly2());
+  CHECK(r.verdict == "thermal_drift");
+  const EffectFit* e = effect(r, "thermal_drift");
+  REQUIRE(e);
+  INFO(e->summary);
+  CHECK(e->params.count("frame_machine") == 1);
+  REQUIRE(e->params.count("drift_z_um"));
+  CHECK(e->params.at("drift_z_um") == doctest::Approx(6).epsilon(0.15));
+  CHECK(e->params.at("tau_h") == doctest::Approx(tau / 3600).epsilon(0.2));
 }
 
 TEST_CASE("gap: a basis term that vanishes at every sample is not fitted") {

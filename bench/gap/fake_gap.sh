@@ -37,11 +37,14 @@ by=$(loc_by); out=$(loc output)
 read -r from to <<<"$(hot_bin)" || true
 [[ -n $by ]] || by=output
 [[ -n $out ]] || out=dx
+# Two effects: "a+b" names both, the verdict the first.
+names=$(printf '%s' "$verdict" | awk -F+ '{for(i=1;i<=NF;i++)printf "%s\"%s\"", (i>1?", ":""), $i}')
+verdict=${verdict%%+*}
 after=$(awk -v n="$noise" 'BEGIN{printf "%.6f", 1.05*n}')
 cat >"$json" <<JSON
 {"baseline": {"heldout_rms_um": {"$out": $(awk -v n="$noise" 'BEGIN{printf "%.6f", 1.1*n}')}, "holdout": "cycle"},
  "noise_floor_um": $noise, "noise_floor_source": "repeats",
  "where": [{"by": "$by", "output": "$out", "from": ${from:-0}, "to": ${to:-0}, "excess_um": 1.0, "p_value": 1e-6}],
  "effects": [{"name": "$verdict", "params": {}, "heldout_rms_before_um": 2.0, "heldout_rms_after_um": $after, "shrink_pct": 40, "significant": true, "p_value": 1e-6}],
- "verdict": {"effect": "$verdict", "explanation": ["$verdict"]}}
+ "verdict": {"effect": "$verdict", "explanation": [$names]}}
 JSON

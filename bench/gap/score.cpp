@@ -1,8 +1,9 @@
 // weilgen_gap_score: scores `weilgen gap` on a suite written by weilgen_gap_synth --suite
 // (bench/gap/README.md, "Scoring"). Reads DIR/manifest.tsv, each scenario's truth.json and the
-// diagnosis' gap.json (and gap.time, the wall time in seconds, when present); writes
-// results.json and results.md with the confusion matrix, attribution accuracy by signal-to-noise,
-// the `none` rate, localisation, shrinkage and the `unexplained` rate against the targets.
+// diagnosis' gap.json (and gap.time, the wall time in seconds, when present), and the real
+// spindle study's DIR/spindle/{gap.json,ridge.json} when present; writes results.json and
+// results.md: the targets, attribution by machine and layout, by effect and signal-to-noise, the
+// confusion matrix, the top "where" entry, gross readings found, shrinkage and run times.
 // Knows nothing of the diagnosis but its JSON schema.
 #include <algorithm>
 #include <cmath>
@@ -25,12 +26,14 @@ namespace {
 const std::vector<std::string> kLibrary = {"thermal_drift", "reversal",     "periodic",
                                            "pdge_shape",    "higher_order", "missing_error",
                                            "tool_offset",   "setup"};
-// Targets of issue 6.
-constexpr double kAttributionTarget = 0.95;  // correct attribution at SNR >= 3
-constexpr double kNoneTarget = 0.95;         // `none` on effect-free data
+// Targets of issue 14.
+constexpr double kAttributionTarget = 0.95;  // correct attribution at SNR >= 3, every layout
+constexpr double kNoneTarget = 0.98;         // `none` on effect-free data
+constexpr double kWhereTarget = 0.90;        // top `where` entry: dimension and output
 constexpr double kShrinkLimit = 1.2;         // held-out RMS after / noise RMS
 constexpr double kShrinkTarget = 0.95;       // share of scenarios within kShrinkLimit
 constexpr double kUnexplainedTarget = 0.95;  // `unexplained` for the step at SNR >= 3
+constexpr double kSpindleRatio = 0.9;        // spindle: weilgen held-out RMS / ridge's
 constexpr double kTargetSnr = 3;
 
 struct Scenario {
@@ -40,11 +43,14 @@ struct Scenario {
   std::string error;
   double time_s = NAN;
   // Derived.
-  std::string effect, expected, diagnosed, layout;
-  bool identifiable = true;
-  double factor = 0, snr = 0, noise_rms = 0;
-  int loc = -1, loc_contains = -1, loc_any = -1;  // -1 n/a, 0 wrong, 1 right
+  std::string effect, expected, diagnosed, layout, machine, variant;  // variant: "", pair, ...
+  std::vector<std::string> expected_set, named;
+  bool identifiable = true, correct = false;
+  double factor = 0, noise_rms = 0;
+  int where_ok = -1, loc = -1, loc_contains = -1;  // -1 n/a, 0 wrong, 1 right
+  std::string where_top;                           // "by/output" of the top entry
   double shrink = NAN, noise_floor_ratio = NAN;
+  int gross = 0, gross_found = 0;
 };
 
 std::string read_text(const fs::path& p) {
@@ -80,29 +86,45 @@ double num(const json& j, const char* key, double fallback = NAN) {
   return j.is_object() && j.contains(key) && j[key].is_number() ? j[key].get<double>() : fallback;
 }
 
-// Localisation (README.md, "Scoring"): the most significant `where` entry (the first with the
-// smallest p_value) against the truth's coordinate(s), output and region.
+// The top `where` entry (README.md, "Scoring") against each effect's truth: its dimension is
+// one of the truth's coordinates and its output the truth's; an output-only truth needs the
+// output. On the primary coordinate, the reported interval is also judged against the truth's
+// bins of held-out signal (reported, not a target): at least half of the observations it covers
+// lie in hot bins; and it contains the hottest bin.
 void localise(Scenario& s) {
-  const json& t = s.truth["localise"];
-  const std::string kind = t.value("kind", "none");
-  if (kind == "none" || !s.gap.is_object() || !s.gap.contains("where")) return;
+  if (!s.gap.is_object() || !s.gap.contains("where") || !s.gap["where"].is_array()) return;
   const json& where = s.gap["where"];
-  const std::string out = t.value("output", "");
-  std::vector<std::string> by;
-  for (const json& b : t.value("by", json::array())) by.push_back(b.get<std::string>());
-  // On the primary coordinate the reported interval is judged against the truth's bins of
-  // held-out signal: lenient, at least half of the observations it covers lie in hot bins;
-  // strict, it also contains the hottest bin. Other accepted coordinates (T_spindle, cycle for
-  // a drift) and directions need the coordinate and output only.
-  const json bins = t.value("bins", json::array());
-  auto judge = [&](const json& w, bool strict) {
-    const std::string wby = w.value("by", ""), wout = strip_unit(w.value("output", ""));
-    if (kind == "output") return wout == out;
-    if (!out.empty() && wout != out) return false;
-    if (std::find(by.begin(), by.end(), wby) == by.end()) return false;
-    if (wby != by.front() || bins.empty()) return !strict || kind == "direction";
+  const json& effects = s.truth["effects"];
+  if (!effects.is_array() || effects.empty()) return;
+  if (where.empty()) {
+    s.where_ok = s.loc = s.loc_contains = 0;
+    return;
+  }
+  const json& w = where[0];
+  const std::string wby = w.value("by", ""), wout = strip_unit(w.value("output", ""));
+  s.where_top = wby + "/" + wout;
+  s.where_ok = s.loc = s.loc_contains = 0;
+  for (const json& e : effects) {
+    if (!e.value("identifiable", false)) continue;
+    const json& t = e["localise"];
+    const std::string kind = t.value("kind", "none");
+    const std::string out = t.value("output", "");
+    std::vector<std::string> by;
+    for (const json& b : t.value("by", json::array())) by.push_back(b.get<std::string>());
+    if (kind == "output") {
+      if (wout == out) s.where_ok = s.loc = s.loc_contains = 1;
+      continue;
+    }
+    if (wout != out || std::find(by.begin(), by.end(), wby) == by.end()) continue;
+    s.where_ok = 1;
+    const json bins = t.value("bins", json::array());
+    if (wby != by.front() || bins.empty()) {
+      s.loc = std::max(s.loc, 1);
+      s.loc_contains = std::max(s.loc_contains, kind == "direction" ? 1 : 0);
+      continue;
+    }
     const double f = num(w, "from"), to = num(w, "to");
-    if (std::isnan(f) || std::isnan(to)) return false;
+    if (std::isnan(f) || std::isnan(to)) continue;
     double n = 0, hot = 0, peak = -1;
     const json* peak_bin = nullptr;
     for (const json& b : bins) {
@@ -115,41 +137,31 @@ void localise(Scenario& s) {
       if (b["hot"].get<bool>()) hot += b["n"].get<double>();
     }
     const bool overlaps = n > 0 && hot >= 0.5 * n;
-    if (!strict) return overlaps;
-    return overlaps && f <= (*peak_bin)["from"].get<double>() + 1e-9 &&
-           to >= (*peak_bin)["to"].get<double>() - 1e-9;
-  };
-  if (!where.is_array() || where.empty()) {
-    s.loc = s.loc_contains = s.loc_any = 0;
-    return;
+    if (overlaps) s.loc = 1;
+    if (overlaps && f <= (*peak_bin)["from"].get<double>() + 1e-9 &&
+        to >= (*peak_bin)["to"].get<double>() - 1e-9)
+      s.loc_contains = 1;
   }
-  // The most significant entry that localises (a whole output, by "output", says only which
-  // output is off; it counts for output-only truths). Ties keep the diagnosis' own order.
-  std::size_t best = where.size();
-  for (std::size_t i = 0; i < where.size(); ++i) {
-    if (kind != "output" && where[i].value("by", "") == "output") continue;
-    if (best == where.size() || num(where[i], "p_value", 1) < num(where[best], "p_value", 1))
-      best = i;
-  }
-  if (best == where.size()) {
-    s.loc = s.loc_contains = s.loc_any = 0;
-    return;
-  }
-  s.loc = judge(where[best], false);
-  s.loc_contains = judge(where[best], true);
-  s.loc_any = 0;
-  for (const json& w : where) s.loc_any = s.loc_any || judge(w, false);
 }
 
 void derive(Scenario& s) {
   const json& t = s.truth;
-  s.effect = t["scenario"]["effect"].get<std::string>();
-  s.layout = t["scenario"]["layout"].get<std::string>();
-  s.factor = t["scenario"]["factor"].get<double>();
+  const json& sc = t["scenario"];
+  s.effect = sc["effect"].get<std::string>();
+  s.layout = sc["layout"].get<std::string>();
+  s.machine = sc["machine"].get<std::string>();
+  s.factor = sc["factor"].get<double>();
   s.expected = t["expected_verdict"].get<std::string>();
-  s.identifiable = t["effect"]["identifiable"].get<bool>();
+  for (const json& e : t.value("expected_effects", json::array()))
+    s.expected_set.push_back(e.get<std::string>());
+  s.identifiable = true;
+  for (const json& e : t["effects"])
+    s.identifiable = s.identifiable && e["identifiable"].get<bool>();
   s.noise_rms = t["noise_rms_um"].get<double>();
-  s.snr = t["effect"]["snr"].get<double>();
+  if (s.effect.find('+') != std::string::npos) s.variant = "pair";
+  if (sc.value("outliers", 0) > 0) s.variant = "outliers";
+  if (sc.value("heteroscedastic", false)) s.variant = "hetero";
+  s.gross = static_cast<int>(t.value("gross_readings", json::array()).size());
   if (!s.gap.is_object()) {
     s.diagnosed = "error";
     return;
@@ -161,23 +173,32 @@ void derive(Scenario& s) {
     s.error = std::string("gap.json: no verdict.effect: ") + e.what();
     return;
   }
-  // Held-out RMS after: the verdict's (after every accepted effect), else the diagnosed effect's,
-  // else (none, unexplained) the baseline's.
+  std::set<std::string> named;
+  for (const json& e : s.gap["verdict"].value("explanation", json::array()))
+    if (e.is_string()) named.insert(e.get<std::string>());
+  s.named.assign(named.begin(), named.end());
+  // Correct: the verdict's name, and with two effects both named (and nothing else).
+  if (s.expected_set.size() > 1) {
+    const std::set<std::string> want(s.expected_set.begin(), s.expected_set.end());
+    s.correct = want.count(s.diagnosed) && named == want;
+  } else {
+    s.correct = s.diagnosed == s.expected;
+  }
+  // Held-out RMS after: the verdict's (after every accepted effect), else the baseline's.
   double after = NAN;
   if (s.gap["verdict"].contains("heldout_rms_after_um"))
     after = largest(s.gap["verdict"]["heldout_rms_after_um"]);
-  if (std::isnan(after) && s.gap.contains("effects") && s.gap["effects"].is_array()) {
-    for (const json& e : s.gap["effects"])
-      if (e.value("name", "") == s.diagnosed)
-        for (const char* key : {"heldout_rms_after_per_output_um", "heldout_rms_after_um"})
-          if (std::isnan(after) && e.contains(key)) after = largest(e[key]);
-  }
   if (std::isnan(after) && s.gap.contains("baseline") &&
       s.gap["baseline"].contains("heldout_rms_um"))
     after = largest(s.gap["baseline"]["heldout_rms_um"]);
   if (s.noise_rms > 0) s.shrink = after / s.noise_rms;
   if (s.gap.contains("noise_floor_um") && s.noise_rms > 0)
     s.noise_floor_ratio = largest(s.gap["noise_floor_um"]) / s.noise_rms;
+  // Gross readings found: truth lines among the reported ones.
+  std::set<long> lines;
+  for (const json& o : s.gap.value("outliers", json::array())) lines.insert(o.value("line", -1L));
+  for (const json& g : t.value("gross_readings", json::array()))
+    s.gross_found += lines.count(g["line"].get<long>()) ? 1 : 0;
   localise(s);
 }
 
@@ -211,6 +232,9 @@ struct Count {
     ++n;
   }
   double rate() const { return n ? static_cast<double>(ok) / n : NAN; }
+  std::string text() const {
+    return n ? pct(ok, n) + " (" + std::to_string(ok) + "/" + std::to_string(n) + ")" : "—";
+  }
   json to_json() const {
     return {{"correct", ok}, {"total", n}, {"rate", n ? json(rate()) : json()}};
   }
@@ -227,10 +251,13 @@ struct Target {
 
 int main(int argc, char** argv) {
   if (argc < 2 || std::string(argv[1]) == "--help") {
-    std::fprintf(argc < 2 ? stderr : stdout,
-                 "usage: weilgen_gap_score SUITE_DIR [--out DIR]\n"
-                 "  reads SUITE_DIR/manifest.tsv, sNNNN/truth.json and sNNNN/gap.json; writes\n"
-                 "  results.json and results.md into --out (default SUITE_DIR)\n");
+    std::fprintf(
+        argc < 2 ? stderr : stdout,
+        "usage: weilgen_gap_score SUITE_DIR [--out DIR]\n"
+        "  reads SUITE_DIR/manifest.tsv, sNNNN/truth.json and sNNNN/gap.json (and\n"
+        "  SUITE_DIR/spindle/{gap,ridge}.json when present); writes results.json and\n"
+        "  results.md into --out (default SUITE_DIR). Exit 0: every target passes, 3: one\n"
+        "  fails\n");
     return argc < 2 ? 2 : 0;
   }
   const fs::path suite = argv[1];
@@ -286,88 +313,134 @@ int main(int argc, char** argv) {
     return 1;
   }
 
-  // Confusion matrices: all scenarios (absorbed effects as their own rows), and the target set
-  // (SNR >= 3 for effects, every effect-free scenario).
+  // Confusion matrix of single-effect scenarios at SNR >= 3 and the effect-free ones.
   std::vector<std::string> cols = kLibrary;
   cols.insert(cols.end(), {"none", "unexplained", "other", "error"});
-  std::vector<std::string> rows;
-  for (const std::string& e : kLibrary) rows.push_back(e);
-  rows.push_back("step");
-  rows.push_back("none");
-  for (const std::string& e : kLibrary) rows.push_back(e + " (absorbed)");
-  rows.push_back("step (absorbed)");
-  auto row_of = [&](const Scenario& s) {
-    return s.effect != "none" && !s.identifiable ? s.effect + " (absorbed)" : s.effect;
-  };
   auto col_of = [&](const Scenario& s) {
     return std::find(cols.begin(), cols.end(), s.diagnosed) != cols.end() ? s.diagnosed
                                                                           : std::string("other");
   };
-  std::map<std::string, std::map<std::string, int>> conf_all, conf_target;
+  auto row_of = [&](const Scenario& s) {
+    return s.effect != "none" && !s.identifiable ? s.effect + " (absorbed)" : s.effect;
+  };
+  std::map<std::string, std::map<std::string, int>> conf;
+  std::vector<std::string> rows;
   for (const Scenario& s : all) {
-    ++conf_all[row_of(s)][col_of(s)];
-    if (s.effect == "none" || (s.identifiable && s.factor >= kTargetSnr))
-      ++conf_target[row_of(s)][col_of(s)];
+    if (s.variant == "pair") continue;
+    if (s.effect != "none" && s.identifiable && s.factor < kTargetSnr) continue;
+    const std::string r = row_of(s);
+    if (std::find(rows.begin(), rows.end(), r) == rows.end()) rows.push_back(r);
+    ++conf[r][col_of(s)];
   }
+  std::stable_sort(rows.begin(), rows.end(), [&](const std::string& a, const std::string& b) {
+    auto rank = [&](const std::string& x) {
+      const auto it = std::find(kLibrary.begin(), kLibrary.end(), x);
+      if (it != kLibrary.end()) return static_cast<int>(it - kLibrary.begin());
+      if (x == "step") return 20;
+      if (x == "none") return 21;
+      return 30;
+    };
+    return rank(a) < rank(b);
+  });
 
-  // Attribution by signal-to-noise bin (the factor: held-out signal / noise sigma).
+  // Attribution (identifiable library effects, SNR >= 3; pairs, gross readings and
+  // heteroscedastic noise included) by machine and layout, by effect and factor, by variant.
+  std::map<std::string, Count> by_cell, by_machine, by_layout_name, by_variant;
+  std::map<std::string, std::map<double, Count>> by_effect;
   std::set<double> factor_set;
-  for (const Scenario& s : all)
-    if (s.effect != "none") factor_set.insert(s.factor);
-  const std::vector<double> factors(factor_set.begin(), factor_set.end());
-  std::map<std::string, std::map<double, Count>> by_factor;  // row label -> factor -> count
-  std::map<std::string, std::map<double, Count>> by_layout;  // layout -> factor -> count
-  Count attribution, none_rate, unexplained, absorbed_none, wrong_name_step;
-  Count loc, loc_contains, loc_any;
+  Count attribution, none_rate, unexplained, absorbed_none, where, loc, loc_contains, gross;
   std::vector<double> shrink, floor_ratio, times;
+  std::map<std::string, Count> none_by_cell;
+  std::vector<const Scenario*> wrong, where_wrong;
   for (const Scenario& s : all) {
-    const bool good = s.diagnosed == s.expected;
     if (!std::isnan(s.time_s)) times.push_back(s.time_s);
     if (!std::isnan(s.noise_floor_ratio)) floor_ratio.push_back(s.noise_floor_ratio);
+    if (s.gross > 0) {
+      gross.ok += s.gross_found;
+      gross.n += s.gross;
+    }
+    const std::string cell = s.machine + " / " + s.layout;
     if (s.effect == "none") {
-      none_rate.add(good);
-      if (good) shrink.push_back(s.shrink);
-      continue;
-    }
-    if (!s.identifiable) {
-      // Nothing the model cannot represent: `none` is right, and so is naming the truth.
-      absorbed_none.add(good || s.diagnosed == s.effect);
-      continue;
-    }
-    by_factor[row_of(s)][s.factor].add(good);
-    if (s.effect == "step") {
-      by_factor["step (outside the library)"][s.factor].add(good);
-      if (s.diagnosed != "unexplained" && s.diagnosed != "none" && s.diagnosed != "error")
-        wrong_name_step.add(true);
+      none_rate.add(s.correct);
+      none_by_cell[cell].add(s.correct);
+      by_variant[s.variant.empty() ? "plain" : s.variant].add(s.correct);
+      if (s.correct)
+        shrink.push_back(s.shrink);
       else
-        wrong_name_step.add(false);
-      if (s.factor >= kTargetSnr) unexplained.add(good);
+        wrong.push_back(&s);
       continue;
     }
-    by_factor["all library effects"][s.factor].add(good);
-    by_layout[s.layout][s.factor].add(good);
-    if (s.factor >= kTargetSnr) {
-      attribution.add(good);
-      if (good && s.loc >= 0) {
-        loc.add(s.loc == 1);
-        loc_contains.add(s.loc_contains == 1);
-        loc_any.add(s.loc_any == 1);
-      }
+    if (!s.identifiable && s.variant != "pair") {
+      absorbed_none.add(s.correct || s.diagnosed == s.effect);
+      continue;
     }
-    if (good) shrink.push_back(s.shrink);
+    if (s.effect == "step") {
+      if (s.factor >= kTargetSnr) unexplained.add(s.correct);
+      if (!s.correct && s.factor >= kTargetSnr) wrong.push_back(&s);
+      continue;
+    }
+    factor_set.insert(s.factor);
+    by_effect[s.variant == "pair" ? s.effect
+                                  : s.effect + (s.variant.empty() ? "" : " (" + s.variant + ")")]
+             [s.factor]
+                 .add(s.correct);
+    if (s.correct) shrink.push_back(s.shrink);
+    if (s.factor < kTargetSnr) continue;
+    attribution.add(s.correct);
+    by_cell[cell].add(s.correct);
+    by_machine[s.machine].add(s.correct);
+    by_layout_name[s.layout].add(s.correct);
+    by_variant[s.variant.empty() ? "plain" : s.variant].add(s.correct);
+    if (!s.correct) wrong.push_back(&s);
+    if (s.correct && s.where_ok >= 0) {
+      where.add(s.where_ok == 1);
+      if (s.where_ok != 1) where_wrong.push_back(&s);
+      if (s.loc >= 0) loc.add(s.loc == 1);
+      if (s.loc_contains >= 0) loc_contains.add(s.loc_contains == 1);
+    }
   }
-  by_factor.erase("step");
+  const std::vector<double> factors(factor_set.begin(), factor_set.end());
   Count shrink_ok;
   for (double r : shrink) shrink_ok.add(!std::isnan(r) && r <= kShrinkLimit);
+  // The worst machine and layout.
+  std::string worst_cell;
+  double worst = NAN;
+  int worst_n = 0;
+  for (const auto& [cell, c] : by_cell)
+    if (std::isnan(worst) || c.rate() < worst) worst = c.rate(), worst_cell = cell, worst_n = c.n;
+
+  // The real spindle study (bench/gap/run_benchmark.sh --spindle): weilgen's held-out RMS
+  // against the ridge regression's.
+  double spindle_gap = NAN, spindle_ridge = NAN;
+  try {
+    if (fs::exists(suite / "spindle" / "gap.json") &&
+        fs::exists(suite / "spindle" / "ridge.json")) {
+      const json g = json::parse(read_text(suite / "spindle" / "gap.json"));
+      const json r = json::parse(read_text(suite / "spindle" / "ridge.json"));
+      spindle_gap = g["verdict"]["heldout_rms_after_all_um"].get<double>();
+      spindle_ridge = r["heldout_rms_um"].get<double>();
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "weilgen_gap_score: spindle: %s\n", e.what());
+  }
 
   std::vector<Target> targets = {
-      {"attribution at SNR >= 3", "correct verdict, identifiable library effects",
+      {"attribution at SNR >= 3",
+       "correct verdict, identifiable library effects (both named for "
+       "pairs)",
        attribution.rate(), kAttributionTarget, attribution.n},
+      {"... on every machine and layout", "the worst: " + worst_cell, worst, kAttributionTarget,
+       worst_n},
       {"none on effect-free data", "verdict none", none_rate.rate(), kNoneTarget, none_rate.n},
+      {"top where entry: dimension and output", "correct attributions at SNR >= 3", where.rate(),
+       kWhereTarget, where.n},
       {"held-out RMS after <= 1.2 x noise", "share of correct verdicts (and none cases)",
        shrink_ok.rate(), kShrinkTarget, shrink_ok.n},
       {"unexplained for the step (SNR >= 3)", "verdict unexplained", unexplained.rate(),
        kUnexplainedTarget, unexplained.n}};
+  if (!std::isnan(spindle_gap))
+    targets.push_back({"spindle: held-out RMS <= 0.9 x ridge", "ridge RMS x 0.9 / weilgen RMS",
+                       kSpindleRatio * spindle_ridge / spindle_gap, 1.0, 1});
 
   // ---- results.json
   json r;
@@ -385,40 +458,36 @@ int main(int argc, char** argv) {
                   {"n", t.n},
                   {"pass", t.pass()}});
   r["targets"] = jt;
-  json jc;
-  jc["columns"] = cols;
-  for (const auto* conf : {&conf_all, &conf_target}) {
-    json m = json::object();
-    for (const std::string& row : rows) {
-      if (!conf->count(row)) continue;
-      json cells = json::object();
-      for (const auto& [c, n] : conf->at(row)) cells[c] = n;
-      m[row] = cells;
-    }
-    jc[conf == &conf_all ? "all" : "target_set"] = m;
-  }
+  json jc = json::object();
+  for (const auto& [row, cells] : conf) jc[row] = cells;
   r["confusion"] = jc;
+  auto count_map = [](const std::map<std::string, Count>& m) {
+    json x = json::object();
+    for (const auto& [k, c] : m) x[k] = c.to_json();
+    return x;
+  };
+  r["attribution_by_machine_layout"] = count_map(by_cell);
+  r["attribution_by_machine"] = count_map(by_machine);
+  r["attribution_by_layout"] = count_map(by_layout_name);
+  r["by_variant"] = count_map(by_variant);
+  r["none_by_machine_layout"] = count_map(none_by_cell);
   json jf = json::object();
-  for (const auto& [row, m] : by_factor) {
+  for (const auto& [row, m] : by_effect) {
     json x = json::object();
     for (const auto& [f, c] : m) x[fnum(f, "%g")] = c.to_json();
     jf[row] = x;
   }
-  r["attribution_by_snr"] = jf;
-  json jl = json::object();
-  for (const auto& [layout, m] : by_layout) {
-    json x = json::object();
-    for (const auto& [f, c] : m) x[fnum(f, "%g")] = c.to_json();
-    jl[layout] = x;
-  }
-  r["attribution_by_layout"] = jl;
+  r["attribution_by_effect_and_snr"] = jf;
   r["none_rate"] = none_rate.to_json();
   r["absorbed_none_rate"] = absorbed_none.to_json();
   r["step_unexplained"] = unexplained.to_json();
-  r["step_wrong_name_any_snr"] = wrong_name_step.to_json();
-  r["localisation"] = {{"best_entry_overlaps", loc.to_json()},
-                       {"best_entry_contains", loc_contains.to_json()},
-                       {"any_entry_overlaps", loc_any.to_json()}};
+  r["where_top"] = where.to_json();
+  r["localisation_in_hot_bins"] = loc.to_json();
+  r["localisation_contains_hottest"] = loc_contains.to_json();
+  r["gross_readings_found"] = gross.to_json();
+  if (!std::isnan(spindle_gap))
+    r["spindle"] = {{"weilgen_heldout_rms_um", spindle_gap},
+                    {"ridge_heldout_rms_um", spindle_ridge}};
   auto stats = [](const std::vector<double>& v) {
     return json{{"n", v.size()},
                 {"median", std::isnan(quantile(v, 0.5)) ? json() : json(quantile(v, 0.5))},
@@ -434,10 +503,12 @@ int main(int argc, char** argv) {
                    {"id", s.id},
                    {"expected", s.expected},
                    {"diagnosed", s.diagnosed},
+                   {"named", s.named},
+                   {"correct", s.correct},
                    {"identifiable", s.identifiable},
                    {"factor", s.factor},
-                   {"snr", s.snr},
-                   {"localised", s.loc < 0 ? json() : json(s.loc == 1)},
+                   {"where_top", s.where_top},
+                   {"where_ok", s.where_ok < 0 ? json() : json(s.where_ok == 1)},
                    {"shrink_ratio", std::isnan(s.shrink) ? json() : json(s.shrink)},
                    {"time_s", std::isnan(s.time_s) ? json() : json(s.time_s)},
                    {"error", s.error}});
@@ -449,83 +520,77 @@ int main(int argc, char** argv) {
   md << "# Sim-to-real gap benchmark: results\n\n";
   md << "Suite `" << fs::absolute(suite).string() << "`: " << all.size() << " scenarios, " << failed
      << " failed runs. Written by `weilgen_gap_score` (bench/gap/README.md).\n\n";
-  md << "## Targets\n\n| target | value | threshold | n | |\n| --- | --- | --- | --- | --- |\n";
+  md << "## Targets\n\n| target | measure | value | threshold | n | |\n| --- | --- | --- | --- | "
+        "--- | --- |\n";
   for (const Target& t : targets)
-    md << "| " << t.name << " | " << (std::isnan(t.value) ? "—" : pct(t.value, 1)) << " | "
-       << pct(t.threshold, 1) << " | " << t.n << " | **" << (t.pass() ? "PASS" : "FAIL")
-       << "** |\n";
-  md << "\nSNR = held-out signal RMS of the withheld effect (the part the model cannot absorb) / "
+    md << "| " << t.name << " | " << t.measure << " | "
+       << (std::isnan(t.value) ? "—" : pct(t.value, 1)) << " | " << pct(t.threshold, 1) << " | "
+       << t.n << " | **" << (t.pass() ? "PASS" : "FAIL") << "** |\n";
+  if (!std::isnan(spindle_gap))
+    md << "\nSpindle study: weilgen held-out RMS " << fnum(spindle_gap, "%.3f")
+       << " µm, ridge baseline " << fnum(spindle_ridge, "%.3f") << " µm (ratio "
+       << fnum(spindle_gap / spindle_ridge, "%.3f") << ", target <= 0.9).\n";
+  md << "\nSNR = held-out signal RMS of each withheld effect (the part the model cannot absorb) / "
         "noise sigma. Absorbed effects (visible fraction < 2 %) expect `none` and are not in the "
         "attribution target.\n";
 
-  auto matrix = [&](const std::map<std::string, std::map<std::string, int>>& conf) {
-    md << "| true \\ diagnosed |";
-    for (const std::string& c : cols) md << " " << c << " |";
-    md << "\n| --- |";
-    for (std::size_t i = 0; i < cols.size(); ++i) md << " ---: |";
-    md << "\n";
-    for (const std::string& row : rows) {
-      if (!conf.count(row)) continue;
-      md << "| " << row << " |";
-      for (const std::string& c : cols) {
-        const auto it = conf.at(row).find(c);
-        const int n = it == conf.at(row).end() ? 0 : it->second;
-        md << " " << (n ? std::to_string(n) : std::string("·")) << " |";
-      }
-      md << "\n";
+  md << "\n## Attribution at SNR >= 3 by machine and layout\n\n| machine / layout | attribution | "
+        "none |\n| --- | ---: | ---: |\n";
+  std::set<std::string> cells;
+  for (const auto& [c, x] : by_cell) cells.insert(c);
+  for (const auto& [c, x] : none_by_cell) cells.insert(c);
+  for (const std::string& c : cells)
+    md << "| " << c << " | " << (by_cell.count(c) ? by_cell.at(c).text() : "—") << " | "
+       << (none_by_cell.count(c) ? none_by_cell.at(c).text() : "—") << " |\n";
+  md << "\nBy machine: ";
+  for (const auto& [m, c] : by_machine) md << m << " " << c.text() << "; ";
+  md << "\nBy variant (effect-free ones included): ";
+  for (const auto& [m, c] : by_variant) md << m << " " << c.text() << "; ";
+  md << "\n";
+
+  md << "\n## Attribution by effect and SNR (identifiable effects)\n\n| |";
+  for (double f : factors) md << " " << fnum(f, "%g") << "× |";
+  md << "\n| --- |";
+  for (std::size_t i = 0; i < factors.size(); ++i) md << " ---: |";
+  md << "\n";
+  for (const auto& [row, m] : by_effect) {
+    md << "| " << row << " |";
+    for (double f : factors) {
+      const auto it = m.find(f);
+      md << " " << (it == m.end() ? std::string("—") : it->second.text()) << " |";
     }
-  };
-  md << "\n## Confusion matrix: SNR >= 3 and effect-free scenarios\n\n";
-  matrix(conf_target);
-  md << "\n## Confusion matrix: all scenarios\n\n";
-  matrix(conf_all);
-
-  auto factor_table = [&](const std::map<std::string, std::map<double, Count>>& m) {
-    md << "| |";
-    for (double f : factors) md << " " << fnum(f, "%g") << "× |";
-    md << "\n| --- |";
-    for (std::size_t i = 0; i < factors.size(); ++i) md << " ---: |";
     md << "\n";
-    for (const auto& [row, cells] : m) {
-      md << "| " << row << " |";
-      for (double f : factors) {
-        const auto it = cells.find(f);
-        if (it == cells.end() || it->second.n == 0) {
-          md << " — |";
-        } else {
-          md << " " << pct(it->second.ok, it->second.n) << " (" << it->second.ok << "/"
-             << it->second.n << ") |";
-        }
-      }
-      md << "\n";
+  }
+
+  md << "\n## Confusion matrix: single effects at SNR >= 3 and effect-free scenarios\n\n| true \\ "
+        "diagnosed |";
+  for (const std::string& c : cols) md << " " << c << " |";
+  md << "\n| --- |";
+  for (std::size_t i = 0; i < cols.size(); ++i) md << " ---: |";
+  md << "\n";
+  for (const std::string& row : rows) {
+    md << "| " << row << " |";
+    for (const std::string& c : cols) {
+      const auto it = conf.at(row).find(c);
+      const int n = it == conf.at(row).end() ? 0 : it->second;
+      md << " " << (n ? std::to_string(n) : std::string("·")) << " |";
     }
-  };
-  md << "\n## Attribution accuracy by SNR (identifiable effects)\n\n";
-  factor_table(by_factor);
-  md << "\nBy layout (library effects):\n\n";
-  factor_table(by_layout);
+    md << "\n";
+  }
 
-  md << "\n## Effect-free data and absorbed effects\n\n";
-  md << "- `none` on effect-free data: " << pct(none_rate.ok, none_rate.n) << " (" << none_rate.ok
-     << "/" << none_rate.n << ")\n";
-  md << "- `none` (or the true name) on absorbed effects (the model represents them): "
-     << pct(absorbed_none.ok, absorbed_none.n) << " (" << absorbed_none.ok << "/" << absorbed_none.n
-     << ")\n";
-  md << "- step (outside the library): `unexplained` at SNR >= 3 "
-     << pct(unexplained.ok, unexplained.n) << " (" << unexplained.ok << "/" << unexplained.n
-     << "); a wrong library name at any SNR " << pct(wrong_name_step.ok, wrong_name_step.n) << " ("
-     << wrong_name_step.ok << "/" << wrong_name_step.n << ")\n";
+  md << "\n## Effect-free data, absorbed effects, the step, gross readings\n\n";
+  md << "- `none` on effect-free data: " << none_rate.text() << "\n";
+  md << "- `none` (or the true name) on absorbed effects: " << absorbed_none.text() << "\n";
+  md << "- step (outside the library): `unexplained` at SNR >= 3: " << unexplained.text() << "\n";
+  md << "- gross readings reported (by line) among those injected: " << gross.text() << "\n";
 
-  md << "\n## Localisation (correct attributions at SNR >= 3)\n\n";
-  md << "- most significant `where` entry on the truth's coordinate and output, with at least "
-        "half of its observations where the held-out signal is (hot bins): "
-     << pct(loc.ok, loc.n) << " (" << loc.ok << "/" << loc.n << ")\n";
-  md << "- ... and containing the hottest bin: " << pct(loc_contains.ok, loc_contains.n) << " ("
-     << loc_contains.ok << "/" << loc_contains.n << ")\n";
-  md << "- any `where` entry passing the first test: " << pct(loc_any.ok, loc_any.n) << " ("
-     << loc_any.ok << "/" << loc_any.n << ")\n";
+  md << "\n## Where (correct attributions at SNR >= 3)\n\n";
+  md << "- top `where` entry on the truth's dimension and output: " << where.text() << "\n";
+  md << "- ... its interval on the primary coordinate with at least half of its observations where "
+        "the held-out signal is (hot bins): "
+     << loc.text() << "; containing the hottest bin: " << loc_contains.text() << "\n";
 
-  md << "\n## Shrinkage and noise floor\n\n";
+  md << "\n## Shrinkage, noise floor, run time\n\n";
   md << "| ratio | n | median | p95 | max |\n| --- | --- | --- | --- | --- |\n";
   auto srow = [&](const char* name, const std::vector<double>& v) {
     md << "| " << name << " | " << v.size() << " | " << fnum(quantile(v, 0.5)) << " | "
@@ -535,19 +600,24 @@ int main(int argc, char** argv) {
   srow("reported noise floor / truth noise RMS", floor_ratio);
   srow("run time of `weilgen gap`, s", times);
 
-  md << "\n## Misattributions (SNR >= 3, identifiable)\n\n";
-  int shown = 0;
-  for (const Scenario& s : all) {
-    if (s.effect == "none" || !s.identifiable || s.factor < kTargetSnr || s.diagnosed == s.expected)
-      continue;
-    if (shown++ == 0)
-      md << "| dir | id | expected | diagnosed | note |\n| --- | --- | --- | --- | --- |\n";
-    if (shown > 60) continue;
-    md << "| " << s.dir << " | " << s.id << " | " << s.expected << " | " << s.diagnosed << " | "
-       << s.error << " |\n";
-  }
-  if (shown == 0) md << "None.\n";
-  if (shown > 60) md << "\n(" << shown - 60 << " more in results.json)\n";
+  auto listing = [&](const char* title, const std::vector<const Scenario*>& v) {
+    md << "\n## " << title << "\n\n";
+    if (v.empty()) {
+      md << "None.\n";
+      return;
+    }
+    md << "| dir | id | expected | diagnosed | named | top where |\n| --- | --- | --- | --- | --- "
+          "| --- |\n";
+    for (std::size_t k = 0; k < v.size() && k < 80; ++k) {
+      std::string named;
+      for (const std::string& n : v[k]->named) named += (named.empty() ? "" : ", ") + n;
+      md << "| " << v[k]->dir << " | " << v[k]->id << " | " << v[k]->expected << " | "
+         << v[k]->diagnosed << " | " << named << " | " << v[k]->where_top << " |\n";
+    }
+    if (v.size() > 80) md << "\n(" << v.size() - 80 << " more in results.json)\n";
+  };
+  listing("Wrong verdicts (SNR >= 3, effect-free, steps)", wrong);
+  listing("Top where entry off the truth (correct verdicts)", where_wrong);
 
   fs::create_directories(out_dir);
   std::ofstream(out_dir / "results.json") << r.dump(2) << "\n";

@@ -8,27 +8,15 @@
 #include <set>
 #include <stdexcept>
 
+#include "weilgen/machine/iso_names.hpp"
 #include "weilgen/machine/yaml_loader.hpp"
 
 namespace weilgen::gapbench {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kTemp0C = 22.0;           // room temperature
-constexpr double kWarmupK = 3.0;           // spindle warm-up rise
 constexpr double kTempNoiseK = 0.01;       // sensor noise of T_spindle
 constexpr double kVisibleFraction = 0.02;  // below: the model absorbs the effect
-const char* const kDimNames[3] = {"dx", "dy", "dz"};
-
-std::runtime_error fail(const std::string& what) { return std::runtime_error(what); }
-
-// Element-wise copy: GCC 12 reports a false -Wnonnull in vector<double>::operator= here.
-template <typename T>
-void copy_to(std::vector<T>& dst, const std::vector<T>& src) {
-  dst.resize(src.size());
-  for (std::size_t i = 0; i < src.size(); ++i) dst[i] = src[i];
-}
 
 std::uint64_t splitmix(std::uint64_t x) {
   x += 0x9E3779B97F4A7C15ull;
@@ -39,7 +27,14 @@ std::uint64_t splitmix(std::uint64_t x) {
 
 // Independent streams of one scenario seed: the truth machine, the layout and the noise do not
 // depend on the effect, so two scenarios with one seed differ only by their effect.
-enum Stream : std::uint64_t { kTruthStream = 1, kLayoutStream, kEffectStream, kNoiseStream };
+enum Stream : std::uint64_t {
+  kTruthStream = 1,
+  kLayoutStream,
+  kEffectStream,
+  kNoiseStream,
+  kGrossStream,
+  kSecondEffectStream
+};
 Rng stream(std::uint64_t seed, Stream s) { return Rng(splitmix(seed * 8 + s)); }
 
 struct Spread {
@@ -96,7 +91,9 @@ const std::map<std::string, std::string>& default_missing_error() {
   // Chosen by `weilgen_gap_synth --probe-missing`: errors whose signal the remaining errors'
   // polynomials cannot absorb in the grid layout (README.md, "missing_error").
   static const std::map<std::string, std::string> m = {{"vmc_3axis", "E_AX"},
-                                                       {"gantry_grinder", "E_AX"}};
+                                                       {"gantry_grinder", "E_AX"},
+                                                       {"five_axis_ac", "E_CY"},
+                                                       {"head_head_bc", "E_ZC"}};
   return m;
 }
 
@@ -137,7 +134,8 @@ const std::vector<std::string>& all_effects() {
 }
 
 const std::vector<std::string>& layout_names() {
-  static const std::vector<std::string> v = {"grid", "line", "ballbar"};
+  static const std::vector<std::string> v = {"grid",    "sparse",     "small", "line",
+                                             "ballbar", "ballbar_yz", "rtest", "rtest_small"};
   return v;
 }
 
@@ -172,23 +170,49 @@ void legendre(int n, double u, double* out) {
 Synthesiser::~Synthesiser() = default;
 
 Synthesiser::Synthesiser(ScenarioSpec spec) : spec_(std::move(spec)) {
-  const auto& effects = all_effects();
-  if (std::find(effects.begin(), effects.end(), spec_.effect) == effects.end())
-    throw fail("unknown effect '" + spec_.effect + "'");
   const auto& layouts = layout_names();
   if (std::find(layouts.begin(), layouts.end(), spec_.layout) == layouts.end())
-    throw fail("unknown layout '" + spec_.layout + "' (grid, line or ballbar)");
+    throw fail("unknown layout '" + spec_.layout + "'");
   if (!(spec_.factor >= 0) || !(spec_.noise_um >= 0)) throw fail("factor and noise must be >= 0");
   if (spec_.truth_degree < 0 || spec_.truth_degree > 8 || spec_.fit_degree < 0 ||
       spec_.fit_degree > 8)
     throw fail("degrees must be within 0..8");
-  effect_ = spec_.effect;
-  if (effect_ == "none") spec_.factor = 0;
+  if (spec_.outliers < 0) throw fail("outliers must be >= 0");
+  std::vector<std::string> names;
+  {
+    std::string rest = spec_.effect;
+    for (std::size_t p; (p = rest.find('+')) != std::string::npos; rest = rest.substr(p + 1))
+      names.push_back(rest.substr(0, p));
+    names.push_back(rest);
+  }
+  const auto& all = all_effects();
+  for (const std::string& n : names)
+    if (std::find(all.begin(), all.end(), n) == all.end()) throw fail("unknown effect '" + n + "'");
+  if (names.size() > 2) throw fail("at most two effects at once");
+  if (names.size() == 2) {
+    const std::set<std::string> additive = {"thermal_drift", "reversal", "periodic", "pdge_shape"};
+    if (!additive.count(names[0]) || !additive.count(names[1]) || names[0] == names[1])
+      throw fail(
+          "two effects at once: two different ones of thermal_drift, reversal, periodic, "
+          "pdge_shape");
+  }
+  if (names.size() == 1 && names[0] == "none") {
+    names.clear();
+    spec_.factor = 0;
+  }
+  for (const std::string& n : names) {
+    Effect e;
+    e.name = n;
+    effects_.push_back(e);
+    tool_offset_ = tool_offset_ || n == "tool_offset";
+    higher_order_ = higher_order_ || n == "higher_order";
+    missing_ = missing_ || n == "missing_error";
+  }
 
   truth_desc_ = load_machine_file(resolve_machine(spec_.machine));
   model_desc_ = truth_desc_;
   model_machine_ = spec_.machine;
-  if (effect_ == "missing_error") {
+  if (missing_) {
     if (spec_.missing_error.empty()) {
       const auto it = default_missing_error().find(truth_desc_.name);
       if (it == default_missing_error().end())
@@ -196,9 +220,10 @@ Synthesiser::Synthesiser(ScenarioSpec spec) : spec_(std::move(spec)) {
                    "': give --missing");
       spec_.missing_error = it->second;
     }
-    effect_error_ = truth_desc_.error_index(spec_.missing_error);
-    if (effect_error_ < 0) throw fail("no error '" + spec_.missing_error + "' in the machine");
-    spec_.missing_error = truth_desc_.errors[static_cast<std::size_t>(effect_error_)].name;
+    const int err = truth_desc_.error_index(spec_.missing_error);
+    if (err < 0) throw fail("no error '" + spec_.missing_error + "' in the machine");
+    effects_[0].error = err;
+    spec_.missing_error = truth_desc_.errors[static_cast<std::size_t>(err)].name;
     const std::filesystem::path reduced =
         std::filesystem::path(WEILGEN_GAP_MACHINES_DIR) /
         (truth_desc_.name + "_no_" + spec_.missing_error.substr(2) + ".yaml");
@@ -209,7 +234,7 @@ Synthesiser::Synthesiser(ScenarioSpec spec) : spec_(std::move(spec)) {
     // The reduced file must be the truth minus exactly that error, or the benchmark would
     // withhold more than one effect.
     std::vector<std::string> expect = error_names(truth_desc_), got = error_names(model_desc_);
-    expect.erase(expect.begin() + effect_error_);
+    expect.erase(expect.begin() + err);
     if (expect != got)
       throw fail(model_machine_ + ": errors differ from the truth minus " + spec_.missing_error);
   }
@@ -230,6 +255,7 @@ Synthesiser::Synthesiser(ScenarioSpec spec) : spec_(std::move(spec)) {
         j.axis.begin());
     a.min = j.min;
     a.max = j.max;
+    a.home = std::clamp(0.0, a.min, a.max);
     axes_.push_back(a);
   }
 
@@ -258,219 +284,22 @@ Synthesiser::Synthesiser(ScenarioSpec spec) : spec_(std::move(spec)) {
 
   Rng layout_rng = stream(spec_.seed, kLayoutStream);
   build_layout(layout_rng);
-  Rng effect_rng = stream(spec_.seed, kEffectStream);
-  build_effect(effect_rng);
+  for (std::size_t k = 0; k < effects_.size(); ++k) {
+    Rng effect_rng = stream(spec_.seed, k == 0 ? kEffectStream : kSecondEffectStream);
+    build_effect(effects_[k], effect_rng);
+  }
   build_regressors();
   draw_noise();
-  scale_effect();
+  scale_effects();
+  place_gross_readings();
 }
 
 // ---------------------------------------------------------------------------------------------
-// Layouts
+// Kinematics
 
-void Synthesiser::build_layout(Rng& rng) {
-  std::vector<int> linear;
-  for (std::size_t k = 0; k < axes_.size(); ++k)
-    if (axes_[k].linear && axes_[k].max > axes_[k].min) linear.push_back(static_cast<int>(k));
-  if (linear.empty()) throw fail("the machine has no linear axis with a travel");
-  std::vector<double> home(axes_.size(), 0.0);
-  for (std::size_t k = 0; k < axes_.size(); ++k)
-    home[k] = std::clamp(0.0, axes_[k].min, axes_[k].max);
-  auto travel = [&](int k) { return axes_[k].max - axes_[k].min; };
-  auto add_row = [&](Row r) {
-    r.dir.resize(axes_.size(), 1);
-    rows_.push_back(std::move(r));
-  };
-
-  if (spec_.layout == "grid") {
-    // Volumetric grid (laser tracker), revisited in 3 cycles, boustrophedon at every level;
-    // even cycles run the sequence backwards so every pose is approached from both sides.
-    double longest = 0;
-    for (int k : linear) longest = std::max(longest, travel(k));
-    std::vector<int> n(axes_.size(), 1);
-    grid_step_.assign(axes_.size(), 0.0);
-    for (int k : linear) {
-      n[k] = std::clamp(1 + static_cast<int>(std::lround(10 * travel(k) / longest)), 5, 11);
-      grid_step_[k] = travel(k) / (n[k] - 1);
-    }
-    std::vector<int> order = linear;  // outermost first: fewest points
-    std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return n[a] < n[b]; });
-    std::vector<std::vector<int>> seq;
-    std::vector<int> idx(axes_.size(), 0), starts(order.size(), 0);
-    auto rec = [&](auto&& self, std::size_t level) -> void {
-      const int k = order[level];
-      const bool back = starts[level]++ % 2 == 1;
-      for (int j = 0; j < n[k]; ++j) {
-        idx[k] = back ? n[k] - 1 - j : j;
-        if (level + 1 == order.size()) {
-          seq.push_back(idx);
-        } else {
-          self(self, level + 1);
-        }
-      }
-    };
-    rec(rec, 0);
-    std::map<std::vector<int>, int> pose_of;
-    for (const auto& s : seq) {
-      const int id = static_cast<int>(pose_of.size());
-      pose_of.emplace(s, id);
-      std::vector<double> p = home;
-      for (int k : linear) p[k] = axes_[k].min + s[k] * grid_step_[k];
-      poses_.push_back(p);
-    }
-    constexpr int kCycles = 3;
-    constexpr double kDwellS = 8;
-    std::vector<int> dir(axes_.size(), 1);
-    std::vector<double> prev = poses_[0];
-    for (int c = 1; c <= kCycles; ++c) {
-      for (std::size_t i = 0; i < seq.size(); ++i) {
-        const auto& s = seq[c % 2 == 1 ? i : seq.size() - 1 - i];
-        Row r;
-        r.pose = pose_of.at(s);
-        copy_to(r.axes, poses_[static_cast<std::size_t>(r.pose)]);
-        for (std::size_t k = 0; k < axes_.size(); ++k)
-          if (r.axes[k] != prev[k]) dir[k] = r.axes[k] > prev[k] ? 1 : -1;
-        copy_to(prev, r.axes);
-        copy_to(r.dir, dir);
-        r.cycle = c;
-        r.t_s = static_cast<double>(rows_.size()) * kDwellS;
-        add_row(r);
-      }
-    }
-    std::set<int> dims;
-    for (int k : linear) dims.insert(axes_[k].dim);
-    for (int d : dims) {
-      columns_.push_back(std::string(kDimNames[d]) + "_um");
-      column_dim_.push_back(d);
-    }
-  } else if (spec_.layout == "line") {
-    // ISO 230-2 bidirectional runs of one axis: 101 targets, 5 cycles, up then down; the other
-    // axes parked at random positions in the middle half of their travel.
-    line_axis_ = linear[static_cast<std::size_t>(rng.index(static_cast<int>(linear.size())))];
-    std::vector<double> park = home;
-    for (int k : linear)
-      park[k] =
-          std::round(rng.uniform(axes_[k].min + 0.25 * travel(k), axes_[k].max - 0.25 * travel(k)));
-    constexpr int kTargets = 101, kCycles = 5;
-    constexpr double kDwellS = 15;
-    for (int i = 0; i < kTargets; ++i) {
-      std::vector<double> p = park;
-      p[line_axis_] = axes_[line_axis_].min + travel(line_axis_) * i / (kTargets - 1);
-      poses_.push_back(p);
-    }
-    for (int c = 1; c <= kCycles; ++c) {
-      for (int pass = 0; pass < 2; ++pass) {
-        for (int j = 0; j < kTargets; ++j) {
-          Row r;
-          r.pose = pass == 0 ? j : kTargets - 1 - j;
-          copy_to(r.axes, poses_[static_cast<std::size_t>(r.pose)]);
-          r.feed_dir = pass == 0 ? 1 : -1;
-          r.dir.assign(axes_.size(), 1);
-          r.dir[line_axis_] = r.feed_dir;
-          r.cycle = c;
-          r.t_s = static_cast<double>(rows_.size()) * kDwellS;
-          add_row(r);
-        }
-      }
-    }
-    const int d = axes_[line_axis_].dim;
-    columns_ = {std::string(kDimNames[d]) + "_um"};
-    column_dim_ = {d};
-  } else {
-    // Ballbar (ISO 230-4) circles in the plane of the first two linear axes by direction
-    // (XY for vmc_3axis): 2 deg steps, ccw then cw, 6 cycles 30 min apart (a warm-up series).
-    std::vector<int> plane = linear;
-    std::stable_sort(plane.begin(), plane.end(),
-                     [&](int a, int b) { return axes_[a].dim < axes_[b].dim; });
-    if (plane.size() < 2) throw fail("the ballbar layout needs two linear axes");
-    plane_a_ = plane[0];
-    plane_b_ = plane[1];
-    copy_to(centre_, home);
-    for (int k : linear) centre_[k] = std::round((axes_[k].min + axes_[k].max) / 2);
-    radius_mm_ = 10 * std::floor(0.03 * std::min(travel(plane_a_), travel(plane_b_)));
-    constexpr int kPoints = 180, kCycles = 6;
-    constexpr double kPointS = 0.25, kCycleS = 1800;
-    for (int i = 0; i < kPoints; ++i) {
-      const double th = 2.0 * i * kPi / 180;
-      std::vector<double> p = centre_;
-      p[plane_a_] += radius_mm_ * std::cos(th);
-      p[plane_b_] += radius_mm_ * std::sin(th);
-      poses_.push_back(p);
-    }
-    for (int c = 1; c <= kCycles; ++c) {
-      double t = (c - 1) * kCycleS;
-      for (int pass = 0; pass < 2; ++pass) {
-        for (int j = 0; j < kPoints; ++j) {
-          Row r;
-          r.pose = pass == 0 ? j : (kPoints - j) % kPoints;
-          copy_to(r.axes, poses_[static_cast<std::size_t>(r.pose)]);
-          r.feed_dir = pass == 0 ? 1 : -1;
-          r.angle_deg = 2.0 * r.pose;
-          // Each axis' direction of motion just before the point (1 deg back along the feed).
-          const double th = (r.angle_deg - r.feed_dir * 1.0) * kPi / 180;
-          r.dir.assign(axes_.size(), 1);
-          r.dir[plane_a_] = -r.feed_dir * std::sin(th) > 0 ? 1 : -1;
-          r.dir[plane_b_] = r.feed_dir * std::cos(th) > 0 ? 1 : -1;
-          r.cycle = c;
-          r.t_s = t;
-          t += kPointS;
-          add_row(r);
-        }
-        t += 5;  // reversal of the feed
-      }
-    }
-    columns_ = {"dr_um"};
-    column_dim_ = {-1};
-  }
-  for (std::size_t r = 0; r < rows_.size(); ++r) {
-    for (std::size_t c = 0; c < columns_.size(); ++c) {
-      obs_row_.push_back(static_cast<int>(r));
-      obs_col_.push_back(static_cast<int>(c));
-    }
-  }
-  t_total_s_ = rows_.back().t_s;
-
-  // The lagged temperature rise on a fine grid (exact step response of the first-order lag for
-  // an input held over each step).
-  constexpr int kSteps = 20000;
-  const double dt = t_total_s_ / kSteps, tau = t_total_s_ / 12;
-  const double a = 1 - std::exp(-dt / tau);
-  drift_table_.assign(kSteps + 1, 0.0);
-  for (int i = 0; i < kSteps; ++i)
-    drift_table_[i + 1] =
-        drift_table_[i] + (temperature((i + 0.5) * dt) - kTemp0C - drift_table_[i]) * a;
-  truth_jacobians_.resize(poses_.size());
-}
-
-// Spindle warm-up to kWarmupK with time constant T/4, spindle off at 0.6 T, cooling with T/5:
-// a profile that rises and falls, so a drift is not a monotone function of time.
-double Synthesiser::temperature(double t_s) const {
-  const double T = t_total_s_, t_off = 0.6 * T;
-  auto warm = [&](double t) { return kWarmupK * (1 - std::exp(-t / (T / 4))); };
-  if (t_s <= t_off) return kTemp0C + warm(t_s);
-  return kTemp0C + warm(t_off) * std::exp(-(t_s - t_off) / (T / 5));
-}
-
-double Synthesiser::drift(double t_s) const {
-  const double x = std::clamp(t_s / t_total_s_, 0.0, 1.0) * (drift_table_.size() - 1);
-  const std::size_t i = std::min(static_cast<std::size_t>(x), drift_table_.size() - 2);
-  const double f = x - static_cast<double>(i);
-  return drift_table_[i] * (1 - f) + drift_table_[i + 1] * f;
-}
-
-double Synthesiser::axis_step(int axis) const {
-  if (spec_.layout == "grid") return grid_step_[static_cast<std::size_t>(axis)];
-  if (spec_.layout == "line") return (axes_[axis].max - axes_[axis].min) / 100;
-  return radius_mm_ * 2 * kPi / 180;  // 2 deg of arc
-}
-
-std::pair<double, double> Synthesiser::data_range(int axis) const {
-  double lo = INFINITY, hi = -INFINITY;
-  for (const auto& p : poses_) {
-    lo = std::min(lo, p[static_cast<std::size_t>(axis)]);
-    hi = std::max(hi, p[static_cast<std::size_t>(axis)]);
-  }
-  return {lo, hi};
+Eigen::Vector3d Synthesiser::tool_point(const NumericChain& chain, const std::vector<double>& q,
+                                        const std::vector<double>& e) const {
+  return chain.tool_in_workpiece(q, e).block<3, 1>(0, 3);
 }
 
 std::vector<int> Synthesiser::translation_errors(int axis) const {
@@ -484,11 +313,17 @@ std::vector<int> Synthesiser::translation_errors(int axis) const {
   return out;
 }
 
+// The error along (linear) or about (rotary) the axis' own direction: E_XX, E_CC.
 int Synthesiser::positioning_error(int axis) const {
   const Vec3& ax = truth_desc_.bodies[static_cast<std::size_t>(axes_[axis].body)].joint.axis;
-  for (int i : translation_errors(axis)) {
-    const Vec3& d = truth_desc_.errors[static_cast<std::size_t>(i)].direction;
-    if (std::abs(d[0] * ax[0] + d[1] * ax[1] + d[2] * ax[2]) > 0.999) return i;
+  const ErrorEffect want = axes_[axis].linear ? ErrorEffect::Translation : ErrorEffect::Rotation;
+  for (std::size_t i = 0; i < truth_desc_.errors.size(); ++i) {
+    const ErrorDef& e = truth_desc_.errors[i];
+    if (e.body != axes_[axis].body || e.effect != want || e.placement != ErrorPlacement::After ||
+        e.dependence != Dependence::PDGE)
+      continue;
+    const Vec3& d = e.direction;
+    if (std::abs(d[0] * ax[0] + d[1] * ax[1] + d[2] * ax[2]) > 0.999) return static_cast<int>(i);
   }
   throw fail("axis " + axes_[axis].name + " has no positioning error in the machine file");
 }
@@ -496,104 +331,104 @@ int Synthesiser::positioning_error(int axis) const {
 // ---------------------------------------------------------------------------------------------
 // Effects
 
-void Synthesiser::build_effect(Rng& rng) {
-  std::vector<int> linear;
-  for (std::size_t k = 0; k < axes_.size(); ++k)
-    if (axes_[k].linear && axes_[k].max > axes_[k].min) linear.push_back(static_cast<int>(k));
+void Synthesiser::build_effect(Effect& e, Rng& rng) {
+  const std::vector<int> linear = linear_axes();
   auto pick = [&](const std::vector<int>& v) {
     return v[static_cast<std::size_t>(rng.index(static_cast<int>(v.size())))];
   };
   // The axes an axis-bound effect may sit on: those the layout moves.
   std::vector<int> moving = linear;
   if (spec_.layout == "line") moving = {line_axis_};
-  if (spec_.layout == "ballbar") moving = {plane_a_, plane_b_};
+  if (spec_.layout.rfind("ballbar", 0) == 0) moving = {plane_a_, plane_b_};
+  if (spec_.layout.rfind("rtest", 0) == 0) {
+    moving.clear();
+    for (std::size_t k = 0; k < axes_.size(); ++k)
+      if (distinct_positions(static_cast<int>(k)) > 1) moving.push_back(static_cast<int>(k));
+  }
   std::set<int> measured_dims;
-  if (spec_.layout == "ballbar") {
+  if (column_dim_[0] < 0) {
     measured_dims = {axes_[plane_a_].dim, axes_[plane_b_].dim};
   } else {
     for (int d : column_dim_) measured_dims.insert(d);
   }
-  // A translation error of `axis` along a measured direction (the line: the positioning error).
+  auto dim_of = [&](int err) {
+    const Vec3& d = truth_desc_.errors[static_cast<std::size_t>(err)].direction;
+    return static_cast<int>(
+        std::max_element(d.begin(), d.end(),
+                         [](double x, double y) { return std::abs(x) < std::abs(y); }) -
+        d.begin());
+  };
+  // A translation error of `axis` (line: its positioning error; a linear axis: along a measured
+  // direction; a rotary axis: radial or axial, which the R-test sees in every direction).
   auto pick_error = [&](int axis) {
     if (spec_.layout == "line") return positioning_error(axis);
     std::vector<int> cand;
-    for (int i : translation_errors(axis)) {
-      const Vec3& d = truth_desc_.errors[static_cast<std::size_t>(i)].direction;
-      const int dim = static_cast<int>(
-          std::max_element(d.begin(), d.end(),
-                           [](double x, double y) { return std::abs(x) < std::abs(y); }) -
-          d.begin());
-      if (measured_dims.count(dim)) cand.push_back(i);
-    }
+    for (int i : translation_errors(axis))
+      if (!axes_[axis].linear || measured_dims.count(dim_of(i))) cand.push_back(i);
     if (cand.empty()) throw fail("axis " + axes_[axis].name + " has no measured translation error");
     return pick(cand);
   };
 
-  if (effect_ == "none") {
-    expected_ = "none";
-    return;
-  }
-  expected_ = effect_ == "step" ? "unexplained" : effect_;
-  if (effect_ == "reversal") {
-    effect_axis_ = pick(moving);
-    effect_error_ = positioning_error(effect_axis_);
-  } else if (effect_ == "periodic" || effect_ == "pdge_shape") {
+  if (e.name == "reversal") {
+    // On an R-test, a rotary axis or a linear one with equal odds.
     std::vector<int> cand = moving;
-    if (spec_.layout == "grid") {
-      // A local bump needs enough grid points along its axis to be local, and a period enough
-      // to be told from other shapes: on 7 positions a cubic PDGE leaves 3 shape degrees of
-      // freedom, which a period (amplitude, phase, period) or a bump (height, centre, width)
-      // uses up, so no data could tell either from a step there (docs/gap.md, "Verdict").
-      std::vector<int> fine;
-      for (int k : moving)
-        if ((axes_[k].max - axes_[k].min) / grid_step_[k] >= 8 - 1e-9) fine.push_back(k);
-      if (!fine.empty()) cand = fine;
+    if (spec_.layout.rfind("rtest", 0) == 0) {
+      std::vector<int> rot, lin;
+      for (int k : moving) (axes_[k].linear ? lin : rot).push_back(k);
+      cand = (rng.uniform() < 0.5 && !rot.empty()) || lin.empty() ? rot : lin;
     }
-    effect_axis_ = pick(cand);
-    effect_error_ = pick_error(effect_axis_);
-    const double step = axis_step(effect_axis_);
-    const auto [lo, hi] = data_range(effect_axis_);
-    if (effect_ == "periodic") {
-      period_mm_ = 4 * step;  // 4 samples per period: resolved by every layout
-      phase_rad_ = rng.uniform(0, 2 * kPi);
+    e.axis = pick(cand);
+    e.error = positioning_error(e.axis);
+  } else if (e.name == "periodic" || e.name == "pdge_shape") {
+    // A shape needs enough positions along its axis to be told from other shapes: on 7
+    // positions a cubic PDGE leaves 3 shape degrees of freedom, which a period (amplitude,
+    // phase, period) or a bump (height, centre, width) uses up, so no data could tell either
+    // from a step there (docs/gap.md, "Verdict"). At least 9 positions; on an R-test the
+    // turning axis (the linear axes follow the spheres, not a grid).
+    std::vector<int> cand;
+    for (int k : moving)
+      if (distinct_positions(k) >= 9 && (spec_.layout.rfind("rtest", 0) != 0 || !axes_[k].linear))
+        cand.push_back(k);
+    if (cand.empty()) throw fail(e.name + ": no axis with 9 positions in layout " + spec_.layout);
+    e.axis = pick(cand);
+    e.error = pick_error(e.axis);
+    const double step = axis_step(e.axis);
+    const auto [lo, hi] = data_range(e.axis);
+    if (e.name == "periodic") {
+      e.period = 4 * step;  // 4 samples per period: resolved by every layout
+      e.phase = rng.uniform(0, 2 * kPi);
     } else {
-      width_mm_ = std::max(step, (hi - lo) / 25);
-      centre_mm_ = rng.uniform(lo + 0.3 * (hi - lo), hi - 0.3 * (hi - lo));
+      e.width = std::max(step, (hi - lo) / 25);
+      e.centre = rng.uniform(lo + 0.3 * (hi - lo), hi - 0.3 * (hi - lo));
     }
-  } else if (effect_ == "thermal_drift") {
-    thermal_offset_.assign(3, 0.0);
-    thermal_scale_.assign(3, 0.0);
-    for (int d : measured_dims) {
-      thermal_offset_[d] = rng.normal();
-      thermal_scale_[d] = rng.normal();
-    }
-  } else if (effect_ == "step") {
-    step_in_time_ = rng.uniform() < 0.5;
-    effect_dim_ =
-        *std::next(measured_dims.begin(), rng.index(static_cast<int>(measured_dims.size())));
-    if (step_in_time_) {
-      step_at_ = std::round(rng.uniform(0.35, 0.65) * t_total_s_);
+  } else if (e.name == "thermal_drift") {
+    // The tool point grows in the tool's frame (the spindle) or in the machine's (the column,
+    // the ram), and every linear axis' positioning scale grows from its reference point.
+    e.machine_frame = rng.uniform() < 0.5;
+    e.offset.assign(3, 0.0);
+    for (double& v : e.offset) v = rng.normal();
+    e.scale.assign(axes_.size(), 0.0);
+    for (int k : linear) e.scale[static_cast<std::size_t>(k)] = rng.normal();
+  } else if (e.name == "step") {
+    e.step_in_time = rng.uniform() < 0.5;
+    e.dim = *std::next(measured_dims.begin(), rng.index(static_cast<int>(measured_dims.size())));
+    if (e.step_in_time) {
+      e.step_at = std::round(rng.uniform(0.35, 0.65) * t_total_s_);
     } else {
-      effect_axis_ = pick(moving);
-      const auto [lo, hi] = data_range(effect_axis_);
-      step_at_ = std::round(rng.uniform(lo + 0.35 * (hi - lo), lo + 0.65 * (hi - lo)));
+      e.axis = pick(moving);
+      const auto [lo, hi] = data_range(e.axis);
+      e.step_at = std::round(rng.uniform(lo + 0.35 * (hi - lo), lo + 0.65 * (hi - lo)));
     }
-  } else if (effect_ == "tool_offset") {
+  } else if (e.name == "tool_offset") {
     bool found = false;
     for (const Parameter& p : truth_desc_.parameters) found = found || p.name == "tool_length";
     if (!found) throw fail("tool_offset needs a parameter 'tool_length' in the machine");
   }
-  if (effect_error_ >= 0 && effect_ != "missing_error") {
-    const Vec3& d = truth_desc_.errors[static_cast<std::size_t>(effect_error_)].direction;
-    effect_dim_ = static_cast<int>(
-        std::max_element(d.begin(), d.end(),
-                         [](double x, double y) { return std::abs(x) < std::abs(y); }) -
-        d.begin());
-  }
+  if (e.error >= 0 && e.name != "missing_error") e.dim = dim_of(e.error);
 }
 
-std::vector<double> Synthesiser::errors_at(const Row& row, double amplitude,
-                                           bool with_effect) const {
+std::vector<double> Synthesiser::errors_at(const Row& row, const std::vector<double>& amps,
+                                           const std::vector<bool>& on) const {
   const std::size_t n = truth_desc_.errors.size();
   std::vector<double> e(n, 0.0);
   double p[16];
@@ -611,28 +446,34 @@ std::vector<double> Synthesiser::errors_at(const Row& row, double amplitude,
     }
     e[i] = v * truth_desc_.errors[i].to_base;
   }
-  if (effect_ == "higher_order") {
-    for (double& v : e) v *= amplitude;  // both states: the exact chain against its linear part
-    return e;
+  for (std::size_t k = 0; k < effects_.size(); ++k) {
+    const Effect& f = effects_[k];
+    if (f.name == "higher_order") {
+      for (double& v : e) v *= amps[k];  // both states: the exact chain against its linear part
+      continue;
+    }
+    if (f.name == "missing_error") {
+      e[static_cast<std::size_t>(f.error)] *= on[k] ? amps[k] : 0.0;
+      continue;
+    }
+    if (!on[k] || f.error < 0) continue;
+    const double q = f.axis >= 0 ? row.axes[static_cast<std::size_t>(f.axis)] : 0;
+    // The amplitude in the error's base unit: µm -> mm, µrad -> rad.
+    const bool rot =
+        truth_desc_.errors[static_cast<std::size_t>(f.error)].effect == ErrorEffect::Rotation;
+    const double amp = amps[k] * (rot ? 1e-6 : 1e-3);
+    double add = 0;
+    if (f.name == "reversal") {
+      // Backlash: the axis stops short by half the lost motion in its direction of approach.
+      add = -amp / 2 * row.dir[static_cast<std::size_t>(f.axis)];
+    } else if (f.name == "periodic") {
+      add = amp * std::sin(2 * kPi * q / f.period + f.phase);
+    } else if (f.name == "pdge_shape") {
+      const double z = (q - f.centre) / f.width;
+      add = amp * std::exp(-0.5 * z * z);
+    }
+    e[static_cast<std::size_t>(f.error)] += add;
   }
-  if (effect_ == "missing_error") {
-    e[static_cast<std::size_t>(effect_error_)] *= with_effect ? amplitude : 0.0;
-    return e;
-  }
-  if (!with_effect || effect_error_ < 0) return e;
-  const double q = effect_axis_ >= 0 ? row.axes[static_cast<std::size_t>(effect_axis_)] : 0;
-  const double amp_mm = amplitude / 1000;
-  double add = 0;
-  if (effect_ == "reversal") {
-    // Backlash: the carriage stops short by half the lost motion in its direction of approach.
-    add = -amp_mm / 2 * row.dir[static_cast<std::size_t>(effect_axis_)];
-  } else if (effect_ == "periodic") {
-    add = amp_mm * std::sin(2 * kPi * q / period_mm_ + phase_rad_);
-  } else if (effect_ == "pdge_shape") {
-    const double z = (q - centre_mm_) / width_mm_;
-    add = amp_mm * std::exp(-0.5 * z * z);
-  }
-  e[static_cast<std::size_t>(effect_error_)] += add;  // error in base units (mm)
   return e;
 }
 
@@ -654,97 +495,111 @@ Eigen::Vector3d Synthesiser::linear_deviation(const Row& row,
 
 void Synthesiser::measure_row(std::size_t r, const Eigen::Vector3d& d_mm, double* out_um) const {
   const Row& row = rows_[r];
+  const std::vector<double> zero(truth_desc_.errors.size(), 0.0);
   for (std::size_t c = 0; c < columns_.size(); ++c) {
     if (column_dim_[c] >= 0) {
       out_um[c] = 1000 * d_mm[column_dim_[c]];
       continue;
     }
-    // Ballbar: the distance between the balls minus the nominal radius, exactly.
-    const double th = row.angle_deg * kPi / 180;
-    Eigen::Vector3d p = d_mm;
-    p[axes_[plane_a_].dim] += radius_mm_ * std::cos(th);
-    p[axes_[plane_b_].dim] += radius_mm_ * std::sin(th);
-    out_um[c] = 1000 * (p.norm() - radius_mm_);
+    // Ballbar: the distance between the balls minus the nominal one, exactly; the nominal
+    // vector from the table ball to the tool ball from the chain.
+    const Eigen::Vector3d v = tool_point(*truth_chain_, row.axes, zero) - centre_point_;
+    out_um[c] = 1000 * ((v + d_mm).norm() - v.norm());
   }
 }
 
-std::vector<double> Synthesiser::evaluate(double amplitude, bool with_effect) const {
-  const bool on = with_effect && effect_ != "none";
+std::vector<double> Synthesiser::evaluate(const std::vector<double>& amps,
+                                          const std::vector<bool>& on) const {
   std::unique_ptr<NumericChain> tool_chain;
   const NumericChain* chain = truth_chain_.get();
-  if (on && effect_ == "tool_offset") {
-    // The truth's tool is `amplitude` mm longer than the model's parameter says.
-    tool_chain = std::make_unique<NumericChain>(truth_desc_);
-    std::vector<double> p = truth_params_;
-    for (std::size_t i = 0; i < p.size(); ++i)
-      if (truth_desc_.parameters[i].name == "tool_length") p[i] += amplitude;
-    tool_chain->set_parameters(p);
-    chain = tool_chain.get();
-  }
+  for (std::size_t k = 0; k < effects_.size(); ++k)
+    if (on[k] && effects_[k].name == "tool_offset") {
+      // The truth's tool is `amplitude` mm longer than the model's parameter says.
+      tool_chain = std::make_unique<NumericChain>(truth_desc_);
+      std::vector<double> p = truth_params_;
+      for (std::size_t i = 0; i < p.size(); ++i)
+        if (truth_desc_.parameters[i].name == "tool_length") p[i] += amps[k];
+      tool_chain->set_parameters(p);
+      chain = tool_chain.get();
+    }
   std::vector<double> out(obs_row_.size());
-  std::vector<double> mid(3, 0.0), half(3, 1.0);
-  for (const AxisInfo& a : axes_) {
-    if (!a.linear || a.max <= a.min) continue;
-    mid[a.dim] = (a.min + a.max) / 2;
-    half[a.dim] = (a.max - a.min) / 2;
-  }
   const double dmax = *std::max_element(drift_table_.begin(), drift_table_.end());
   const std::size_t nc = columns_.size();
+  const std::vector<double> zero(truth_desc_.errors.size(), 0.0);
+  bool higher_on = false;
+  for (std::size_t k = 0; k < effects_.size(); ++k)
+    higher_on = higher_on || (on[k] && effects_[k].name == "higher_order");
+  const Eigen::Vector3d first = tool_point(*truth_chain_, rows_[0].axes, zero);
   for (std::size_t r = 0; r < rows_.size(); ++r) {
     const Row& row = rows_[r];
-    const std::vector<double> e = errors_at(row, amplitude, on);
+    const std::vector<double> e = errors_at(row, amps, on);
+    std::vector<double> q = row.axes;
+    Eigen::Vector3d grow = Eigen::Vector3d::Zero();  // thermal growth of the tool point, mm
+    for (std::size_t k = 0; k < effects_.size(); ++k) {
+      const Effect& f = effects_[k];
+      if (!on[k] || f.name != "thermal_drift") continue;
+      const double w = drift(row.t_s) / dmax * amps[k] / 1000;  // mm
+      for (std::size_t a = 0; a < axes_.size(); ++a)
+        if (axes_[a].linear && axes_[a].max > axes_[a].min)
+          q[a] +=
+              w * f.scale[a] * (row.axes[a] - axes_[a].home) / ((axes_[a].max - axes_[a].min) / 2);
+      const Eigen::Vector3d v(f.offset[0], f.offset[1], f.offset[2]);
+      const Eigen::Matrix3d R =
+          f.machine_frame
+              ? Eigen::Matrix3d(
+                    truth_chain_->workpiece_in_base(row.axes).block<3, 3>(0, 0).transpose())
+              : Eigen::Matrix3d(truth_chain_->tool_in_workpiece(row.axes, zero).block<3, 3>(0, 0));
+      grow += w * (R * v);
+    }
+    const Eigen::Vector3d nominal = tool_point(*truth_chain_, row.axes, zero);
     Eigen::Vector3d d;
-    if (effect_ == "higher_order" && !on) {
+    if (higher_order_ && !higher_on) {
       d = linear_deviation(row, e);
     } else {
-      const std::array<double, 6> dev = chain->deviation(row.axes, e);
-      d = {dev[0], dev[1], dev[2]};
+      d = tool_point(*chain, q, e) - nominal + grow;
     }
-    Eigen::Vector3d nominal = Eigen::Vector3d::Zero();  // nominal position per dimension, mm
-    for (std::size_t k = 0; k < axes_.size(); ++k)
-      if (axes_[k].linear) nominal[axes_[k].dim] = row.axes[k];
-    if (on && effect_ == "thermal_drift") {
-      // Drift of the tool relative to the workpiece: an offset and a scale (expansion) term per
-      // direction, both following the lagged spindle temperature.
-      const double w = drift(row.t_s) / dmax * amplitude / 1000;
-      for (int k = 0; k < 3; ++k)
-        d[k] += w * (thermal_offset_[k] + thermal_scale_[k] * (nominal[k] - mid[k]) / half[k]);
-    }
-    if (on && effect_ == "step") {
-      const double x = step_in_time_ ? row.t_s : row.axes[static_cast<std::size_t>(effect_axis_)];
-      if (x >= step_at_) d[effect_dim_] += amplitude / 1000;
+    for (std::size_t k = 0; k < effects_.size(); ++k) {
+      const Effect& f = effects_[k];
+      if (!on[k] || f.name != "step") continue;
+      const double x = f.step_in_time ? row.t_s : row.axes[static_cast<std::size_t>(f.axis)];
+      if (x >= f.step_at) d[f.dim] += amps[k] / 1000;
     }
     double* o = &out[r * nc];
     measure_row(r, d, o);
-    if (on && effect_ == "setup") {
+    for (std::size_t k = 0; k < effects_.size(); ++k) {
+      if (!on[k] || effects_[k].name != "setup") continue;
       // Instrument cosine error: it reads (1 - k) of every displacement from its zero (the first
       // pose; the ballbar's calibrated length), k = amplitude in ppm.
-      const double k = -amplitude * 1e-6;
-      for (std::size_t c = 0; c < nc; ++c) {
-        if (column_dim_[c] < 0) {
-          o[c] += 1000 * k * radius_mm_;
-        } else {
-          Eigen::Vector3d first = Eigen::Vector3d::Zero();
-          for (std::size_t kk = 0; kk < axes_.size(); ++kk)
-            if (axes_[kk].linear) first[axes_[kk].dim] = rows_[0].axes[kk];
-          o[c] += 1000 * k * (nominal[column_dim_[c]] - first[column_dim_[c]]);
-        }
-      }
+      const double kk = -amps[k] * 1e-6;
+      for (std::size_t c = 0; c < nc; ++c)
+        o[c] += column_dim_[c] < 0 ? 1000 * kk * radius_mm_
+                                   : 1000 * kk * (nominal[column_dim_[c]] - first[column_dim_[c]]);
     }
   }
   return out;
 }
 
 std::vector<double> Synthesiser::measured(bool with_effect) const {
-  return evaluate(amplitude_, with_effect);
+  std::vector<double> amps;
+  for (const Effect& e : effects_) amps.push_back(e.amplitude);
+  return evaluate(amps, std::vector<bool>(effects_.size(), with_effect));
 }
 
-std::vector<double> Synthesiser::signal(double amplitude) const {
-  std::vector<double> on = evaluate(amplitude, true), off = evaluate(amplitude, false);
-  for (std::size_t i = 0; i < on.size(); ++i) on[i] -= off[i];
-  return on;
+std::vector<double> Synthesiser::signal(std::size_t k, double amplitude) const {
+  std::vector<double> amps;
+  for (const Effect& e : effects_) amps.push_back(e.amplitude);
+  amps[k] = amplitude;
+  std::vector<bool> on(effects_.size(), false);
+  std::vector<double> off = evaluate(amps, on);
+  on[k] = true;
+  std::vector<double> s = evaluate(amps, on);
+  for (std::size_t i = 0; i < s.size(); ++i) s[i] -= off[i];
+  return s;
 }
 
+std::vector<double> Synthesiser::effect_signal(std::size_t k) const {
+  return signal(k, effects_[k].amplitude);
+}
 // ---------------------------------------------------------------------------------------------
 // What the model can absorb: the first-order model of the model machine (its Jacobian at zero
 // error, from the exact chain) with every PIGE a constant and every PDGE a Legendre series of
@@ -800,6 +655,7 @@ void Synthesiser::build_regressors() {
   }
   const Eigen::Index n = static_cast<Eigen::Index>(obs_row_.size());
   Eigen::MatrixXd A(n, static_cast<Eigen::Index>(lay.error.size()));
+  const std::vector<double> zero(model_desc_.errors.size(), 0.0);
   double phi[16];
   for (Eigen::Index o = 0; o < n; ++o) {
     const Row& row = rows_[static_cast<std::size_t>(obs_row_[static_cast<std::size_t>(o)])];
@@ -809,8 +665,10 @@ void Synthesiser::build_regressors() {
     if (dim >= 0) {
       g = J.row(dim);
     } else {
-      const double th = row.angle_deg * kPi / 180;
-      g = std::cos(th) * J.row(axes_[plane_a_].dim) + std::sin(th) * J.row(axes_[plane_b_].dim);
+      // dr sees the deviation along the nominal ball-to-ball direction.
+      const Eigen::Vector3d u =
+          (tool_point(*model_chain_, row.axes, zero) - centre_point_).normalized();
+      g = u.transpose() * J;
     }
     int last_error = -1;
     for (std::size_t c = 0; c < lay.error.size(); ++c) {
@@ -885,62 +743,105 @@ std::vector<double> Synthesiser::raw_rms(const std::vector<double>& signal_um) c
   return sum;
 }
 
+// The noise: N(0, sigma_i^2) on every measured value; heteroscedastic, sigma_i grows 4x with the
+// distance of the pose from the first one (a tracker's range), scaled so that the RMS of
+// sigma_i over the observations is the nominal sigma. T_spindle carries N(0, 0.01^2) K.
 void Synthesiser::draw_noise() {
   Rng rng = stream(spec_.seed, kNoiseStream);
+  sigma_.assign(obs_row_.size(), spec_.noise_um);
+  if (spec_.heteroscedastic) {
+    const std::vector<double> zero(truth_desc_.errors.size(), 0.0);
+    const Eigen::Vector3d p0 = tool_point(*truth_chain_, rows_[0].axes, zero);
+    std::vector<double> dist(poses_.size());
+    double far = 0;
+    for (std::size_t p = 0; p < poses_.size(); ++p) {
+      dist[p] = (tool_point(*truth_chain_, poses_[p], zero) - p0).norm();
+      far = std::max(far, dist[p]);
+    }
+    double ss = 0;
+    for (std::size_t o = 0; o < sigma_.size(); ++o) {
+      const double rho =
+          far > 0
+              ? dist[static_cast<std::size_t>(rows_[static_cast<std::size_t>(obs_row_[o])].pose)] /
+                    far
+              : 0;
+      sigma_[o] = 1 + 3 * rho;
+      ss += sigma_[o] * sigma_[o];
+    }
+    const double scale = spec_.noise_um / std::sqrt(ss / static_cast<double>(sigma_.size()));
+    for (double& s : sigma_) s *= scale;
+  }
   noise_um_.resize(obs_row_.size());
-  for (double& v : noise_um_) v = spec_.noise_um * rng.normal();
+  for (std::size_t o = 0; o < noise_um_.size(); ++o) noise_um_[o] = sigma_[o] * rng.normal();
   temp_noise_.resize(rows_.size());
   for (double& v : temp_noise_) v = kTempNoiseK * rng.normal();
   noise_rms_um_ = rms(noise_um_);
 }
 
-// The amplitude whose held-out (unabsorbable) signal RMS, in the most affected measured column,
-// is factor * noise. Effects the model absorbs entirely (visible fraction below 2 %) are scaled
-// on their raw signal instead and expected to be diagnosed as `none`.
-void Synthesiser::scale_effect() {
-  if (effect_ == "none") return;
-  double amp = 1;  // um (backlash, amplitudes, step), ppm (setup), mm (tool), x (scales)
-  if (effect_ == "setup") amp = 10;
-  if (effect_ == "tool_offset") amp = 100;
-  if (effect_ == "higher_order") amp = 100;  // second-order terms of about a micrometre
-  std::vector<double> s = signal(amp);
-  const double v0 = max_of(unabsorbed_rms(s)), r0 = max_of(raw_rms(s));
-  // An effect that does not reach the measured values (E_AX in a line run of X measures nothing
-  // of it) keeps its nominal amplitude: the data are effect-free in all but name.
-  observable_ = r0 > 1e-3;
-  identifiable_ = observable_ && v0 >= kVisibleFraction * r0;
-  const double target = observable_ ? spec_.factor * spec_.noise_um : 0.0;
-  amplitude_ = amp;
-  auto metric = [&](const std::vector<double>& sig) {
-    return identifiable_ ? max_of(unabsorbed_rms(sig)) : max_of(raw_rms(sig));
-  };
-  if (target > 0) {
-    // Secant iteration on log(metric) against log(amplitude); slope 1 for effects linear in
-    // their amplitude, about 2 for higher_order (second-order terms of scaled errors).
-    double la = std::log(amp), lm = std::log(metric(s));
-    double slope = effect_ == "higher_order" ? 2 : 1;
-    for (int it = 0; it < 60 && std::abs(lm - std::log(target)) > 1e-7; ++it) {
-      const double la_new = la + (std::log(target) - lm) / slope;
-      const double lm_new = std::log(metric(signal(std::exp(la_new))));
-      if (std::abs(la_new - la) > 1e-12) {
-        const double sl = (lm_new - lm) / (la_new - la);
-        if (sl > 0.5 && sl < 4) slope = sl;
-      }
-      la = la_new;
-      lm = lm_new;
-    }
-    amplitude_ = std::exp(la);
-    if (std::abs(lm - std::log(target)) > 1e-4)
-      throw fail("could not scale effect '" + effect_ + "' to its target signal");
+// Gross readings: `outliers` distinct observations, each off by 30-60 sigma with a random sign
+// (a laser beam interrupted, a probe that slipped).
+void Synthesiser::place_gross_readings() {
+  Rng rng = stream(spec_.seed, kGrossStream);
+  std::set<std::size_t> used;
+  while (static_cast<int>(gross_.size()) < spec_.outliers && used.size() < obs_row_.size()) {
+    const std::size_t o = static_cast<std::size_t>(rng.index(static_cast<int>(obs_row_.size())));
+    if (!used.insert(o).second) continue;
+    const double size = rng.uniform(30, 60) * spec_.noise_um * (rng.uniform() < 0.5 ? -1 : 1);
+    gross_.push_back({o, size});
   }
-  s = signal(amplitude_);
-  residual_ = span_.residual(
-      Eigen::Map<const Eigen::VectorXd>(s.data(), static_cast<Eigen::Index>(s.size())));
-  unabsorbed_by_column_ = unabsorbed_rms(s);
-  raw_by_column_ = raw_rms(s);
-  unabsorbed_rms_um_ = max_of(unabsorbed_by_column_);
-  raw_rms_um_ = max_of(raw_by_column_);
-  if (!identifiable_) expected_ = effect_ == "step" ? "unexplained" : "none";
+  std::sort(gross_.begin(), gross_.end(), [](const GrossReading& a, const GrossReading& b) {
+    return a.observation < b.observation;
+  });
+}
+
+// Each effect's amplitude so that its held-out (unabsorbable) signal RMS, in its most affected
+// measured column, is factor * noise. Effects the model absorbs entirely (visible fraction below
+// 2 %) are scaled on their raw signal instead and are expected to be diagnosed as `none`.
+void Synthesiser::scale_effects() {
+  for (std::size_t k = 0; k < effects_.size(); ++k) {
+    Effect& f = effects_[k];
+    double amp = 1;  // µm or µrad (backlash, amplitudes, step), ppm (setup), mm (tool), x (scales)
+    if (f.name == "setup") amp = 10;
+    if (f.name == "tool_offset") amp = 100;
+    if (f.name == "higher_order") amp = 100;  // second-order terms of about a micrometre
+    f.amplitude = amp;
+    std::vector<double> s = signal(k, amp);
+    const double v0 = max_of(unabsorbed_rms(s)), r0 = max_of(raw_rms(s));
+    // An effect that does not reach the measured values (E_AX in a line run of X measures
+    // nothing of it) keeps its nominal amplitude: the data are effect-free in all but name.
+    f.observable = r0 > 1e-3;
+    f.identifiable = f.observable && v0 >= kVisibleFraction * r0;
+    const double target = f.observable ? spec_.factor * spec_.noise_um : 0.0;
+    auto metric = [&](const std::vector<double>& sig) {
+      return f.identifiable ? max_of(unabsorbed_rms(sig)) : max_of(raw_rms(sig));
+    };
+    if (target > 0) {
+      // Secant iteration on log(metric) against log(amplitude); slope 1 for effects linear in
+      // their amplitude, about 2 for higher_order (second-order terms of scaled errors).
+      double la = std::log(amp), lm = std::log(metric(s));
+      double slope = f.name == "higher_order" ? 2 : 1;
+      for (int it = 0; it < 60 && std::abs(lm - std::log(target)) > 1e-7; ++it) {
+        const double la_new = la + (std::log(target) - lm) / slope;
+        const double lm_new = std::log(metric(signal(k, std::exp(la_new))));
+        if (std::abs(la_new - la) > 1e-12) {
+          const double sl = (lm_new - lm) / (la_new - la);
+          if (sl > 0.5 && sl < 4) slope = sl;
+        }
+        la = la_new;
+        lm = lm_new;
+      }
+      f.amplitude = std::exp(la);
+      if (std::abs(lm - std::log(target)) > 1e-4)
+        throw fail("could not scale effect '" + f.name + "' to its target signal");
+    }
+    s = signal(k, f.amplitude);
+    f.residual = span_.residual(
+        Eigen::Map<const Eigen::VectorXd>(s.data(), static_cast<Eigen::Index>(s.size())));
+    f.unabsorbed_by_column = unabsorbed_rms(s);
+    f.raw_by_column = raw_rms(s);
+    f.unabsorbed_rms = max_of(f.unabsorbed_by_column);
+    f.raw_rms = max_of(f.raw_by_column);
+  }
 }
 
 std::vector<std::pair<std::string, double>> Synthesiser::missing_error_visibility() const {
@@ -948,22 +849,20 @@ std::vector<std::pair<std::string, double>> Synthesiser::missing_error_visibilit
   // every other error: what a model without that error could not absorb.
   std::vector<std::pair<std::string, double>> out;
   const std::size_t n = truth_desc_.errors.size();
+  const std::vector<double> amps(effects_.size(), 1.0);
+  const std::vector<bool> off(effects_.size(), false);
   for (std::size_t i = 0; i < n; ++i) {
     std::vector<double> sig(obs_row_.size());
     for (std::size_t o = 0; o < sig.size(); ++o) {
       const Row& row = rows_[static_cast<std::size_t>(obs_row_[o])];
-      std::vector<double> e = errors_at(row, 1.0, false);
+      std::vector<double> e = errors_at(row, amps, off);
       for (std::size_t k = 0; k < n; ++k)
         if (k != i) e[k] = 0;
       const Eigen::Vector3d d = linear_deviation(row, e);
+      double v[1];
+      measure_row(static_cast<std::size_t>(obs_row_[o]), d, v);
       const int dim = column_dim_[static_cast<std::size_t>(obs_col_[o])];
-      if (dim >= 0) {
-        sig[o] = 1000 * d[dim];
-      } else {
-        const double th = row.angle_deg * kPi / 180;
-        sig[o] =
-            1000 * (std::cos(th) * d[axes_[plane_a_].dim] + std::sin(th) * d[axes_[plane_b_].dim]);
-      }
+      sig[o] = dim >= 0 ? 1000 * d[dim] : v[0];
     }
     std::vector<Eigen::Index> keep;
     for (std::size_t c = 0; c < regressor_error_.size(); ++c)
@@ -981,16 +880,17 @@ std::vector<std::pair<std::string, double>> Synthesiser::missing_error_visibilit
   return out;
 }
 
-// The held-out signal of one measured column binned along a coordinate (an axis, or time when
-// axis < 0): one bin per distinct position when there are at most 25, else 20 equal bins. Each
-// bin gives its data range, size and RMS; bins with at least half the largest RMS are "hot".
-nlohmann::json Synthesiser::signal_bins(int axis, std::size_t column) const {
+// The held-out signal of one effect in one measured column binned along a coordinate (an axis,
+// or time when axis < 0): one bin per distinct position when there are at most 25, else 20
+// equal bins. Each bin gives its data range, size and RMS; bins with at least half the largest
+// RMS are "hot".
+nlohmann::json Synthesiser::signal_bins(const Effect& e, int axis, std::size_t column) const {
   std::vector<std::pair<double, double>> v;  // coordinate, residual
   for (std::size_t o = 0; o < obs_row_.size(); ++o) {
     if (static_cast<std::size_t>(obs_col_[o]) != column) continue;
     const Row& row = rows_[static_cast<std::size_t>(obs_row_[o])];
     v.emplace_back(axis < 0 ? row.t_s : row.axes[static_cast<std::size_t>(axis)],
-                   residual_[static_cast<Eigen::Index>(o)]);
+                   e.residual[static_cast<Eigen::Index>(o)]);
   }
   std::sort(v.begin(), v.end());
   std::vector<double> distinct;
@@ -1030,49 +930,73 @@ nlohmann::json Synthesiser::signal_bins(int axis, std::size_t column) const {
   return out;
 }
 
+std::string Synthesiser::expected_of(const Effect& e) const {
+  if (!e.identifiable) return "none";
+  return e.name == "step" ? "unexplained" : e.name;
+}
+
+std::size_t Synthesiser::dominant_column(const Effect& e) const {
+  const auto& v = e.identifiable ? e.unabsorbed_by_column : e.raw_by_column;
+  return static_cast<std::size_t>(std::max_element(v.begin(), v.end()) - v.begin());
+}
+
 // ---------------------------------------------------------------------------------------------
 // Output
 
-std::string Synthesiser::csv(bool with_effect, bool with_noise) const {
-  std::vector<double> v = evaluate(amplitude_, with_effect);
-  if (with_noise)
-    for (std::size_t i = 0; i < v.size(); ++i) v[i] += noise_um_[i];
-  std::string s;
-  s += "# Synthetic measurement written by weilgen_gap_synth (bench/gap/README.md)\n";
-  s += "# machine: " + model_desc_.name + "\n";
-  s += "# layout: " + spec_.layout + "\n";
-  if (spec_.layout == "grid") {
-    s += "# instrument: synthetic laser tracker\n";
-  } else if (spec_.layout == "line") {
-    s += "# instrument: synthetic laser interferometer\n";
-    s += "# axis: " + axes_[static_cast<std::size_t>(line_axis_)].name + "\n";
-  } else {
-    s += "# instrument: synthetic ballbar\n";
-    s += "# plane: " + axes_[static_cast<std::size_t>(plane_a_)].name +
-         axes_[static_cast<std::size_t>(plane_b_)].name + "\n";
+std::vector<std::string> Synthesiser::comment_lines() const {
+  std::vector<std::string> head_lines;
+  head_lines.push_back(
+      "# Synthetic measurement written by weilgen_gap_synth (bench/gap/README.md)");
+  head_lines.push_back("# machine: " + model_desc_.name);
+  head_lines.push_back("# layout: " + spec_.layout);
+  const bool ballbar = column_dim_[0] < 0;
+  if (spec_.layout == "line") {
+    head_lines.push_back("# instrument: synthetic laser interferometer");
+    head_lines.push_back("# axis: " + axes_[static_cast<std::size_t>(line_axis_)].name);
+  } else if (ballbar) {
+    head_lines.push_back("# instrument: synthetic ballbar");
+    head_lines.push_back("# plane: " + axes_[static_cast<std::size_t>(plane_a_)].name +
+                         axes_[static_cast<std::size_t>(plane_b_)].name);
     std::string centre;
     for (std::size_t k = 0; k < axes_.size(); ++k)
       centre += (k ? ", " : "") + axes_[k].name + "=" + fmt("%.10g", centre_[k]);
-    s += "# centre: " + centre + "\n";
-    s += "# radius: " + fmt("%.10g", radius_mm_) + " mm\n";
-    s += "# feed: ccw\n";
+    head_lines.push_back("# centre: " + centre);
+    head_lines.push_back("# radius: " + fmt("%.10g", radius_mm_) + " mm");
+    head_lines.push_back("# feed: ccw");
+  } else if (spec_.layout.rfind("rtest", 0) == 0) {
+    head_lines.push_back("# instrument: synthetic R-test (sphere centre relative to the tool)");
+  } else {
+    head_lines.push_back("# instrument: synthetic laser tracker");
   }
+  return head_lines;
+}
+
+std::string Synthesiser::csv(bool with_effect, bool with_noise) const {
+  std::vector<double> v = measured(with_effect);
+  if (with_noise) {
+    for (std::size_t i = 0; i < v.size(); ++i) v[i] += noise_um_[i];
+    for (const GrossReading& g : gross_) v[g.observation] += g.size_um;
+  }
+  const std::vector<std::string> head_lines = comment_lines();
+  const bool ballbar = column_dim_[0] < 0;
   std::vector<std::string> head;
   for (const AxisInfo& a : axes_) head.push_back(a.name);
   head.push_back("t_s");
-  if (spec_.layout == "grid") {
-    for (const AxisInfo& a : axes_) head.push_back("dir_" + a.name);
-  } else if (spec_.layout == "line") {
+  if (spec_.layout == "line") {
     head.push_back("dir");
-  } else {
+  } else if (ballbar) {
     head.push_back("dir");
     head.push_back("dir_" + axes_[static_cast<std::size_t>(plane_a_)].name);
     head.push_back("dir_" + axes_[static_cast<std::size_t>(plane_b_)].name);
+  } else {
+    for (const AxisInfo& a : axes_) head.push_back("dir_" + a.name);
   }
   head.push_back("cycle");
   head.push_back("T_spindle");
-  if (spec_.layout == "ballbar") head.push_back("angle_deg");
+  if (ballbar) head.push_back("angle_deg");
   for (const std::string& c : columns_) head.push_back(c);
+  std::string s;
+  for (const std::string& l : head_lines) s += l + "\n";
   for (std::size_t i = 0; i < head.size(); ++i) s += (i ? "," : "") + head[i];
   s += "\n";
   const std::size_t nc = columns_.size();
@@ -1081,131 +1005,104 @@ std::string Synthesiser::csv(bool with_effect, bool with_noise) const {
     std::string line;
     for (double a : row.axes) line += fmt("%.10g", a) + ",";
     line += fmt("%.2f", row.t_s) + ",";
-    if (spec_.layout == "grid") {
-      for (int d : row.dir) line += std::to_string(d) + ",";
-    } else if (spec_.layout == "line") {
+    if (spec_.layout == "line") {
       line += std::to_string(row.feed_dir) + ",";
-    } else {
+    } else if (ballbar) {
       line += std::to_string(row.feed_dir) + "," +
               std::to_string(row.dir[static_cast<std::size_t>(plane_a_)]) + "," +
               std::to_string(row.dir[static_cast<std::size_t>(plane_b_)]) + ",";
+    } else {
+      for (int d : row.dir) line += std::to_string(d) + ",";
     }
     line += std::to_string(row.cycle) + ",";
     line += fmt("%.4f", temperature(row.t_s) + temp_noise_[r]);
-    if (spec_.layout == "ballbar") line += "," + fmt("%.10g", row.angle_deg);
+    if (ballbar) line += "," + fmt("%.10g", row.angle_deg);
     for (std::size_t c = 0; c < nc; ++c) line += "," + fmt("%.6f", v[r * nc + c]);
     s += line + "\n";
   }
   return s;
 }
 
-nlohmann::json Synthesiser::truth() const {
+nlohmann::json Synthesiser::effect_json(const Effect& f) const {
   using nlohmann::json;
   auto output_name = [&](std::size_t c) {
     return column_dim_[c] >= 0 ? std::string(kDimNames[column_dim_[c]]) : std::string("dr");
   };
-  json j;
-  j["generator"] = "weilgen_gap_synth";
-  j["format"] = 1;
-  j["scenario"] = {{"machine", truth_desc_.name},
-                   {"model_machine", model_machine_},
-                   {"effect", effect_},
-                   {"factor", spec_.factor},
-                   {"noise_sigma_um", spec_.noise_um},
-                   {"layout", spec_.layout},
-                   {"seed", spec_.seed},
-                   {"truth_degree", spec_.truth_degree},
-                   {"fit_degree", spec_.fit_degree}};
-  j["expected_verdict"] = expected_;
-  j["noise_sigma_um"] = spec_.noise_um;
-  j["noise_rms_um"] = noise_rms_um_;
-  j["rows"] = rows_.size();
-  j["observations"] = obs_row_.size();
-  j["duration_s"] = t_total_s_;
-  json cols = json::array();
-  for (std::size_t c = 0; c < columns_.size(); ++c) cols.push_back(columns_[c]);
-  j["measured_columns"] = cols;
-  j["model_regressors"] = {{"columns", regressors_.cols()},
-                           {"rank", span_.basis.cols()},
-                           {"smallest_kept_singular_value", span_.smallest_kept},
-                           {"largest_dropped_singular_value", span_.largest_dropped}};
-
   json eff;
-  eff["name"] = effect_;
-  eff["observable"] = observable_;
-  eff["identifiable"] = identifiable_;
-  eff["heldout_signal_rms_um"] = unabsorbed_rms_um_;
-  eff["raw_signal_rms_um"] = raw_rms_um_;
-  eff["visible_fraction"] = raw_rms_um_ > 0 ? unabsorbed_rms_um_ / raw_rms_um_ : 0.0;
-  eff["snr"] = spec_.noise_um > 0 ? unabsorbed_rms_um_ / spec_.noise_um : 0.0;
+  eff["name"] = f.name;
+  eff["observable"] = f.observable;
+  eff["identifiable"] = f.identifiable;
+  eff["expected"] = expected_of(f);
+  eff["heldout_signal_rms_um"] = f.unabsorbed_rms;
+  eff["raw_signal_rms_um"] = f.raw_rms;
+  eff["visible_fraction"] = f.raw_rms > 0 ? f.unabsorbed_rms / f.raw_rms : 0.0;
+  eff["snr"] = spec_.noise_um > 0 ? f.unabsorbed_rms / spec_.noise_um : 0.0;
   json by_out = json::object(), raw_out = json::object();
-  std::size_t dominant = 0;
-  for (std::size_t c = 0; c < unabsorbed_by_column_.size(); ++c) {
-    by_out[output_name(c)] = unabsorbed_by_column_[c];
-    raw_out[output_name(c)] = raw_by_column_[c];
-    const auto& v = identifiable_ ? unabsorbed_by_column_ : raw_by_column_;
-    if (v[c] > v[dominant]) dominant = c;
+  for (std::size_t c = 0; c < f.unabsorbed_by_column.size(); ++c) {
+    by_out[output_name(c)] = f.unabsorbed_by_column[c];
+    raw_out[output_name(c)] = f.raw_by_column[c];
   }
   eff["heldout_signal_rms_by_output_um"] = by_out;
   eff["raw_signal_rms_by_output_um"] = raw_out;
-
+  const std::size_t dominant = dominant_column(f);
   json params = json::object();
-  json loc = {{"kind", "none"}, {"by", json::array()}};
-  const std::string out_name = effect_ == "none" ? std::string() : output_name(dominant);
-  if (effect_ != "none") loc = {{"kind", "output"}, {"by", json::array()}, {"output", out_name}};
+  const std::string out_name = output_name(dominant);
+  json loc = {{"kind", "output"}, {"by", json::array()}, {"output", out_name}};
   const std::string axis_name =
-      effect_axis_ >= 0 ? axes_[static_cast<std::size_t>(effect_axis_)].name : std::string();
+      f.axis >= 0 ? axes_[static_cast<std::size_t>(f.axis)].name : std::string();
   const std::string error_name =
-      effect_error_ >= 0 ? truth_desc_.errors[static_cast<std::size_t>(effect_error_)].name
-                         : std::string();
-  if (effect_ == "reversal") {
+      f.error >= 0 ? truth_desc_.errors[static_cast<std::size_t>(f.error)].name : std::string();
+  const bool rot = f.error >= 0 && truth_desc_.errors[static_cast<std::size_t>(f.error)].effect ==
+                                       ErrorEffect::Rotation;
+  const std::string axis_unit =
+      f.axis >= 0 && !axes_[static_cast<std::size_t>(f.axis)].linear ? "deg" : "mm";
+  if (f.name == "reversal") {
     params = {{"axis", axis_name},
               {"error", error_name},
-              {"backlash_um", amplitude_},
+              {rot ? "backlash_urad" : "backlash_um", f.amplitude},
               {"model", "error += -backlash/2 * dir (approach direction of the axis)"}};
     loc = {{"kind", "direction"}, {"by", {"dir_" + axis_name, "dir"}}, {"output", out_name}};
-  } else if (effect_ == "periodic") {
+  } else if (f.name == "periodic") {
     params = {{"axis", axis_name},
               {"error", error_name},
-              {"period_mm", period_mm_},
-              {"amplitude_um", amplitude_},
-              {"phase_rad", phase_rad_}};
-    const auto [lo, hi] = data_range(effect_axis_);
+              {"period_" + axis_unit, f.period},
+              {rot ? "amplitude_urad" : "amplitude_um", f.amplitude},
+              {"phase_rad", f.phase}};
+    const auto [lo, hi] = data_range(f.axis);
     loc = {{"kind", "whole"}, {"by", {axis_name}}, {"output", out_name}, {"from", lo}, {"to", hi}};
-  } else if (effect_ == "pdge_shape") {
-    params = {{"axis", axis_name},          {"error", error_name},
-              {"centre_mm", centre_mm_},    {"width_mm", width_mm_},
-              {"amplitude_um", amplitude_}, {"shape", "a exp(-(q-c)^2/(2 w^2))"}};
-    const auto [lo, hi] = data_range(effect_axis_);
+  } else if (f.name == "pdge_shape") {
+    params = {{"axis", axis_name},
+              {"error", error_name},
+              {"centre_" + axis_unit, f.centre},
+              {"width_" + axis_unit, f.width},
+              {rot ? "amplitude_urad" : "amplitude_um", f.amplitude},
+              {"shape", "a exp(-(q-c)^2/(2 w^2))"}};
+    const auto [lo, hi] = data_range(f.axis);
     loc = {{"kind", "interval"},
            {"by", {axis_name}},
            {"output", out_name},
-           {"from", std::max(lo, centre_mm_ - 2 * width_mm_)},
-           {"to", std::min(hi, centre_mm_ + 2 * width_mm_)},
-           {"at", centre_mm_}};
-  } else if (effect_ == "thermal_drift") {
+           {"from", std::max(lo, f.centre - 2 * f.width)},
+           {"to", std::min(hi, f.centre + 2 * f.width)},
+           {"at", f.centre}};
+  } else if (f.name == "thermal_drift") {
     const double dmax = *std::max_element(drift_table_.begin(), drift_table_.end());
-    std::vector<double> mid(3, 0.0), half(3, 1.0);
-    for (const AxisInfo& a : axes_) {
-      if (!a.linear || a.max <= a.min) continue;
-      mid[a.dim] = (a.min + a.max) / 2;
-      half[a.dim] = (a.max - a.min) / 2;
-    }
-    json per = json::object();
-    for (int d = 0; d < 3; ++d) {
-      if (thermal_offset_[d] == 0 && thermal_scale_[d] == 0) continue;
-      per[kDimNames[d]] = {
-          {"offset_um_per_K", amplitude_ * thermal_offset_[d] / dmax},
-          {"scale_um_per_K_per_m", 1000 * amplitude_ * thermal_scale_[d] / (dmax * half[d])},
-          {"scale_reference_mm", mid[d]}};
-    }
+    json scale = json::object();
+    for (std::size_t a = 0; a < axes_.size(); ++a)
+      if (axes_[a].linear && axes_[a].max > axes_[a].min)
+        scale[axes_[a].name] =
+            1000 * f.amplitude * f.scale[a] / (dmax * (axes_[a].max - axes_[a].min) / 2);
+    json offset = json::object();
+    for (int d = 0; d < 3; ++d)
+      offset[std::string(1, "xyz"[d])] = f.amplitude * f.offset[static_cast<std::size_t>(d)] / dmax;
     params = {{"temperature", "T_spindle"},
+              {"frame", f.machine_frame ? "machine" : "tool"},
               {"model",
-               "d = D(t) (offset + scale (P - reference)); D: first-order lag of "
-               "T_spindle - 22 degC"},
+               "the tool point moves by D(t) offset (in the frame), each linear axis by D(t) "
+               "scale (q - home); D: first-order lag of T_spindle - 22 degC"},
               {"tau_lag_s", t_total_s_ / 12},
               {"drift_max_K", dmax},
-              {"per_output", per}};
+              {"offset_um_per_K", offset},
+              {"scale_um_per_m_per_K", scale}};
     // Where the lagged rise is at least half its peak.
     double from = t_total_s_, to = 0, at = 0, best = -1;
     for (std::size_t i = 0; i < drift_table_.size(); ++i) {
@@ -1222,78 +1119,133 @@ nlohmann::json Synthesiser::truth() const {
     loc = {{"kind", "interval"}, {"by", {"t_s", "T_spindle", "cycle"}},
            {"output", out_name}, {"from", from},
            {"to", to},           {"at", at}};
-  } else if (effect_ == "step") {
-    const std::string coord = step_in_time_ ? "t_s" : axis_name;
+  } else if (f.name == "step") {
+    const std::string coord = f.step_in_time ? "t_s" : axis_name;
     double hi = t_total_s_;
-    if (!step_in_time_) hi = data_range(effect_axis_).second;
-    params = {{"kind", step_in_time_ ? "time" : "position"},
+    if (!f.step_in_time) hi = data_range(f.axis).second;
+    params = {{"kind", f.step_in_time ? "time" : "position"},
               {"coordinate", coord},
-              {"at", step_at_},
-              {"output", kDimNames[effect_dim_]},
-              {"step_um", amplitude_}};
+              {"at", f.step_at},
+              {"output", kDimNames[f.dim]},
+              {"step_um", f.amplitude}};
     json by = json::array({coord});
-    if (step_in_time_) by.push_back("cycle");
+    if (f.step_in_time) by.push_back("cycle");
     loc = {{"kind", "interval"}, {"by", by}, {"output", out_name},
-           {"from", step_at_},   {"to", hi}, {"at", step_at_}};
-  } else if (effect_ == "higher_order") {
-    double max_t = 0, max_r = 0;
-    for (const Row& row : rows_) {
-      const std::vector<double> e = errors_at(row, amplitude_, true);
-      for (std::size_t i = 0; i < e.size(); ++i) {
-        const bool rot = truth_desc_.errors[i].effect == ErrorEffect::Rotation;
-        (rot ? max_r : max_t) = std::max(rot ? max_r : max_t, std::abs(e[i]));
-      }
-    }
-    params = {{"error_scale", amplitude_},
-              {"largest_translation_error_um", 1000 * max_t},
-              {"largest_rotation_error_urad", 1e6 * max_r},
+           {"from", f.step_at},  {"to", hi}, {"at", f.step_at}};
+  } else if (f.name == "higher_order") {
+    params = {{"error_scale", f.amplitude},
               {"model_order", model_desc_.algebra.order},
               {"how",
                "every truth error multiplied by error_scale; the exact chain minus its "
                "first-order part is the effect"}};
-  } else if (effect_ == "missing_error") {
-    double ss = 0;
-    for (const Row& row : rows_) {
-      const double v = errors_at(row, amplitude_, true)[static_cast<std::size_t>(effect_error_)] /
-                       truth_desc_.errors[static_cast<std::size_t>(effect_error_)].to_base;
-      ss += v * v;
-    }
+  } else if (f.name == "missing_error") {
     params = {{"error", spec_.missing_error},
-              {"unit", truth_desc_.errors[static_cast<std::size_t>(effect_error_)].unit},
-              {"rms_over_rows", std::sqrt(ss / rows_.size())},
-              {"scale_of_drawn", amplitude_},
+              {"unit", truth_desc_.errors[static_cast<std::size_t>(f.error)].unit},
+              {"scale_of_drawn", f.amplitude},
               {"model_machine", model_machine_}};
-  } else if (effect_ == "tool_offset") {
+  } else if (f.name == "tool_offset") {
     double model_len = 0;
     for (std::size_t i = 0; i < model_desc_.parameters.size(); ++i)
       if (model_desc_.parameters[i].name == "tool_length") model_len = model_params_[i];
     params = {{"tool_length_model_mm", model_len},
-              {"tool_length_truth_mm", model_len + amplitude_},
-              {"offset_mm", amplitude_}};
-  } else if (effect_ == "setup") {
-    params = {{"scale_ppm", -amplitude_},
-              {"cosine_angle_mrad", 1e3 * std::acos(1 - amplitude_ * 1e-6)},
+              {"tool_length_truth_mm", model_len + f.amplitude},
+              {"offset_mm", f.amplitude}};
+  } else if (f.name == "setup") {
+    params = {{"scale_ppm", -f.amplitude},
+              {"cosine_angle_mrad", 1e3 * std::acos(1 - f.amplitude * 1e-6)},
               {"model", "reading = (1 - k) x displacement from the instrument zero (first pose)"}};
   }
   eff["params"] = params;
-  j["effect"] = eff;
   // Where the held-out signal is, along the primary coordinate: what a localisation is judged by.
   if (loc["kind"] == "interval" || loc["kind"] == "whole") {
     const std::string by = loc["by"][0].get<std::string>();
     int axis = -1;
     for (std::size_t k = 0; k < axes_.size(); ++k)
       if (axes_[k].name == by) axis = static_cast<int>(k);
-    loc["bins"] = signal_bins(axis, dominant);
+    loc["bins"] = signal_bins(f, axis, dominant);
   }
-  j["localise"] = loc;
+  eff["localise"] = loc;
+  return eff;
+}
+
+nlohmann::json Synthesiser::truth() const {
+  using nlohmann::json;
+  json j;
+  j["generator"] = "weilgen_gap_synth";
+  j["format"] = 2;
+  j["scenario"] = {{"machine", truth_desc_.name},
+                   {"model_machine", model_machine_},
+                   {"effect", spec_.effect},
+                   {"factor", spec_.factor},
+                   {"noise_sigma_um", spec_.noise_um},
+                   {"layout", spec_.layout},
+                   {"seed", spec_.seed},
+                   {"truth_degree", spec_.truth_degree},
+                   {"fit_degree", spec_.fit_degree},
+                   {"outliers", spec_.outliers},
+                   {"heteroscedastic", spec_.heteroscedastic}};
+  // The verdict expected: every identifiable library effect named; a step makes it unexplained.
+  std::vector<std::string> expected;
+  bool step = false;
+  for (const Effect& f : effects_) {
+    const std::string e = expected_of(f);
+    if (e == "unexplained") step = true;
+    if (e != "none" && e != "unexplained") expected.push_back(e);
+  }
+  std::string verdict = step ? "unexplained" : expected.empty() ? "none" : expected[0];
+  if (!step)
+    for (std::size_t k = 1; k < expected.size(); ++k) verdict += "+" + expected[k];
+  j["expected_verdict"] = verdict;
+  j["expected_effects"] = step ? json::array() : json(expected);
+  j["noise_sigma_um"] = spec_.noise_um;
+  j["noise_rms_um"] = noise_rms_um_;
+  j["noise_sigma_range_um"] = {*std::min_element(sigma_.begin(), sigma_.end()),
+                               *std::max_element(sigma_.begin(), sigma_.end())};
+  j["rows"] = rows_.size();
+  j["observations"] = obs_row_.size();
+  j["duration_s"] = t_total_s_;
+  j["measured_columns"] = columns_;
+  j["model_regressors"] = {{"columns", regressors_.cols()},
+                           {"rank", span_.basis.cols()},
+                           {"smallest_kept_singular_value", span_.smallest_kept},
+                           {"largest_dropped_singular_value", span_.largest_dropped}};
+  if (!spheres_.empty()) j["rtest_spheres_mm"] = spheres_;
+  json effs = json::array();
+  for (const Effect& f : effects_) effs.push_back(effect_json(f));
+  j["effects"] = effs;
+  // The first effect as `effect` (format 1 readers), or an empty one.
+  if (!effects_.empty()) {
+    j["effect"] = effs[0];
+    j["localise"] = effs[0]["localise"];
+  } else {
+    j["effect"] = {{"name", "none"},
+                   {"observable", true},
+                   {"identifiable", true},
+                   {"heldout_signal_rms_um", 0},
+                   {"raw_signal_rms_um", 0},
+                   {"visible_fraction", 0},
+                   {"snr", 0}};
+    j["localise"] = {{"kind", "none"}, {"by", json::array()}};
+  }
+  json gross = json::array();
+  for (const GrossReading& g : gross_) {
+    const std::size_t row = static_cast<std::size_t>(obs_row_[g.observation]);
+    gross.push_back({{"observation", g.observation},
+                     {"line", comment_lines().size() + 1 + row + 1},
+                     {"output", columns_[static_cast<std::size_t>(obs_col_[g.observation])]},
+                     {"size_um", g.size_um}});
+  }
+  j["gross_readings"] = gross;
 
   json errs = json::array();
   for (std::size_t i = 0; i < truth_desc_.errors.size(); ++i) {
     const ErrorDef& e = truth_desc_.errors[i];
     const TruthError& t = errors_[i];
     double scale = 1;
-    if (effect_ == "higher_order") scale = amplitude_;
-    if (effect_ == "missing_error" && static_cast<int>(i) == effect_error_) scale = amplitude_;
+    for (const Effect& f : effects_) {
+      if (f.name == "higher_order") scale = f.amplitude;
+      if (f.name == "missing_error" && static_cast<int>(i) == f.error) scale = f.amplitude;
+    }
     json c = json::array();
     for (double v : t.coeff) c.push_back(v * scale);
     json je = {{"name", e.name}, {"unit", e.unit}, {"to_base", e.to_base}};
@@ -1311,11 +1263,13 @@ nlohmann::json Synthesiser::truth() const {
   }
   j["truth_errors"] = errs;
   json tp = json::object();
-  for (std::size_t i = 0; i < truth_desc_.parameters.size(); ++i)
-    tp[truth_desc_.parameters[i].name] =
-        truth_params_[i] +
-        (effect_ == "tool_offset" && truth_desc_.parameters[i].name == "tool_length" ? amplitude_
-                                                                                     : 0.0);
+  for (std::size_t i = 0; i < truth_desc_.parameters.size(); ++i) {
+    double v = truth_params_[i];
+    for (const Effect& f : effects_)
+      if (f.name == "tool_offset" && truth_desc_.parameters[i].name == "tool_length")
+        v += f.amplitude;
+    tp[truth_desc_.parameters[i].name] = v;
+  }
   j["truth_parameters"] = tp;
   return j;
 }

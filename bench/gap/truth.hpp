@@ -1,9 +1,12 @@
 // The truth generator of the sim-to-real gap benchmark (bench/gap/README.md): a shipped machine
 // with random geometric errors within its spreads, evaluated with the exact numeric chain
-// (weilgen/model/numeric_chain.hpp), plus exactly one effect withheld from the model (or none), sampled
-// in one measurement layout and written as a measurement CSV (docs/data-format.md) with a
-// truth.json. Nothing here calls or mirrors the diagnosis code (src/cli/verb_gap.cpp): the only
-// shared pieces are the machine description, the exact chain and the CSV format.
+// (weilgen/model/numeric_chain.hpp), plus one or two effects withheld from the model (or none),
+// sampled in one measurement layout and written as a measurement CSV (docs/data-format.md) with
+// a truth.json. Every effect is a physical perturbation inside the chain (an error's shape, an
+// axis' position, the tool length, the tool point's growth) or at the instrument (a cosine
+// error, a step, gross readings). Nothing here calls or mirrors the diagnosis code
+// (src/analysis/gap/): the only shared pieces are the machine description, the exact chain and
+// the CSV format.
 #pragma once
 
 #include <Eigen/Dense>
@@ -12,6 +15,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <random>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -24,19 +28,28 @@ namespace weilgen::gapbench {
 const std::vector<std::string>& library_effects();
 // Everything the generator can withhold: the library, "step" (outside it) and "none".
 const std::vector<std::string>& all_effects();
-const std::vector<std::string>& layout_names();  // grid, line, ballbar
+// grid, sparse, small, line, ballbar, ballbar_yz, rtest, rtest_small.
+const std::vector<std::string>& layout_names();
 
 struct ScenarioSpec {
   std::string machine = "vmc_3axis";  // truth machine: shipped name or path
+  // A library effect, "step", "none", or two library effects joined by '+' (both withheld, each
+  // scaled to `factor` on its own).
   std::string effect = "none";
-  double factor = 0;      // held-out signal RMS of the effect / noise sigma
-  double noise_um = 1.0;  // noise sigma of every measured value
+  double factor = 0;      // held-out signal RMS of each effect / noise sigma
+  double noise_um = 1.0;  // noise sigma (RMS over the observations) of every measured value
   std::string layout = "grid";
   std::uint64_t seed = 1;
   int truth_degree = 3;  // degree of the truth's PDGE polynomials
   int fit_degree = 3;    // degree of the model's PDGE bases that define "absorbable"
   // missing_error: the error left out of the model machine; empty = the machine's default.
   std::string missing_error;
+  int outliers = 0;              // gross readings (30-60 sigma) added to random observations
+  bool heteroscedastic = false;  // noise sigma growing 4x with the distance from the first pose
+  // Size (the speed benchmark, bench/gap/speed.sh): 0 = the layout's own cycles; else the grid
+  // is repeated for as many cycles as needed, and any layout is cut after the row that reaches
+  // this many observations.
+  int observations = 0;
 };
 
 // Deterministic uniform and normal deviates (Box-Muller on mt19937_64): the same numbers with
@@ -54,6 +67,17 @@ class Rng {
   double spare_ = 0;
   bool has_spare_ = false;
 };
+
+// Helpers of the generator's files.
+inline constexpr double kPi = 3.14159265358979323846;
+inline constexpr const char* kDimNames[3] = {"dx", "dy", "dz"};
+inline std::runtime_error fail(const std::string& what) { return std::runtime_error(what); }
+// Element-wise copy: GCC 12 reports a false -Wnonnull in vector<double>::operator= here.
+template <typename T>
+void copy_to(std::vector<T>& dst, const std::vector<T>& src) {
+  dst.resize(src.size());
+  for (std::size_t i = 0; i < src.size(); ++i) dst[i] = src[i];
+}
 
 // A 64-bit seed from text (FNV-1a): stable scenario seeds from scenario ids.
 std::uint64_t seed_from(const std::string& text);
@@ -74,18 +98,19 @@ struct Row {
 
 class Synthesiser {
  public:
-  // Builds the truth machine, the layout and the effect, and scales the effect so that its
+  // Builds the truth machine, the layout and the effects, and scales each effect so that its
   // held-out signal is factor * noise_um. Throws std::runtime_error / InputError on bad specs.
   explicit Synthesiser(ScenarioSpec spec);
   ~Synthesiser();
 
-  // The measurement file; the variants without effect or noise serve the self-check.
+  // The measurement file; the variants without effect or noise serve the self-check (gross
+  // readings come with the noise).
   std::string csv(bool with_effect = true, bool with_noise = true) const;
   nlohmann::json truth() const;
   // Path or shipped name of the model machine `weilgen gap` is given.
   const std::string& model_machine() const { return model_machine_; }
 
-  // Noise-free measured values (um), one per observation (row-major, measured columns in
+  // Noise-free measured values (µm), one per observation (row-major, measured columns in
   // measured_columns() order).
   std::vector<double> measured(bool with_effect) const;
   const std::vector<std::string>& measured_columns() const { return columns_; }
@@ -94,6 +119,11 @@ class Synthesiser {
   // on the model's regressors over all observations), and of the signal itself.
   std::vector<double> unabsorbed_rms(const std::vector<double>& signal_um) const;
   std::vector<double> raw_rms(const std::vector<double>& signal_um) const;
+  // The noise-free signal of effect k alone at its scaled amplitude (µm per observation).
+  std::vector<double> effect_signal(std::size_t k) const;
+  std::size_t num_effects() const { return effects_.size(); }
+  // The truth's noise sigma of each observation (µm; all equal unless heteroscedastic).
+  const std::vector<double>& noise_sigma() const { return sigma_; }
 
   // Probe: for every error of the truth machine, the fraction of its (unit-shape) signal the
   // model could not absorb if the error were missing from it ("visible fraction").
@@ -104,35 +134,76 @@ class Synthesiser {
     std::string name;
     int body = -1;
     bool linear = true;
-    int dim = 0;  // output component of a linear axis (x, y, z) in the workpiece frame
+    int dim = 0;  // principal direction of the joint axis (x, y, z)
     double min = 0, max = 0;
+    double home = 0;  // the reference position: 0 clamped into the travel
   };
   struct TruthError {
     int axis = -1;              // index into axes_ of a PDGE's axis; -1: constant (PIGE)
     std::vector<double> coeff;  // Legendre coefficients in the declared unit (PIGE: one)
   };
+  // One withheld effect and its realisation.
+  struct Effect {
+    std::string name;
+    int axis = -1, error = -1, dim = -1;  // the axis, error and measured direction it acts on
+    double period = 0, phase = 0, centre = 0, width = 0;  // periodic, pdge_shape (axis unit)
+    double step_at = 0;                                   // step: s or axis unit
+    bool step_in_time = true;
+    bool machine_frame = false;  // thermal: the growth is fixed in the machine frame, else tool
+    std::vector<double> offset, scale;  // thermal: per direction of its frame; per axis
+    double amplitude = 0;               // physical amplitude (unit per effect, see truth())
+    bool observable = true, identifiable = true;
+    double unabsorbed_rms = 0, raw_rms = 0;
+    std::vector<double> unabsorbed_by_column, raw_by_column;
+    Eigen::VectorXd residual;  // the held-out signal per observation
+  };
+  struct GrossReading {
+    std::size_t observation = 0;
+    double size_um = 0;
+  };
 
+  // Layouts (truth_layout.cpp).
   void build_layout(Rng& rng);
-  void build_effect(Rng& rng);
-  void build_regressors();
-  void scale_effect();
-  void draw_noise();
+  void grid_layout(int lo, int hi, double per_travel, int cycles, double dwell_s);
+  void small_layout();
+  void line_layout(Rng& rng);
+  void ballbar_layout(int dim_a, int dim_b);
+  void rtest_layout(bool small);
+  void finish_layout();
+  // Appends a pass over poses (indices into poses_), approach directions following the moves.
+  void add_pass(const std::vector<int>& sequence, int cycle, double dwell_s);
+  std::vector<int> linear_axes() const;  // indices of linear axes with a travel
 
-  std::vector<double> errors_at(const Row& row, double amplitude, bool with_effect) const;
-  std::vector<double> evaluate(double amplitude, bool with_effect) const;
-  std::vector<double> signal(double amplitude) const;
-  // A 3-vector deviation (mm) to the values measured at one row (um), before instrument effects.
+  void build_effect(Effect& e, Rng& rng);
+  void build_regressors();
+  void scale_effects();
+  void draw_noise();
+  void place_gross_readings();
+
+  std::vector<double> errors_at(const Row& row, const std::vector<double>& amps,
+                                const std::vector<bool>& on) const;
+  std::vector<double> evaluate(const std::vector<double>& amps, const std::vector<bool>& on) const;
+  std::vector<double> signal(std::size_t k, double amplitude) const;
+  // Tool position (mm, workpiece frame) of `chain` at axes q with errors e.
+  Eigen::Vector3d tool_point(const NumericChain& chain, const std::vector<double>& q,
+                             const std::vector<double>& e) const;
+  // A 3-vector deviation (mm) to the values measured at one row (µm), before instrument effects.
   void measure_row(std::size_t r, const Eigen::Vector3d& d_mm, double* out_um) const;
   // First-order deviation of the truth machine: J(pose) * errors (positions, mm).
   Eigen::Vector3d linear_deviation(const Row& row, const std::vector<double>& errors) const;
   const Eigen::MatrixXd& truth_jacobian(int pose) const;
   double drift(double t_s) const;  // thermal: lagged temperature rise, degC
-  nlohmann::json signal_bins(int axis, std::size_t column) const;
+  nlohmann::json signal_bins(const Effect& e, int axis, std::size_t column) const;
+  nlohmann::json effect_json(const Effect& e) const;
+  std::vector<std::string> comment_lines() const;  // the CSV's "# key: value" lines
   double temperature(double t_s) const;
   std::vector<int> translation_errors(int axis) const;  // "after" translations of an axis body
   int positioning_error(int axis) const;
-  double axis_step(int axis) const;  // sample spacing of the layout along an axis, mm
+  double axis_step(int axis) const;  // sample spacing of the layout along an axis
   std::pair<double, double> data_range(int axis) const;
+  std::size_t distinct_positions(int axis) const;
+  std::string expected_of(const Effect& e) const;
+  std::size_t dominant_column(const Effect& e) const;
 
   ScenarioSpec spec_;
   Description truth_desc_, model_desc_;
@@ -148,32 +219,24 @@ class Synthesiser {
   std::vector<std::string> columns_;    // measured columns: dx_um ... or dr_um
   std::vector<int> column_dim_;         // dimension of each measured column; -1 for dr_um
   std::vector<std::vector<double>> poses_;
-  std::vector<double> grid_step_;  // per axis (grid layout)
+  std::vector<double> grid_step_;             // per axis (grid layouts)
+  std::vector<std::vector<double>> spheres_;  // rtest: the spheres' centres (workpiece, mm)
   int line_axis_ = -1;
   int plane_a_ = -1, plane_b_ = -1;  // ballbar plane axes
   double radius_mm_ = 0;
   std::vector<double> centre_;
+  Eigen::Vector3d centre_point_ = Eigen::Vector3d::Zero();  // ballbar: the table ball (mm)
   double t_total_s_ = 0;
   std::vector<double> drift_table_;  // lagged temperature on a fine time grid
 
-  // Effect.
-  std::string effect_;
-  std::string expected_ = "none";
-  int effect_axis_ = -1, effect_error_ = -1, effect_dim_ = -1;
-  double period_mm_ = 0, phase_rad_ = 0, centre_mm_ = 0, width_mm_ = 0;
-  double step_at_ = 0;
-  bool step_in_time_ = true;
-  std::vector<double> thermal_offset_, thermal_scale_;  // per dimension (unit-less shapes)
-  double amplitude_ = 0;    // the effect's physical amplitude (unit per effect, see truth())
-  bool observable_ = true;  // the effect reaches the measured values at all
-  bool identifiable_ = true;
-  double unabsorbed_rms_um_ = 0, raw_rms_um_ = 0;
-  std::vector<double> unabsorbed_by_column_, raw_by_column_;
-  Eigen::VectorXd residual_;  // the held-out signal per observation
+  // Effects.
+  std::vector<Effect> effects_;
+  bool tool_offset_ = false, higher_order_ = false, missing_ = false;
 
   // Noise.
-  std::vector<double> noise_um_, temp_noise_;
+  std::vector<double> sigma_, noise_um_, temp_noise_;
   double noise_rms_um_ = 0;
+  std::vector<GrossReading> gross_;
 
   // Model regressors, column-normalised, and their column space.
   Eigen::MatrixXd regressors_;

@@ -81,9 +81,10 @@ py::object sensitivity(py::handle machine, const py::kwargs& kwargs) {
   kw.set("confidence", so.sobol_options.confidence);
   // --replicates / --bootstrap as the CLI reads them: replicates by default.
   const std::optional<long> replicates = kw.integer("replicates"), boot = kw.integer("bootstrap");
-  const long long r = replicates.value_or(0), b = boot.value_or(0);
+  const long long reps = replicates.value_or(0), resamples = boot.value_or(0);
   if (so.sobol)
-    set_sobol_intervals(so.sobol_options, replicates ? &r : nullptr, boot ? &b : nullptr);
+    set_sobol_intervals(so.sobol_options, replicates ? &reps : nullptr,
+                        boot ? &resamples : nullptr);
   so.validate();
   const nlohmann::json doc = without_gil([&] {
     const Study st = call.open(false);

@@ -6,12 +6,14 @@ inside the training part, trained on the first half of the run and scored on the
 (the same split as `weilgen gap --holdout forward:0.5`). What a competent engineer would fit by
 hand; weilgen's held-out RMS is compared with its score.
 
-Usage: ridge_thermal.py DATA.csv [--rpm] [--lags 0,0.5,2,8]
-Prints the held-out RMS per channel and over all channels (um), and the chosen lambdas.
+Usage: ridge_thermal.py DATA.csv [--rpm] [--lags 0,0.5,2,8] [--json OUT.json]
+Prints the held-out RMS per channel and over all channels (um), and the chosen lambdas; --json
+writes them ({"heldout_rms_um": all channels, "per_channel_um": {...}}) for bench/gap.
 Needs Debian's python3-numpy (run with /usr/bin/python3).
 """
 import argparse
 import csv
+import json
 import math
 
 import numpy as np
@@ -42,6 +44,7 @@ def main():
     ap.add_argument("--rpm", action="store_true", help="add the spindle speed as a heat input")
     ap.add_argument("--lags", default="0,0.5,2,8", help="first-order lags in hours")
     ap.add_argument("--train-fraction", type=float, default=0.5)
+    ap.add_argument("--json", help="write the held-out RMS values to this file")
     a = ap.parse_args()
     with open(a.data) as fh:
         rows = list(csv.DictReader(fh))
@@ -62,6 +65,7 @@ def main():
     idx = np.flatnonzero(train)
     blocks = np.array_split(idx, 5)
     total_ss, total_n = 0.0, 0
+    per_channel = {}
     for ch in ("dx_um", "dy_um", "dz_um"):
         y = np.array([float(r[ch]) for r in rows])
         cv = []
@@ -75,11 +79,17 @@ def main():
         lam = lams[int(np.argmin(cv))]
         beta, c = ridge_fit(Xs[train], y[train], lam)
         res = y[test] - Xs[test] @ beta - c
-        print(f"{ch}: held-out RMS {math.sqrt(np.mean(res ** 2)):.3f} um (lambda {lam:.3g})")
+        per_channel[ch] = math.sqrt(np.mean(res ** 2))
+        print(f"{ch}: held-out RMS {per_channel[ch]:.3f} um (lambda {lam:.3g})")
         total_ss += float(np.sum(res ** 2))
         total_n += int(res.size)
     print(f"all channels: held-out RMS {math.sqrt(total_ss / total_n):.3f} um "
           f"({len(inputs)} inputs x {len(lags)} lags, train {int(train.sum())} rows)")
+    if a.json:
+        with open(a.json, "w") as fh:
+            json.dump({"heldout_rms_um": math.sqrt(total_ss / total_n),
+                       "per_channel_um": per_channel, "inputs": len(inputs),
+                       "lags_h": a.lags, "rpm": a.rpm}, fh, indent=2)
 
 
 if __name__ == "__main__":

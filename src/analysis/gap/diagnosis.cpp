@@ -8,6 +8,7 @@
 
 #include "effects.hpp"
 #include "internal.hpp"
+#include "scoring.hpp"
 #include "weilgen/base/format.hpp"
 #include "weilgen/base/parallel.hpp"
 #include "weilgen/base/text.hpp"
@@ -42,229 +43,32 @@ GapDiagnosis::GapDiagnosis(GapOptions options) : options_(std::move(options)) {
 
 namespace {
 
-// Evaluates one candidate (all variants; the variant chosen by training SSE over the splits)
-// against the engine's current model.
-struct Evaluated {
-  EffectFit fit;
-  gap_detail::Variant variant;  // the chosen (possibly refined) variant
-  MatrixXd columns;             // full-data columns of the chosen variant (for acceptance)
-  VectorXd heldout;             // held-out residual after
-  VectorXd coef;                // full-data coefficients of the columns
-  double heldout_sse = INFINITY;
-};
-
-// Least-squares coefficients of columns Eperp (already projected off the model's span) for the
-// residual r; empty when the model spans them. The rank is decided on columns scaled by their
-// norm before projection (`norm`): columns (nearly) inside the span would otherwise get huge
-// coefficients from rounding.
-std::optional<VectorXd> projected_fit(const MatrixXd& Eperp, VectorXd norm, const VectorXd& r) {
-  for (Index k = 0; k < norm.size(); ++k)
-    if (!(norm[k] > 0)) norm[k] = 1;
-  const MatrixXd Es = Eperp * norm.cwiseInverse().asDiagonal();
-  Eigen::ColPivHouseholderQR<MatrixXd> qr(Es);
-  qr.setThreshold(1e-6);
-  if (qr.rank() == 0) return std::nullopt;
-  return VectorXd(norm.cwiseInverse().asDiagonal() * qr.solve(r));
-}
-
-// The columns of a θ-dependent variant for the fit `ff` on rows `train`: at the fit's θ, then
-// (Variant::theta_iterations) at the θ of the joint fit [A E] with those columns.
-MatrixXd theta_columns(const gap_detail::Candidate& c, const gap_detail::Variant& v,
-                       const FoldFit& ff, const std::vector<std::size_t>& train, std::size_t np) {
-  MatrixXd E = c.columns(v, split_theta(ff.theta, np));
-  for (int it = 0; it < v.theta_iterations; ++it) {
-    const MatrixXd Etr = rows_of(E, train);
-    const MatrixXd P = ff.U.transpose() * Etr;
-    const auto coef = projected_fit(Etr - ff.U * P, Etr.colwise().norm().transpose(), ff.res_train);
-    if (!coef) break;
-    E = c.columns(v, split_theta(VectorXd(ff.theta - ff.VS * (P * *coef)), np));
-  }
-  return E;
-}
-
-Evaluated evaluate(const gap_detail::Candidate& c, const Engine& e, std::size_t np,
-                   const VectorXd& base_r, const VectorXd& base_h, double s2, double alpha,
-                   double n_candidates, unsigned threads) {
-  Evaluated best;
-  double best_train = INFINITY;
-  // Training SSE over the splits and the held-out residual of one variant; false when the
-  // model already spans its columns.
-  auto score = [&](const gap_detail::Variant& v, double& train_sse, VectorXd& after,
-                   MatrixXd& shared) {
-    train_sse = 0;
-    after = VectorXd::Constant(e.y.size(), kNaN);
-    const bool regularised = static_cast<bool>(c.fitted_columns);
-    if (!v.needs_theta && !regularised) shared = c.columns(v, {});
-    for (std::size_t f = 0; f < e.splits.size(); ++f) {
-      const Split& s = e.splits[f];
-      const FoldFit& ff = e.folds[f];
-      const MatrixXd E = regularised     ? c.fitted_columns(v, s.train, ff.res_train)
-                         : v.needs_theta ? theta_columns(c, v, ff, s.train, np)
-                                         : shared;
-      const MatrixXd Etr = rows_of(E, s.train), Ete = rows_of(E, s.test);
-      const MatrixXd P = ff.U.transpose() * Etr;
-      const MatrixXd Eperp = Etr - ff.U * P;
-      const auto fitted = projected_fit(Eperp, Etr.colwise().norm().transpose(), ff.res_train);
-      if (!fitted) return false;  // the model already spans these columns
-      const VectorXd& coef = *fitted;
-      train_sse += (ff.res_train - Eperp * coef).squaredNorm();
-      const VectorXd delta = (Ete - ff.W * P) * coef;
-      for (std::size_t i = 0; i < s.test.size(); ++i)
-        after[static_cast<Index>(s.test[i])] =
-            ff.res_test[static_cast<Index>(i)] - delta[static_cast<Index>(i)];
-    }
-    return true;
-  };
-  MatrixXd best_shared;
-  // The grid of variants on every core; the choice is made in variant order, so it is the same
-  // for any number of threads.
-  const std::size_t nv = c.variants.size();
-  std::vector<double> variant_sse(nv, INFINITY);
-  std::vector<VectorXd> afters(nv);
-  std::vector<MatrixXd> shareds(nv);
-  std::vector<char> usable(nv, 0);
-  parallel_blocks(nv, 1, threads, [&](std::size_t, std::size_t b, std::size_t end, unsigned) {
-    for (std::size_t k = b; k < end; ++k)
-      usable[k] = score(c.variants[k], variant_sse[k], afters[k], shareds[k]) ? 1 : 0;
-  });
-  for (std::size_t k = 0; k < nv; ++k) {
-    if (!usable[k] || !(variant_sse[k] < best_train)) continue;
-    best_train = variant_sse[k];
-    best.variant = c.variants[k];
-    best.heldout = std::move(afters[k]);
-    best_shared = std::move(shareds[k]);
-  }
-  // Continuous hyper-parameters (a period, a lag, a bump's centre and width) are refined between
-  // their grid neighbours by golden section on the training SSE, one after the other, twice; the
-  // p-value keeps the grid's multiplicity.
-  if (std::isfinite(best_train) && !best.variant.refine.empty()) {
-    gap_detail::Variant v = best.variant;
-    auto sse_at = [&](std::size_t k, double x) {
-      gap_detail::Variant t = v;
-      t.hyper[k] = x;
-      double sse = INFINITY;
-      VectorXd after;
-      MatrixXd shared;
-      if (!score(t, sse, after, shared)) return static_cast<double>(INFINITY);
-      return sse;
-    };
-    const double g = (std::sqrt(5.0) - 1) / 2;
-    for (int pass = 0; pass < 2; ++pass)
-      for (const auto& r : v.refine) {
-        double lo = r.lo, hi = r.hi;
-        double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo);
-        double f1 = sse_at(r.index, x1), f2 = sse_at(r.index, x2);
-        for (int it = 0; it < 30 && hi - lo > 1e-6 * std::abs(hi); ++it) {
-          if (f1 < f2) {
-            hi = x2, x2 = x1, f2 = f1, x1 = hi - g * (hi - lo), f1 = sse_at(r.index, x1);
-          } else {
-            lo = x1, x1 = x2, f1 = f2, x2 = lo + g * (hi - lo), f2 = sse_at(r.index, x2);
-          }
-        }
-        const double x = f1 < f2 ? x1 : x2;
-        if (std::min(f1, f2) < sse_at(r.index, v.hyper[r.index])) v.hyper[r.index] = x;
-      }
-    double sse = INFINITY;
-    VectorXd after;
-    MatrixXd shared;
-    if (score(v, sse, after, shared) && sse < best_train) {
-      best_train = sse;
-      best.variant = v;
-      best.heldout = after;
-      best_shared = shared;
-    }
-  }
-  if (std::isfinite(best_train)) {
-    best.fit.variant = best.variant.label;
-    const std::vector<std::size_t> all = all_rows(static_cast<std::size_t>(e.y.size())).train;
-    best.columns = c.fitted_columns ? c.fitted_columns(best.variant, all, e.full.res_train)
-                   : best.variant.needs_theta ? theta_columns(c, best.variant, e.full, all, np)
-                                              : best_shared;
-    best.fit.tested_variants = static_cast<double>(c.variants.size());
-  }
-  best.fit.name = c.name;
-  if (!std::isfinite(best_train)) return best;
-  // Held-out before/after.
-  Gap before, afterg;
-  std::array<double, kObservationKinds> sb{}, sa{};
-  std::array<std::size_t, kObservationKinds> n{};
-  const auto& obs = e.data.points.observations;
-  best.heldout_sse = 0;
-  for (Index i = 0; i < e.y.size(); ++i) {
-    if (!std::isfinite(best.heldout[i])) continue;
-    const auto o = static_cast<std::size_t>(obs[static_cast<std::size_t>(i)].output);
-    sb[o] += base_r[i] * base_r[i];
-    sa[o] += best.heldout[i] * best.heldout[i];
-    ++n[o];
-    before.ss += base_r[i] * base_r[i];
-    afterg.ss += best.heldout[i] * best.heldout[i];
-    before.expected += s2 * (1 + base_h[i]);
-    ++before.n;
-  }
-  best.heldout_sse = afterg.ss;
-  for (std::size_t o = 0; o < kObservationKinds; ++o) {
-    best.fit.rms_before[o] = n[o] ? std::sqrt(sb[o] / static_cast<double>(n[o])) : kNaN;
-    best.fit.rms_after[o] = n[o] ? std::sqrt(sa[o] / static_cast<double>(n[o])) : kNaN;
-  }
-  const double nn = static_cast<double>(before.n);
-  best.fit.heldout_rms_before_um = std::sqrt(before.ss / nn);
-  best.fit.heldout_rms_after_um = std::sqrt(afterg.ss / nn);
-  best.fit.shrink_pct = 100 * (1 - best.fit.heldout_rms_after_um / best.fit.heldout_rms_before_um);
-  const double excess_before = std::max(0.0, before.ss - before.expected);
-  // Of the excess over the floor; of the whole held-out SS when the floor already exceeds it.
-  const double denominator = excess_before > 0 ? excess_before : before.ss;
-  best.fit.explained_fraction =
-      denominator > 0 ? std::clamp((before.ss - afterg.ss) / denominator, 0.0, 1.0) : 0;
-  // Nested-model F test on all data, corrected for variants and candidates.
-  const MatrixXd& E = best.columns;
-  MatrixXd AE(e.A.rows(), e.A.cols() + E.cols());
-  AE << e.A, E;
-  const FoldFit f1 = fit_fold(AE, e.y, all_rows(static_cast<std::size_t>(e.y.size())));
-  const double q = static_cast<double>(f1.rank) - static_cast<double>(e.full_rank);
-  const double sse1 = f1.res_train.squaredNorm();
-  const double d2 = static_cast<double>(e.y.size()) - static_cast<double>(f1.rank);
-  best.fit.extra_parameters = static_cast<std::size_t>(std::max(0.0, q));
-  if (q > 0 && d2 > 0) {
-    best.fit.f_statistic = ((e.full_sse - sse1) / q) / (sse1 / d2);
-    best.fit.p_value =
-        std::min(1.0, f_sf(best.fit.f_statistic, q, d2) * best.fit.tested_variants * n_candidates);
-  }
-  if (c.fitted_columns && q > 0 && before.n > static_cast<std::size_t>(q) + 1) {
-    // A model fitted with regularisation has more effective parameters than columns, so its
-    // in-sample F test flatters it; its held-out improvement does not: test that instead.
-    const double dh = nn - q;
-    best.fit.f_statistic = ((before.ss - afterg.ss) / q) / (afterg.ss / dh);
-    best.fit.p_value =
-        std::min(1.0, f_sf(best.fit.f_statistic, q, dh) * best.fit.tested_variants * n_candidates);
-  }
-  // Held-out improvement must also beat chance: the drop in held-out SS against the floor.
-  const double heldout_gain = (before.ss - afterg.ss) / s2;
-  best.fit.significant = best.fit.p_value < alpha && heldout_gain > 0;
-  best.coef = f1.theta.tail(E.cols());  // full-data coefficients, for the description
-  return best;
-}
-
-// The shape degrees of freedom the data leave along coordinate `axis` in `output` beyond the
-// baseline design A0 (rank rank0): the rank that one free value per distinct position adds.
-std::size_t shape_dof_free(const MatrixXd& A0, std::size_t rank0, const GapData& d, int axis,
-                           int output) {
+// The shape degrees of freedom the data leave along the coordinate of shape variant `v` beyond
+// the baseline design (its block factors F, rank rank0): the rank that one free value per
+// distinct position adds, each observation seeing it with the shaped error's sensitivity (or its
+// weight in the output).
+std::size_t shape_dof_free(const BlockFactors& F, std::size_t rank0, const GapData& d,
+                           const gap_detail::Variant& v) {
   const auto& obs = d.points.observations;
+  const auto axis = static_cast<std::size_t>(v.shape_axis);
+  auto weight = [&](std::size_t i) {
+    return v.shape_weight ? (*v.shape_weight)[static_cast<Index>(i)]
+                          : observation_weight(obs[i], v.shape_output);
+  };
   std::vector<double> levels;
-  for (const auto& o : obs)
-    if (observation_weight(o, output) != 0)
-      levels.push_back(d.points.poses[o.row][static_cast<std::size_t>(axis)]);
+  for (std::size_t i = 0; i < obs.size(); ++i)
+    if (weight(i) != 0) levels.push_back(d.points.poses[obs[i].row][axis]);
   std::sort(levels.begin(), levels.end());
   levels.erase(std::unique(levels.begin(), levels.end()), levels.end());
-  MatrixXd AG = MatrixXd::Zero(A0.rows(), A0.cols() + static_cast<Index>(levels.size()));
-  AG.leftCols(A0.cols()) = A0;
+  MatrixXd G = MatrixXd::Zero(static_cast<Index>(obs.size()), static_cast<Index>(levels.size()));
   for (std::size_t i = 0; i < obs.size(); ++i) {
-    const double w = observation_weight(obs[i], output);
+    const double w = weight(i);
     if (w == 0) continue;
-    const double q = d.points.poses[obs[i].row][static_cast<std::size_t>(axis)];
+    const double q = d.points.poses[obs[i].row][axis];
     const auto l = std::lower_bound(levels.begin(), levels.end(), q) - levels.begin();
-    AG(static_cast<Index>(i), A0.cols() + l) = w;
+    G(static_cast<Index>(i), l) = w;
   }
-  const std::size_t r = EquilibratedSvd(AG, 1e-9, /*full_v=*/false).rank();
+  const std::size_t r = joint_rank(F, G);
   return r > rank0 ? r - rank0 : 0;
 }
 
@@ -316,9 +120,10 @@ void decide_verdict(GapResult& R, const GapOptions& opt, const std::vector<std::
         return unexplained(first.name + " removes " + pct(first.explained_fraction) +
                            " of the excess and needs " + R.explanation[k].name +
                            " along the same coordinate and output: a shape outside the library");
-  if (first.explained_fraction < 0.5)
-    return unexplained("the first effect, " + first.name + ", removes only " +
-                       pct(first.explained_fraction) + " of the excess held-out sum of squares");
+  // Two effects at once each remove about half: the accepted set is judged together.
+  if (explained < 0.5)
+    return unexplained("the accepted effects remove only " + pct(explained) +
+                       " of the excess held-out sum of squares");
   if (R.final_p_value < opt.alpha) {
     if (explained < opt.explain_fraction)
       return unexplained("the accepted effects remove " + pct(explained) +
@@ -339,7 +144,7 @@ void decide_verdict(GapResult& R, const GapOptions& opt, const std::vector<std::
 // Gross readings, in rounds: the deleted residuals of the full-data fit, the readings
 // find_outliers flags removed, refit, until a round flags none (at most 4 rounds).
 std::vector<GapOutlier> gross_readings(const Model& model, const ErrorParameterisation& param,
-                                       const GapData& data) {
+                                       const GapData& data, unsigned threads) {
   std::vector<GapOutlier> all;
   std::vector<std::size_t> index(data.points.observations.size());  // into `data`
   std::iota(index.begin(), index.end(), 0);
@@ -349,9 +154,9 @@ std::vector<GapOutlier> gross_readings(const Model& model, const ErrorParameteri
     const MatrixXd A = design_matrix(model, param, cur.points);
     VectorXd y(static_cast<Index>(obs.size()));
     for (std::size_t i = 0; i < obs.size(); ++i) y[static_cast<Index>(i)] = obs[i].value;
-    const FoldFit f = fit_fold(A, y, all_rows(obs.size()));
+    const FoldFit f = fit_fold(A, y, all_rows(obs.size()), threads);
     VectorXd r = f.res_train;
-    for (Index i = 0; i < r.size(); ++i) r[i] /= std::max(1e-3, 1 - f.U.row(i).squaredNorm());
+    for (Index i = 0; i < r.size(); ++i) r[i] /= std::max(1e-3, 1 - f.lev_train[i]);
     std::vector<GapOutlier> found = find_outliers(cur, r);
     if (found.empty()) break;
     GapData next = cur;
@@ -388,7 +193,8 @@ GapResult GapDiagnosis::run(const Model& model, const ErrorParameterisation& par
   R.count = data.points.count;
   R.parameters = param_.size();
 
-  if (std::vector<GapOutlier> gross = gross_readings(model, param_, data); !gross.empty()) {
+  if (std::vector<GapOutlier> gross = gross_readings(model, param_, data, options_.threads);
+      !gross.empty()) {
     // Diagnose without them; residuals for plots keep the data's indexing (NaN for outliers).
     GapData clean = data;
     clean.points.observations.clear();
@@ -416,9 +222,9 @@ GapResult GapDiagnosis::run(const Model& model, const ErrorParameterisation& par
     return inner;
   }
 
-  Engine e{data, design_matrix(model, param_, data.points), {}, {}, {}, 0, 0, {}};
-  e.y.resize(static_cast<Index>(obs.size()));
-  for (std::size_t i = 0; i < obs.size(); ++i) e.y[static_cast<Index>(i)] = obs[i].value;
+  VectorXd values(static_cast<Index>(obs.size()));
+  for (std::size_t i = 0; i < obs.size(); ++i) values[static_cast<Index>(i)] = obs[i].value;
+  Engine e(data, design_matrix(model, param_, data.points), values, options_.threads);
   e.fit_full();
   R.rank = e.full_rank;
   e.splits = make_splits(data, scheme, R.rank + 5);
@@ -482,15 +288,20 @@ GapResult GapDiagnosis::run(const Model& model, const ErrorParameterisation& par
   VectorXd cur_r = r, cur_h = h;
   std::vector<bool> used(candidates.size(), false);
   // Shape effects: free shape dof per (coordinate, output), and the dof the accepted ones use.
-  const MatrixXd A0 = e.A;
+  const std::shared_ptr<const BlockFactors> F0 = e.factors;
   const std::size_t rank0 = e.full_rank;
-  std::map<std::pair<int, int>, std::size_t> dof_free, dof_used;
+  // Keyed by (coordinate, shaped error or output).
+  using ShapeKey = std::pair<int, std::string>;
+  auto shape_key = [](const gap_detail::Variant& v) {
+    return ShapeKey{v.shape_axis,
+                    v.shape_key.empty() ? std::to_string(v.shape_output) : v.shape_key};
+  };
+  std::map<ShapeKey, std::size_t> dof_free, dof_used;
   std::vector<std::pair<int, int>> accepted_shape;  // per accepted effect; (-1, -1) if none
   auto check_shape = [&](const gap_detail::Variant& v, EffectFit& fit) {
     if (v.shape_axis < 0) return;
-    const std::pair<int, int> key{v.shape_axis, v.shape_output};
-    if (!dof_free.count(key))
-      dof_free[key] = shape_dof_free(A0, rank0, data, v.shape_axis, v.shape_output);
+    const ShapeKey key = shape_key(v);
+    if (!dof_free.count(key)) dof_free[key] = shape_dof_free(*F0, rank0, data, v);
     fit.shape_dof_free = dof_free[key];
     fit.shape_dof_used = dof_used[key] + fit.extra_parameters + v.refine.size();
     if (fit.shape_dof_used >= fit.shape_dof_free) {
@@ -506,11 +317,20 @@ GapResult GapDiagnosis::run(const Model& model, const ErrorParameterisation& par
     }
   };
   for (int step = 0; step < options_.max_effects; ++step) {
+    ScoringContext sc;
+    sc.engine = &e;
+    sc.np = param_.size();
+    sc.base_r = &cur_r;
+    sc.base_h = &cur_h;
+    sc.s2 = s2;
+    sc.alpha = options_.alpha;
+    sc.n_candidates = n_candidates;
+    sc.threads = options_.threads;
+    std::vector<Evaluated> all = evaluate_candidates(candidates, used, sc);
     std::vector<Evaluated> ev;
     for (std::size_t k = 0; k < candidates.size(); ++k) {
       if (used[k]) continue;
-      Evaluated x = evaluate(candidates[k], e, param_.size(), cur_r, cur_h, s2, options_.alpha,
-                             n_candidates, options_.threads);
+      Evaluated x = std::move(all[k]);
       if (!std::isfinite(x.heldout_sse)) continue;
       candidates[k].describe(x.variant, x.coef, x.fit);
       check_shape(x.variant, x.fit);
@@ -543,10 +363,19 @@ GapResult GapDiagnosis::run(const Model& model, const ErrorParameterisation& par
     e.A = AE;
     e.refit();
     e.heldout(cur_r, cur_h);
+    // A regularised model's columns joined the design as fitted on all data, so the folds'
+    // refit would see held-out rows through them: its own held-out residual (each fold's columns
+    // fitted on that fold's training part) is the honest one, and the search ends with it.
+    if (pick->regularised) {
+      cur_r = pick->heldout;
+      R.explanation.push_back(fit);
+      accepted_shape.emplace_back(-1, -1);
+      break;
+    }
     R.explanation.push_back(fit);
     if (pick->variant.shape_axis >= 0) {
       accepted_shape.emplace_back(pick->variant.shape_axis, pick->variant.shape_output);
-      dof_used[accepted_shape.back()] = fit.shape_dof_used;
+      dof_used[shape_key(pick->variant)] = fit.shape_dof_used;
     } else {
       accepted_shape.emplace_back(-1, -1);
     }

@@ -1,28 +1,76 @@
+// periodic and pdge_shape: a shape of one motion error of one axis along that axis (a pitch
+// error of a ball screw, a bump in a guideway), sent through the kinematics: the columns are the
+// error's sensitivity at each observation's pose times the shape of the axis position. On a
+// 3-axis machine a straightness shape moves one output; on a turning table or a tilting head the
+// same error reaches the outputs rotated, and an angular error through its lever arm.
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <numeric>
-#include <optional>
-#include <set>
-#include <stdexcept>
+#include <memory>
 
 #include "effects.hpp"
-#include "weilgen/base/text.hpp"
-#include "weilgen/machine/iso_names.hpp"
 
 namespace weilgen::gap_detail {
 
-// ---- periodic and pdge_shape (position-dependent shapes along one axis, one output) --------
+namespace {
+
+// Per observation: the error's sensitivity times f(axis position), one column per f.
+MatrixXd shaped(const GapData& d, const AxisError& ae,
+                const std::vector<std::function<double(double)>>& f) {
+  const auto& obs = d.points.observations;
+  MatrixXd E = MatrixXd::Zero(static_cast<Index>(obs.size()), static_cast<Index>(f.size()));
+  for (std::size_t i = 0; i < obs.size(); ++i) {
+    const double w = (*ae.unit)[static_cast<Index>(i)];
+    if (w == 0) continue;
+    const double q = d.points.poses[obs[i].row][ae.axis.index];
+    for (std::size_t k = 0; k < f.size(); ++k)
+      E(static_cast<Index>(i), static_cast<Index>(k)) = w * f[k](q);
+  }
+  return E;
+}
+
+std::string axis_unit(const GapData& d, const AxisError& ae) {
+  return ae.axis.index < d.axis_units.size() ? d.axis_units[ae.axis.index] : "mm";
+}
+
+// "E_YX of X" (with the errors the data cannot tell from it).
+std::string error_of(const AxisError& ae) {
+  std::string s = ae.name + " of " + ae.axis.name;
+  for (const std::string& o : ae.same_as) s += " (or " + o + ")";
+  return s;
+}
+
+void mark_shape(Variant& v, const AxisError& ae) {
+  v.shape_axis = static_cast<int>(ae.axis.index);
+  v.shape_output = ae.output;
+  v.shape_weight = ae.unit;
+  v.shape_key = ae.name;
+}
+
+GapRegion shape_region(const AxisError& ae, double from, double to) {
+  GapRegion r;
+  r.by = ae.axis.name;
+  r.output = observation_name(static_cast<std::size_t>(ae.output));
+  r.from = from;
+  r.to = to;
+  return r;
+}
+
+void describe_error(const AxisError& ae, EffectFit& fit) {
+  fit.params["error_" + ae.name] = 1;
+  fit.params["axis_" + ae.axis.name] = 1;
+}
+
+}  // namespace
 
 void add_periodic(const EffectContext& ctx, std::vector<Candidate>& out) {
   const GapData& d = *ctx.data;
-  const std::vector<AxisInfo> axes = varying_axes(d, 6);
-  if (axes.empty()) return;
+  const auto errors = shaped_errors(ctx);
+  if (errors->empty()) return;
   Candidate c;
   c.name = "periodic";
-  // hyper: [axis list index, output, period]
-  for (std::size_t k = 0; k < axes.size(); ++k) {
-    const auto& L = axes[k].levels;
+  // hyper: [error list index, period (axis unit)]
+  for (std::size_t k = 0; k < errors->size(); ++k) {
+    const auto& L = (*errors)[k].axis.levels;
     std::vector<double> gaps;
     for (std::size_t i = 1; i < L.size(); ++i) gaps.push_back(L[i] - L[i - 1]);
     std::nth_element(gaps.begin(), gaps.begin() + static_cast<long>(gaps.size() / 2), gaps.end());
@@ -37,129 +85,109 @@ void add_periodic(const EffectContext& ctx, std::vector<Candidate>& out) {
     const double c_lo = span / hi, c_hi = span / lo;
     const int grid = std::max(40, static_cast<int>(std::ceil((c_hi - c_lo) / 0.25)) + 1);
     const double dcyc = (c_hi - c_lo) / (grid - 1);
-    for (int o : outputs_of(d))
-      for (int g = 0; g < grid; ++g) {
-        const double cycles = c_lo + dcyc * g, period = span / cycles;
-        c.variants.push_back({axes[k].name + ", " + output_name(static_cast<std::size_t>(o)),
-                              {static_cast<double>(k), static_cast<double>(o), period},
-                              false,
-                              {{2, span / (cycles + dcyc), span / std::max(cycles - dcyc, 1.0)}}});
-        c.variants.back().shape_axis = static_cast<int>(axes[k].index);
-        c.variants.back().shape_output = o;
-      }
+    for (int g = 0; g < grid; ++g) {
+      const double cycles = c_lo + dcyc * g, period = span / cycles;
+      c.variants.push_back({error_of((*errors)[k]),
+                            {static_cast<double>(k), period},
+                            false,
+                            {{1, span / (cycles + dcyc), span / std::max(cycles - dcyc, 1.0)}}});
+      mark_shape(c.variants.back(), (*errors)[k]);
+    }
   }
   if (c.variants.empty()) return;
-  c.columns = [&d, axes](const Variant& v, const std::vector<double>&) {
-    const double w = 2 * M_PI / v.hyper[2];
-    return one_output(
-        d, static_cast<int>(v.hyper[1]),
-        {[w](double q) { return std::cos(w * q); }, [w](double q) { return std::sin(w * q); }},
-        axes[static_cast<std::size_t>(v.hyper[0])].index);
+  c.columns = [&d, errors](const Variant& v, const std::vector<double>&) {
+    const double w = 2 * M_PI / v.hyper[1];
+    return shaped(
+        d, (*errors)[static_cast<std::size_t>(v.hyper[0])],
+        {[w](double q) { return std::cos(w * q); }, [w](double q) { return std::sin(w * q); }});
   };
-  c.describe = [axes](const Variant& v, const VectorXd& coef, EffectFit& fit) {
-    const AxisInfo& a = axes[static_cast<std::size_t>(v.hyper[0])];
-    const int o = static_cast<int>(v.hyper[1]);
+  c.describe = [&d, errors](const Variant& v, const VectorXd& coef, EffectFit& fit) {
+    const AxisError& ae = (*errors)[static_cast<std::size_t>(v.hyper[0])];
+    const std::string au = axis_unit(d, ae), eu = ae.rotation ? "urad" : "um";
     const double amp = std::hypot(coef[0], coef[1]);
-    fit.params["period_mm"] = v.hyper[2];
-    fit.params["amplitude"] = amp;
-    fit.summary = "period " + num(v.hyper[2], 3) + " mm, " + num(amp, 2) + " " + unit_of(o) +
-                  " in " + output_name(static_cast<std::size_t>(o)) + " along " + a.name;
-    GapRegion r;
-    r.by = a.name;
-    r.output = output_name(static_cast<std::size_t>(o));
-    r.from = a.levels.front();
-    r.to = a.levels.back();
-    fit.region = r;
+    fit.params["period_" + au] = v.hyper[1];
+    fit.params["amplitude_" + eu] = amp;
+    describe_error(ae, fit);
+    fit.summary = "periodic " + error_of(ae) + ": period " + num(v.hyper[1], 3) + " " + au + ", " +
+                  num(amp, 2) + (ae.rotation ? " µrad" : " µm");
+    fit.region = shape_region(ae, ae.axis.levels.front(), ae.axis.levels.back());
   };
   out.push_back(std::move(c));
 }
 
 void add_pdge_shape(const EffectContext& ctx, std::vector<Candidate>& out) {
   const GapData& d = *ctx.data;
-  const std::vector<AxisInfo> axes = varying_axes(d, 6);
-  if (axes.empty()) return;
+  const auto errors = shaped_errors(ctx);
+  if (errors->empty()) return;
   Candidate c;
   c.name = "pdge_shape";
-  // hyper: [axis list index, output, kind (0 bump, 1 extra degrees), centre, width]
-  for (std::size_t k = 0; k < axes.size(); ++k) {
-    const auto& L = axes[k].levels;
+  // hyper: [error list index, kind (0 bump, 1 extra degrees), centre, width]
+  for (std::size_t k = 0; k < errors->size(); ++k) {
+    const AxisError& ae = (*errors)[k];
+    const auto& L = ae.axis.levels;
     const double span = L.back() - L.front();
-    for (int o : outputs_of(d)) {
-      const std::string head = axes[k].name + ", " + output_name(static_cast<std::size_t>(o));
-      c.variants.push_back(
-          {head + ", degrees 4-5", {static_cast<double>(k), static_cast<double>(o), 1, 0, 0}});
-      c.variants.back().shape_axis = static_cast<int>(axes[k].index);
-      c.variants.back().shape_output = o;
-      // Centres at a quarter of the sample spacing (at most 61): on a coarse grid the fit of a
-      // bump between two sample positions differs by orders of magnitude from one centred on
-      // either, so centres on the samples alone miss the truth's local minimum.
-      const std::size_t nc = std::min<std::size_t>(61, 4 * (L.size() - 1) + 1);
-      const double dc = span / static_cast<double>(nc - 1);
-      for (std::size_t i = 0; i < nc; ++i) {
-        const double centre = L.front() + dc * static_cast<double>(i);
-        for (double f : {1.0 / 30, 1.0 / 15, 1.0 / 8}) {
-          c.variants.push_back(
-              {head + ", bump",
-               {static_cast<double>(k), static_cast<double>(o), 0, centre, span * f},
-               false,
-               {{3, centre - dc, centre + dc}, {4, span * f / 2, span * f * 2}}});
-          c.variants.back().shape_axis = static_cast<int>(axes[k].index);
-          c.variants.back().shape_output = o;
-        }
+    const std::string head = error_of(ae);
+    c.variants.push_back({head + ", degrees 4-5", {static_cast<double>(k), 1, 0, 0}});
+    mark_shape(c.variants.back(), ae);
+    // Centres at a quarter of the sample spacing (at most 61): on a coarse grid the fit of a
+    // bump between two sample positions differs by orders of magnitude from one centred on
+    // either, so centres on the samples alone miss the truth's local minimum.
+    const std::size_t nc = std::min<std::size_t>(61, 4 * (L.size() - 1) + 1);
+    const double dc = span / static_cast<double>(nc - 1);
+    for (std::size_t i = 0; i < nc; ++i) {
+      const double centre = L.front() + dc * static_cast<double>(i);
+      for (double f : {1.0 / 30, 1.0 / 15, 1.0 / 8}) {
+        c.variants.push_back({head + ", bump",
+                              {static_cast<double>(k), 0, centre, span * f},
+                              false,
+                              {{2, centre - dc, centre + dc}, {3, span * f / 2, span * f * 2}}});
+        mark_shape(c.variants.back(), ae);
       }
     }
   }
-  c.columns = [&d, axes](const Variant& v, const std::vector<double>&) {
-    const AxisInfo& a = axes[static_cast<std::size_t>(v.hyper[0])];
-    const int o = static_cast<int>(v.hyper[1]);
-    if (v.hyper[2] == 1) {
-      const double lo = a.levels.front(), hi = a.levels.back();
+  c.columns = [&d, errors](const Variant& v, const std::vector<double>&) {
+    const AxisError& ae = (*errors)[static_cast<std::size_t>(v.hyper[0])];
+    if (v.hyper[1] == 1) {
+      const double lo = ae.axis.levels.front(), hi = ae.axis.levels.back();
       auto u = [lo, hi](double q) { return (2 * q - lo - hi) / (hi - lo); };
-      return one_output(d, o,
-                        {[u](double q) { return std::pow(u(q), 4); },
-                         [u](double q) { return std::pow(u(q), 5); }},
-                        a.index);
+      return shaped(d, ae,
+                    {[u](double q) { return std::pow(u(q), 4); },
+                     [u](double q) { return std::pow(u(q), 5); }});
     }
-    const double c0 = v.hyper[3], w = v.hyper[4];
-    return one_output(
-        d, o, {[c0, w](double q) { return std::exp(-0.5 * (q - c0) * (q - c0) / (w * w)); }},
-        a.index);
+    const double c0 = v.hyper[2], w = v.hyper[3];
+    return shaped(d, ae,
+                  {[c0, w](double q) { return std::exp(-0.5 * (q - c0) * (q - c0) / (w * w)); }});
   };
-  c.describe = [axes](const Variant& v, const VectorXd& coef, EffectFit& fit) {
-    const AxisInfo& a = axes[static_cast<std::size_t>(v.hyper[0])];
-    const int o = static_cast<int>(v.hyper[1]);
-    GapRegion r;
-    r.by = a.name;
-    r.output = output_name(static_cast<std::size_t>(o));
-    if (v.hyper[2] == 1) {
-      fit.summary = "more shape along " + a.name + " in " +
-                    output_name(static_cast<std::size_t>(o)) + ": u^4 " + num(coef[0], 2) +
-                    ", u^5 " + num(coef[1], 2) + " " + unit_of(o);
-      r.from = a.levels.front();
-      r.to = a.levels.back();
-    } else {
-      fit.params["centre"] = v.hyper[3];
-      fit.params["width"] = v.hyper[4];
-      fit.params["amplitude"] = coef[0];
-      fit.summary = "bump " + num(coef[0], 2) + " " + unit_of(o) + " in " +
-                    output_name(static_cast<std::size_t>(o)) + " at " + a.name + " = " +
-                    num(v.hyper[3], 4) + " (width " + num(v.hyper[4], 3) + ")";
-      r.from = v.hyper[3] - 2 * v.hyper[4];
-      r.to = v.hyper[3] + 2 * v.hyper[4];
-      // A bump is resolved when at least 3 sample positions carry a tenth of its height or
-      // more (|q - c| < 2.15 w); over one or two it is a step or a single position's offset.
-      const auto covered = std::count_if(a.levels.begin(), a.levels.end(), [&](double q) {
-        return std::abs(q - v.hyper[3]) < 2.15 * v.hyper[4];
-      });
-      fit.params["positions_covered"] = static_cast<double>(covered);
-      if (covered < 3) {
-        fit.distinguishable = false;
-        fit.indistinct_reason = "the bump covers " + std::to_string(covered) + " sample position" +
-                                (covered == 1 ? "" : "s") + " along " + a.name +
-                                ": narrower than the sampling, it cannot be told from a step";
-      }
+  c.describe = [&d, errors](const Variant& v, const VectorXd& coef, EffectFit& fit) {
+    const AxisError& ae = (*errors)[static_cast<std::size_t>(v.hyper[0])];
+    const std::string au = axis_unit(d, ae), eu = ae.rotation ? "urad" : "um";
+    const char* eus = ae.rotation ? " µrad" : " µm";
+    describe_error(ae, fit);
+    if (v.hyper[1] == 1) {
+      fit.summary = "more shape of " + error_of(ae) + ": u^4 " + num(coef[0], 2) + ", u^5 " +
+                    num(coef[1], 2) + eus;
+      fit.region = shape_region(ae, ae.axis.levels.front(), ae.axis.levels.back());
+      return;
     }
-    fit.region = r;
+    const double centre = v.hyper[2], width = v.hyper[3];
+    fit.params["centre_" + au] = centre;
+    fit.params["width_" + au] = width;
+    fit.params["amplitude_" + eu] = coef[0];
+    fit.summary = "bump of " + error_of(ae) + ": " + num(coef[0], 2) + eus + " at " + ae.axis.name +
+                  " = " + num(centre, 4) + " " + au + " (width " + num(width, 3) + " " + au + ")";
+    fit.region = shape_region(ae, centre - 2 * width, centre + 2 * width);
+    // A bump is resolved when at least 3 sample positions carry a tenth of its height or
+    // more (|q - c| < 2.15 w); over one or two it is a step or a single position's offset.
+    const auto covered = std::count_if(ae.axis.levels.begin(), ae.axis.levels.end(), [&](double q) {
+      return std::abs(q - centre) < 2.15 * width;
+    });
+    fit.params["positions_covered"] = static_cast<double>(covered);
+    if (covered < 3) {
+      fit.distinguishable = false;
+      fit.indistinct_reason = "the bump covers " + std::to_string(covered) + " sample position" +
+                              (covered == 1 ? "" : "s") + " along " + ae.axis.name +
+                              ": narrower than the sampling, it cannot be told from a step";
+    }
   };
   out.push_back(std::move(c));
 }

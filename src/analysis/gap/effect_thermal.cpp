@@ -1,242 +1,277 @@
+// thermal_drift as a growth of the machine with time or temperature, sent through the
+// kinematics (docs/gap.md, "Effect library"): the spindle side grows in the tool's frame (it
+// turns with a tilting head), the structure before the rotary axes in the machine's (a turning
+// table shows it rotated), and each linear axis' positioning scale grows with it (the axis'
+// position times the signal, through the axis Jacobian). The signal is linear in time, a heat-up
+// lag 1 - e^{-t/tau}, or a temperature sensor as read or through a first-order lag.
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <numeric>
-#include <optional>
-#include <set>
-#include <stdexcept>
+#include <memory>
 
 #include "effects.hpp"
-#include "weilgen/base/text.hpp"
 #include "weilgen/machine/iso_names.hpp"
 
 namespace weilgen::gap_detail {
 
-// ---- thermal_drift -----------------------------------------------------------------------
+namespace {
+
+constexpr double kLagRatio = 1.5;
+
+struct ThermalContext {
+  const GapData* d = nullptr;
+  double t0 = 0, t1 = 0;
+  std::vector<std::string> sensors;
+  std::vector<Frame> frames;
+  std::vector<std::vector<Eigen::Matrix3d>> rotation;  // per frame, per row
+  std::vector<Eigen::MatrixXd> jacobian;               // per row (axis Jacobians)
+  std::vector<std::size_t> linear;                     // GapData::axes indices of linear axes
+  std::vector<int> linear_dir;                         // each one's machine direction 0..2
+  bool angles = false;                                 // angular outputs measured
+};
+
+// hyper: [kind, tau_s, sensor, frame, target]; kind 0 = linear in time, 1 = heat-up lag,
+// 2 = sensor (lagged by tau_s, 0 = as read); target -1 = every direction, 0..2 = one direction
+// of the frame with the scale of the linear axis along it.
+std::vector<double> signal_of(const ThermalContext& tc, const Variant& v) {
+  const GapData& d = *tc.d;
+  const int kind = static_cast<int>(v.hyper[0]);
+  std::vector<double> s(d.time_s.size(), 0.0);
+  if (kind == 0) {
+    for (std::size_t r = 0; r < s.size(); ++r) s[r] = (d.time_s[r] - tc.t0) / 3600.0;
+  } else if (kind == 1) {
+    for (std::size_t r = 0; r < s.size(); ++r)
+      s[r] = 1 - std::exp(-(d.time_s[r] - tc.t0) / v.hyper[1]);
+  } else {
+    s = first_order_lag(d, d.temperature.at(tc.sensors[static_cast<std::size_t>(v.hyper[2])]),
+                        v.hyper[1]);
+    double mean = 0;
+    for (const auto& o : d.points.observations) mean += s[o.row];
+    mean /= static_cast<double>(std::max<std::size_t>(1, d.points.observations.size()));
+    for (double& x : s) x -= mean;
+  }
+  for (double& x : s)
+    if (!std::isfinite(x)) x = 0;
+  return s;
+}
+
+struct Columns {
+  MatrixXd E;
+  std::vector<std::string> labels;  // "drift_x", "tilt_a", "scale_X"
+};
+
+// The variant's columns, each kept only when it adds to the ones before (a fixed coordinate's
+// scale is the offset again; a frame direction no output sees is zero).
+Columns thermal_columns(const ThermalContext& tc, const Variant& v) {
+  const GapData& d = *tc.d;
+  const auto& obs = d.points.observations;
+  const std::vector<double> s = signal_of(tc, v);
+  const auto& R = tc.rotation[static_cast<std::size_t>(v.hyper[3])];
+  const int target = static_cast<int>(v.hyper[4]);
+  std::vector<VectorXd> cols;
+  std::vector<std::string> labels;
+  const auto n = static_cast<Index>(obs.size());
+  for (int k = 0; k < 3; ++k) {
+    if (target >= 0 && k != target) continue;
+    for (int part = 0; part < (tc.angles ? 2 : 1); ++part) {
+      VectorXd c(n);
+      for (std::size_t i = 0; i < obs.size(); ++i) {
+        double v6[6] = {0, 0, 0, 0, 0, 0};
+        for (int o = 0; o < 3; ++o) v6[3 * part + o] = R[obs[i].row](o, k) * 1e-3 * s[obs[i].row];
+        if (part == 1)
+          for (int o = 3; o < 6; ++o) v6[o] *= 1e-3;  // µrad: 1e-6 rad
+        c[static_cast<Index>(i)] = measured(obs[i], v6);
+      }
+      cols.push_back(c);
+      labels.push_back(std::string(part ? "tilt_" : "drift_") + "xyz"[k]);
+    }
+  }
+  for (std::size_t a = 0; a < tc.linear.size(); ++a) {
+    if (target >= 0 && tc.linear_dir[a] != target) continue;
+    VectorXd c(n);
+    for (std::size_t i = 0; i < obs.size(); ++i) {
+      const Eigen::MatrixXd& J = tc.jacobian[obs[i].row];
+      if (J.size() == 0) {
+        c[static_cast<Index>(i)] = 0;
+        continue;
+      }
+      const double q_m = d.points.poses[obs[i].row][tc.linear[a]] / 1000;
+      double v6[6];
+      for (int o = 0; o < 6; ++o)
+        v6[o] = J(o, static_cast<Index>(tc.linear[a])) * q_m * s[obs[i].row] * 1e-3;
+      c[static_cast<Index>(i)] = measured(obs[i], v6);
+    }
+    cols.push_back(c);
+    labels.push_back("scale_" + d.axes[tc.linear[a]]);
+  }
+  // Keep a column when it adds to the kept ones (Gram-Schmidt, relative 1e-9).
+  Columns out;
+  std::vector<VectorXd> basis;
+  std::vector<std::size_t> keep;
+  for (std::size_t k = 0; k < cols.size(); ++k) {
+    VectorXd r = cols[k];
+    for (const VectorXd& b : basis) r -= b * b.dot(r);
+    if (!(r.norm() > 1e-9 * std::max(1e-300, cols[k].norm()))) continue;
+    basis.push_back(r / r.norm());
+    keep.push_back(k);
+  }
+  out.E.resize(n, static_cast<Index>(keep.size()));
+  for (std::size_t k = 0; k < keep.size(); ++k) {
+    out.E.col(static_cast<Index>(k)) = cols[keep[k]];
+    out.labels.push_back(labels[keep[k]]);
+  }
+  return out;
+}
+
+}  // namespace
 
 void add_thermal(const EffectContext& ctx, std::vector<Candidate>& out) {
   const GapData& d = *ctx.data;
-  const std::vector<int> outs = outputs_of(d);
+  if (!ctx.chain) return;
+  auto tc = std::make_shared<ThermalContext>();
+  tc->d = &d;
   double t0 = INFINITY, t1 = -INFINITY;
   for (const auto& o : d.points.observations)
     if (std::isfinite(d.time_s[o.row]))
       t0 = std::min(t0, d.time_s[o.row]), t1 = std::max(t1, d.time_s[o.row]);
   const bool time = t1 > t0;
-  if (!time && d.temperature.empty()) return;
+  tc->t0 = t0;
+  tc->t1 = t1;
+  for (const auto& [name, v] : d.temperature) tc->sensors.push_back(name);
+  if (!time && tc->sensors.empty()) return;
+  // The tool's frame always; the machine's where it differs (a tilting head, a turning table).
+  tc->frames.push_back(Frame::Tool);
+  tc->rotation.push_back(frame_rotations(ctx, Frame::Tool));
+  {
+    std::vector<Eigen::Matrix3d> m = frame_rotations(ctx, Frame::Machine);
+    bool differs = false;
+    for (std::size_t r = 0; r < m.size() && !differs; ++r)
+      differs = (m[r] - tc->rotation[0][r]).norm() > 1e-9;
+    if (differs) {
+      tc->frames.push_back(Frame::Machine);
+      tc->rotation.push_back(std::move(m));
+    }
+  }
+  const Description& desc = ctx.model->description();
+  const std::vector<int> bodies = desc.axes();
+  for (std::size_t a = 0; a < d.axes.size() && a < bodies.size(); ++a) {
+    const Joint& j = desc.bodies[static_cast<std::size_t>(bodies[a])].joint;
+    if (j.type != JointType::Prismatic || axis_values(d, a).size() < 2) continue;
+    tc->linear.push_back(a);
+    tc->linear_dir.push_back(principal_axis(j.axis));
+  }
+  if (!tc->linear.empty()) tc->jacobian = axis_jacobians(ctx);
+  const std::vector<int> outs = outputs_of(d);
+  for (int o : outs) tc->angles = tc->angles || o >= 3;
+
   Candidate c;
   c.name = "thermal_drift";
-  // hyper: [kind, tau_s or sensor index]; kind 0 = linear in time, 1 = lag in time,
-  // 2 = temperature (offset), 3 = temperature × coordinate along the output (scale).
   // Lags are scanned over the whole range on a fine log grid (ratio 1.5) before the best is
   // refined between its neighbours: with cycle folds the training error over the lag has
   // several minima, and a coarse grid refined by golden section can settle in the wrong one.
-  const double ratio = 1.5;
   std::vector<double> lags;  // fractions of the run
-  for (double f = 0.01; f <= 2.0 * ratio; f *= ratio) lags.push_back(f);
-  if (time) {
-    c.variants.push_back({"linear in time", {0, 0}});
-    for (double f : lags)
-      c.variants.push_back({"heat-up lag",
-                            {1, (t1 - t0) * f},
-                            false,
-                            {{1, (t1 - t0) * f / ratio, (t1 - t0) * f * ratio}}});
-  }
-  std::vector<std::string> sensors;
-  for (const auto& [name, v] : d.temperature) sensors.push_back(name);
-  // Each sensor, as read and through a first-order lag (the structure heats up behind the
-  // sensor): hyper[2] = tau (s, 0 = none). Offset and scale (ΔT × the coordinate along the
-  // output) together.
-  // hyper[3]: the output the sensor acts on, or -1 for all measured outputs together (a
-  // structure's sensors differ per direction: the greedy search may take one per output).
+  for (double f = 0.01; f <= 2.0 * kLagRatio; f *= kLagRatio) lags.push_back(f);
+  // One direction at a time as well as all together: a structure's sensors differ per
+  // direction, and the greedy search may take one per direction.
   std::vector<double> targets = {-1};
-  if (outs.size() > 1)
-    for (int o : outs) targets.push_back(o);
-  for (double target : targets)
-    for (std::size_t j = 0; j < sensors.size(); ++j) {
-      const std::string head =
-          "temperature " + sensors[j] +
-          (target < 0 ? "" : std::string(" on ") + output_name(static_cast<std::size_t>(target)));
-      c.variants.push_back({head, {2, static_cast<double>(j), 0, target}});
-      if (time)
-        for (double f : lags)
-          if (f <= 0.5)
-            c.variants.push_back({head + " lagged",
-                                  {2, static_cast<double>(j), (t1 - t0) * f, target},
-                                  false,
-                                  {{2, (t1 - t0) * f / ratio, (t1 - t0) * f * ratio}}});
+  int dirs = 0;
+  for (int o : outs) dirs += o < 3;
+  if (dirs > 1)
+    for (int k = 0; k < 3; ++k) targets.push_back(k);
+  for (std::size_t f = 0; f < tc->frames.size(); ++f) {
+    const std::string in = tc->frames[f] == Frame::Tool ? "" : " (machine frame)";
+    const auto fr = static_cast<double>(f);
+    if (time) {
+      c.variants.push_back({"linear in time" + in, {0, 0, -1, fr, -1}});
+      for (double x : lags)
+        c.variants.push_back({"heat-up lag" + in,
+                              {1, (t1 - t0) * x, -1, fr, -1},
+                              false,
+                              {{1, (t1 - t0) * x / kLagRatio, (t1 - t0) * x * kLagRatio}}});
     }
-  auto mean_of = [&d](const std::vector<double>& v) {
-    double sum = 0;
-    std::size_t n = 0;
-    for (const auto& o : d.points.observations) sum += v[o.row], ++n;
-    return n ? sum / static_cast<double>(n) : 0.0;
-  };
-  auto lagged = [&d](const std::vector<double>& T, double tau) {
-    return first_order_lag(d, T, tau);
-  };
-  c.columns = [&d, outs, t0, sensors, mean_of, lagged](const Variant& v,
-                                                       const std::vector<double>&) {
-    const int kind = static_cast<int>(v.hyper[0]);
-    if (kind == 0)
-      return per_output(d, outs, [&](std::size_t r) { return (d.time_s[r] - t0) / 3600.0; });
-    if (kind == 1) {
-      const double tau = v.hyper[1];
-      return per_output(d, outs,
-                        [&](std::size_t r) { return 1 - std::exp(-(d.time_s[r] - t0) / tau); });
-    }
-    const std::vector<int> outs_v =
-        v.hyper[3] < 0 ? outs : std::vector<int>{static_cast<int>(v.hyper[3])};
-    const std::vector<double> T =
-        lagged(d.temperature.at(sensors[static_cast<std::size_t>(v.hyper[1])]), v.hyper[2]);
-    const double Tm = mean_of(T);
-    const MatrixXd offset = per_output(d, outs_v, [&](std::size_t r) { return T[r] - Tm; });
-    // Scale: ΔT times the coordinate along the output's direction (dx with X ...), in m.
-    const auto& obs = d.points.observations;
-    MatrixXd E = MatrixXd::Zero(static_cast<Index>(obs.size()), static_cast<Index>(outs_v.size()));
-    for (std::size_t i = 0; i < obs.size(); ++i)
-      for (std::size_t k = 0; k < outs_v.size(); ++k) {
-        const double w = observation_weight(obs[i], outs_v[k]);
-        if (w == 0 || outs_v[k] > 2) continue;
-        const std::string axis(1, static_cast<char>('X' + outs_v[k]));
-        const auto it = std::find(d.axes.begin(), d.axes.end(), axis);
-        if (it == d.axes.end()) continue;
-        const double q = d.points.poses[obs[i].row][static_cast<std::size_t>(it - d.axes.begin())];
-        E(static_cast<Index>(i), static_cast<Index>(k)) = w * (T[obs[i].row] - Tm) * q / 1000.0;
+    for (double target : targets)
+      for (std::size_t j = 0; j < tc->sensors.size(); ++j) {
+        const std::string head = "temperature " + tc->sensors[j] +
+                                 (target < 0 ? "" : std::string(" along ") + "xyz"[int(target)]) +
+                                 in;
+        const auto sj = static_cast<double>(j);
+        c.variants.push_back({head, {2, 0, sj, fr, target}});
+        if (time)
+          for (double x : lags)
+            if (x <= 0.5)
+              c.variants.push_back({head + " lagged",
+                                    {2, (t1 - t0) * x, sj, fr, target},
+                                    false,
+                                    {{1, (t1 - t0) * x / kLagRatio, (t1 - t0) * x * kLagRatio}}});
       }
-    std::vector<Index> keep;  // scale columns that vary (a fixed coordinate adds nothing)
-    for (Index k = 0; k < E.cols(); ++k)
-      if ((E.col(k) - offset.col(k) * (E.col(k).dot(offset.col(k)) /
-                                       std::max(1e-300, offset.col(k).squaredNorm())))
-              .norm() > 1e-9 * std::max(1.0, E.col(k).norm()))
-        keep.push_back(k);
-    MatrixXd all(E.rows(), offset.cols() + static_cast<Index>(keep.size()));
-    all.leftCols(offset.cols()) = offset;
-    for (std::size_t k = 0; k < keep.size(); ++k)
-      all.col(offset.cols() + static_cast<Index>(k)) = E.col(keep[k]);
-    return all;
+  }
+  c.columns = [tc](const Variant& v, const std::vector<double>&) {
+    return thermal_columns(*tc, v).E;
   };
-  c.describe = [outs, sensors](const Variant& v, const VectorXd& coef, EffectFit& fit) {
+  c.describe = [tc](const Variant& v, const VectorXd& coef, EffectFit& fit) {
+    const GapData& data = *tc->d;
     const int kind = static_cast<int>(v.hyper[0]);
+    const Frame frame = tc->frames[static_cast<std::size_t>(v.hyper[3])];
+    const Columns cols = thermal_columns(*tc, v);
+    const std::string per = kind == 0 ? "_per_h" : kind == 1 ? "" : "_per_K";
+    const std::string per_text = kind == 0 ? "/h" : kind == 1 ? "" : "/K";
+    std::string drift, scale;
+    for (std::size_t k = 0; k < cols.labels.size() && static_cast<Index>(k) < coef.size(); ++k) {
+      const std::string& l = cols.labels[k];
+      const double x = coef[static_cast<Index>(k)];
+      const std::string sx = (x >= 0 ? "+" : "") + num(x, 2);
+      if (l.rfind("scale_", 0) == 0) {
+        fit.params[l + "_um_per_m" + per] = x;
+        scale += (scale.empty() ? "" : ", ") + std::string("scale of ") + l.substr(6) + " " + sx +
+                 " µm/m" + per_text;
+      } else {
+        const bool tilt = l[0] == 't';
+        fit.params[l + (tilt ? "_urad" : "_um") + per] = x;
+        drift += (drift.empty() ? "" : ", ") + std::string(tilt ? "tilt " : "") + l.back() + " " +
+                 sx + (tilt ? " µrad" : " µm") + per_text;
+      }
+    }
+    fit.params[frame == Frame::Tool ? "frame_tool" : "frame_machine"] = 1;
+    std::string what;
     if (kind == 0) {
-      fit.summary = "drift " + per_output_text(outs, coef, 1, "/h", fit, "rate_per_h");
+      what = "drift in time";
     } else if (kind == 1) {
       fit.params["tau_h"] = v.hyper[1] / 3600;
-      fit.summary = "heat-up drift (tau " + num(v.hyper[1] / 3600, 2) +
-                    " h): " + per_output_text(outs, coef, 1, "", fit, "amplitude");
+      what = "heat-up (tau " + num(v.hyper[1] / 3600, 2) + " h)";
     } else {
-      const std::string& s = sensors[static_cast<std::size_t>(v.hyper[1])];
+      const std::string& s = tc->sensors[static_cast<std::size_t>(v.hyper[2])];
       fit.params["sensor_" + s] = 1;
-      fit.params["lag_h"] = v.hyper[2] / 3600;
-      const std::vector<int> outs_v =
-          v.hyper[3] < 0 ? outs : std::vector<int>{static_cast<int>(v.hyper[3])};
-      fit.summary = "thermal, " + s +
-                    (v.hyper[2] > 0 ? " (lag " + num(v.hyper[2] / 3600, 2) + " h)" : "") + ": " +
-                    per_output_text(outs_v, coef.head(static_cast<Index>(outs_v.size())), 1, "/K",
-                                    fit, "per_K");
-    }
-  };
-  out.push_back(std::move(c));
-}
-
-}  // namespace weilgen::gap_detail
-
-namespace weilgen::gap_detail {
-
-// ---- thermal_drift in the machine frame ----------------------------------------------------
-// The spindle, column and headstock grow in the machine's frame; a table that turns (A, C)
-// shows that growth to the workpiece rotated by its own orientation. Offered when the
-// workpiece frame turns over the data: a drift vector fixed in the machine frame (3 parameters)
-// following time (linear or a heat-up lag) or a sensor (as read or lagged), seen through
-// R_workpiece(q)^T.
-void add_thermal_machine_frame(const EffectContext& ctx, std::vector<Candidate>& out) {
-  const GapData& d = *ctx.data;
-  if (!ctx.chain) return;
-  auto rt = std::make_shared<std::vector<Eigen::Matrix3d>>(d.points.poses.size(),
-                                                           Eigen::Matrix3d::Identity());
-  bool turns = false;
-  std::vector<char> needed(d.points.poses.size(), 0);
-  for (const auto& o : d.points.observations) needed[o.row] = 1;
-  const Eigen::Matrix3d* first = nullptr;
-  for (std::size_t r = 0; r < rt->size(); ++r) {
-    if (!needed[r] || d.points.poses[r].size() != d.axes.size()) continue;
-    (*rt)[r] = ctx.chain->workpiece_in_base(d.points.poses[r]).block<3, 3>(0, 0).transpose();
-    if (!first) first = &(*rt)[r];
-    turns = turns || ((*rt)[r] - *first).norm() > 1e-9;
-  }
-  if (!turns) return;
-  double t0 = INFINITY, t1 = -INFINITY;
-  for (const auto& o : d.points.observations)
-    if (std::isfinite(d.time_s[o.row]))
-      t0 = std::min(t0, d.time_s[o.row]), t1 = std::max(t1, d.time_s[o.row]);
-  const bool time = t1 > t0;
-  std::vector<std::string> sensors;
-  for (const auto& [name, v] : d.temperature) sensors.push_back(name);
-  if (!time && sensors.empty()) return;
-  Candidate c;
-  c.name = "thermal_drift";
-  // hyper: [kind, tau_s, sensor]; kind 0 = linear in time, 1 = heat-up lag, 2 = sensor (lag
-  // tau_s, 0 = as read).
-  const double ratio = 1.5;
-  if (time) {
-    c.variants.push_back({"linear in time (machine frame)", {0, 0, -1}});
-    for (double f = 0.01; f <= 2.0 * ratio; f *= ratio)
-      c.variants.push_back({"heat-up lag (machine frame)",
-                            {1, (t1 - t0) * f, -1},
-                            false,
-                            {{1, (t1 - t0) * f / ratio, (t1 - t0) * f * ratio}}});
-  }
-  for (std::size_t j = 0; j < sensors.size(); ++j) {
-    c.variants.push_back(
-        {"temperature " + sensors[j] + " (machine frame)", {2, 0, static_cast<double>(j)}});
-    if (time)
-      for (double f = 0.01; f <= 0.5; f *= ratio)
-        c.variants.push_back({"temperature " + sensors[j] + " lagged (machine frame)",
-                              {2, (t1 - t0) * f, static_cast<double>(j)},
-                              false,
-                              {{1, (t1 - t0) * f / ratio, (t1 - t0) * f * ratio}}});
-  }
-  c.columns = [&d, rt, t0, sensors](const Variant& v, const std::vector<double>&) {
-    const int kind = static_cast<int>(v.hyper[0]);
-    std::vector<double> signal(d.time_s.size(), 0.0);
-    if (kind == 0) {
-      for (std::size_t r = 0; r < signal.size(); ++r) signal[r] = (d.time_s[r] - t0) / 3600.0;
-    } else if (kind == 1) {
-      for (std::size_t r = 0; r < signal.size(); ++r)
-        signal[r] = 1 - std::exp(-(d.time_s[r] - t0) / v.hyper[1]);
-    } else {
-      signal = first_order_lag(d, d.temperature.at(sensors[static_cast<std::size_t>(v.hyper[2])]),
-                               v.hyper[1]);
-      double mean = 0;
-      for (const auto& o : d.points.observations) mean += signal[o.row];
-      mean /= static_cast<double>(std::max<std::size_t>(1, d.points.observations.size()));
-      for (double& s : signal) s -= mean;
-    }
-    const auto& obs = d.points.observations;
-    MatrixXd E = MatrixXd::Zero(static_cast<Index>(obs.size()), 3);
-    for (std::size_t i = 0; i < obs.size(); ++i)
-      for (int o = 0; o < 3; ++o) {
-        const double w = observation_weight(obs[i], o);
-        if (w == 0) continue;
-        for (int k = 0; k < 3; ++k)  // µm of drift along machine axis k
-          E(static_cast<Index>(i), k) += w * (*rt)[obs[i].row](o, k) * signal[obs[i].row];
-      }
-    return E;
-  };
-  c.describe = [sensors](const Variant& v, const VectorXd& coef, EffectFit& fit) {
-    const int kind = static_cast<int>(v.hyper[0]);
-    std::string what = kind == 0 ? "drift per h" : kind == 1 ? "heat-up drift" : "per K";
-    if (kind == 1) fit.params["tau_h"] = v.hyper[1] / 3600;
-    if (kind == 2) {
-      fit.params["sensor_" + sensors[static_cast<std::size_t>(v.hyper[2])]] = 1;
       fit.params["lag_h"] = v.hyper[1] / 3600;
+      what = s + (v.hyper[1] > 0 ? " (lag " + num(v.hyper[1] / 3600, 2) + " h)" : "");
     }
-    std::string s;
-    for (int k = 0; k < 3 && k < coef.size(); ++k) {
-      const std::string axis(1, static_cast<char>('x' + k));
-      fit.params["machine_" + axis + "_um"] = coef[k];
-      s += (k ? ", " : "") + axis + " " + num(coef[k], 2) + " µm";
+    fit.summary =
+        "thermal, " + what + (frame == Frame::Tool ? ", tool side: " : ", machine frame: ") +
+        (drift.empty() ? "" : drift) + (drift.empty() || scale.empty() ? "" : "; ") + scale;
+    // Where: along the signal's own coordinate, in the output the fitted growth moves most.
+    const auto& obs = data.points.observations;
+    const VectorXd moved = cols.E * coef.head(cols.E.cols());
+    std::array<double, kObservationKinds> ss{};
+    for (std::size_t i = 0; i < obs.size(); ++i)
+      ss[static_cast<std::size_t>(obs[i].output)] +=
+          moved[static_cast<Index>(i)] * moved[static_cast<Index>(i)];
+    GapRegion r;
+    r.output = observation_name(
+        static_cast<std::size_t>(std::max_element(ss.begin(), ss.end()) - ss.begin()));
+    if (kind < 2) {
+      r.by = "t_s";
+      r.unit = "s";
+      r.from = tc->t0;
+      r.to = tc->t1;
+    } else {
+      r.by = tc->sensors[static_cast<std::size_t>(v.hyper[2])];
+      r.unit = "°C";
+      const std::vector<double>& T = data.temperature.at(r.by);
+      r.from = INFINITY;
+      r.to = -INFINITY;
+      for (const auto& o : obs)
+        if (std::isfinite(T[o.row]))
+          r.from = std::min(r.from, T[o.row]), r.to = std::max(r.to, T[o.row]);
     }
-    fit.summary = "thermal in the machine frame (" + v.label + "), " + what + ": " + s;
+    fit.region = r;
   };
   out.push_back(std::move(c));
 }

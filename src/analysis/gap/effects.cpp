@@ -18,7 +18,7 @@ std::vector<Candidate> effect_candidates(const EffectContext& ctx,
   std::vector<Candidate> out;
   for (const std::string& n : names) {
     if (n == "thermal_drift")
-      add_thermal(ctx, out), add_thermal_sensors(ctx, out), add_thermal_machine_frame(ctx, out);
+      add_thermal(ctx, out), add_thermal_sensors(ctx, out);
     else if (n == "reversal")
       add_reversal(ctx, out);
     else if (n == "periodic")

@@ -18,6 +18,8 @@
 
 namespace weilgen::gap_detail {
 
+struct AxisError;
+
 // What an effect's columns need to know: the data, the model and its parameterisation, the
 // observation-to-row map, and a numeric chain for the linearised effects.
 struct EffectContext {
@@ -25,6 +27,9 @@ struct EffectContext {
   const Model* model = nullptr;
   const ErrorParameterisation* param = nullptr;
   std::shared_ptr<const NumericChain> chain;  // exact kinematics (higher_order, tool_offset)
+  // The axes' motion errors with their sensitivities (axis_errors(ctx, 6)), shared by the shape
+  // effects; computed on first use.
+  mutable std::shared_ptr<const std::vector<AxisError>> shaped_errors;
 };
 
 struct Variant {
@@ -37,10 +42,14 @@ struct Variant {
   bool needs_theta = false;   // columns depend on the identified parameters
   // Continuous hyper-parameters refined around the grid value: (index, lo, hi) bounds.
   std::vector<Refine> refine;
-  // A shape along one coordinate in one output (periodic, pdge_shape): GapData::axes index and
-  // output 0..5; -1 for other effects. The diagnosis checks that the data can tell the shape
-  // from any other along that coordinate.
+  // A shape along one coordinate (periodic, pdge_shape): GapData::axes index and the output
+  // 0..5 it moves most; -1 for other effects. The diagnosis checks that the data can tell the
+  // shape from any other along that coordinate. `shape_weight`: per observation, how much of
+  // the shaped error it sees (the error's sensitivity); null: the observation's weight in
+  // shape_output. `shape_key` names the shaped quantity (an error), shape_output when empty.
   int shape_axis = -1, shape_output = -1;
+  std::shared_ptr<const Eigen::VectorXd> shape_weight;
+  std::string shape_key;
   // needs_theta: refit θ jointly with the columns this many times before they are taken (the
   // columns at the first-order θ are biased when that θ has absorbed part of the effect).
   int theta_iterations = 0;
@@ -75,7 +84,6 @@ std::vector<Candidate> effect_candidates(const EffectContext& ctx,
 // One family of the library each (effect_*.cpp): appends its candidate, if the data allow it.
 void add_thermal(const EffectContext& ctx, std::vector<Candidate>& out);
 void add_thermal_sensors(const EffectContext& ctx, std::vector<Candidate>& out);
-void add_thermal_machine_frame(const EffectContext& ctx, std::vector<Candidate>& out);
 void add_reversal(const EffectContext& ctx, std::vector<Candidate>& out);
 void add_periodic(const EffectContext& ctx, std::vector<Candidate>& out);
 void add_pdge_shape(const EffectContext& ctx, std::vector<Candidate>& out);
@@ -194,5 +202,34 @@ inline std::vector<double> first_order_lag(const GapData& d, const std::vector<d
 // (mm, deg). An effect of an axis (its backlash, its scale) reaches the outputs through it, the
 // rotation of a turning table included.
 std::vector<Eigen::MatrixXd> axis_jacobians(const EffectContext& ctx);
+
+// A 6-vector deviation (mm, rad) as an observation sees it (µm, µrad; a dr its radial part).
+double measured(const PointObservation& ob, const double* v6);
+
+// The frames a thermal growth is fixed in: the tool's (the spindle grows along its own axis and
+// turns with a head) or the machine base's (a column or ram; a turning table shows its growth
+// rotated). Per table row, the frame's orientation in the workpiece frame, whose outputs the
+// data measure (identity where nothing turns).
+enum class Frame { Tool, Machine };
+std::vector<Eigen::Matrix3d> frame_rotations(const EffectContext& ctx, Frame frame);
+
+// One motion error of one axis that the machine file has (ISO 230-1: E_XX, E_YX ... E_CC) and
+// how much of it every observation sees: the periodic and bump shapes are shapes of one such
+// error along its axis, sent through the kinematics (the model's coefficients at the pose).
+struct AxisError {
+  AxisInfo axis;                         // the axis and its distinct positions
+  int error = -1;                        // Description::errors index
+  std::string name;                      // E_XX
+  bool rotation = false;                 // the error in µrad (else µm)
+  std::vector<std::string> same_as;      // errors of this axis whose columns are proportional
+  int output = 0;                        // the observation kind it moves most
+  std::shared_ptr<const VectorXd> unit;  // per observation: µm (µrad) per µm (µrad) of error
+};
+// The errors of every axis with at least `min_levels` positions that reach the observations,
+// positioning first, then straightness, then angular; errors with the same column (up to a
+// factor) as one before are folded into its `same_as`.
+std::vector<AxisError> axis_errors(const EffectContext& ctx, std::size_t min_levels);
+// axis_errors(ctx, 6), computed once per context.
+std::shared_ptr<const std::vector<AxisError>> shaped_errors(const EffectContext& ctx);
 
 }  // namespace weilgen::gap_detail

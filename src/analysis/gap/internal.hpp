@@ -1,10 +1,11 @@
 // Internals of the gap diagnosis shared by its files (not a public API): the linear engine
-// (the per-fold SVD fits of the baseline), the F-test helpers, the noise floor and the
-// localisation.
+// (the baseline factored in blocks, the fits of every split, extra columns fitted by
+// projection), the F-test helpers, the noise floor and the localisation.
 #pragma once
 
 #include <Eigen/Dense>
 #include <limits>
+#include <memory>
 #include <numeric>
 #include <vector>
 
@@ -22,13 +23,50 @@ double f_sf(double f, double d1, double d2);
 // Distinct finite values.
 std::size_t distinct(const std::vector<double>& v);
 
-// The training fit of one split: A_tr = U S Vᵀ (equilibrated, rank r), the pseudo-inverse as
-// VS·Uᵀ, residuals and test leverages.
+// ---- The linear engine (docs/gap.md, "Baseline"; docs/performance.md, "Gap diagnosis") ----
+// The design is factored once per block of observations: A_b = Q_b R_b with Q_b orthonormal
+// (n_b × k_b, k_b the block's numerical rank) and R_b (k_b × p). A block never straddles a
+// held-out part, so every split's training part is a union of blocks and its fit is the
+// column-equilibrated SVD of the stacked R_b (a few hundred rows whatever the number of
+// observations): the same SVD as that of the training rows of A, to rounding. Extra columns E
+// are projected once per block (Q_bᵀ E_b) and the projections serve every split.
+struct BlockFactors {
+  std::vector<std::vector<std::size_t>> rows;  // observation indices of each block, ascending
+  std::vector<int> part;                       // the block's part of the partition
+  std::vector<MatrixXd> Q, R;
+  std::vector<VectorXd> qty;  // Q_bᵀ y_b
+  Index cols = 0;             // p
+};
+
+// Factors A (rows × p) in blocks: each part of `parts` (observation indices) is cut into
+// blocks of at most kBlockRows rows; blocks are factored in parallel (the blocks do not depend
+// on the thread count, so neither do the results).
+inline constexpr std::size_t kBlockRows = 4096;
+std::shared_ptr<const BlockFactors> factor_blocks(
+    const MatrixXd& A, const VectorXd& y, const std::vector<std::vector<std::size_t>>& parts,
+    unsigned threads);
+
+// The fit of the blocks of some parts (a split's training part, or all data): θ (minimum norm,
+// rank cut 1e-9 on equilibrated columns), the pseudo-inverse's right factor VS (A⁺ = VS Uᵀ),
+// U = blockdiag(Q_b) · UM, and R_b θ per block for the residual of projected columns.
 struct FoldFit {
-  MatrixXd U, VS, W;  // W = A_test · VS
-  VectorXd theta, res_train, res_test, lev_test;
+  std::vector<std::size_t> blocks;                // the training blocks
+  MatrixXd UM, VS;                                // (Σ k_b × rank), (p × rank)
+  std::vector<VectorXd> Rtheta;                   // per training block (same order as `blocks`)
+  std::vector<VectorXd> qty;                      // per training block: Q_bᵀ y_b
+  VectorXd theta, res_train, res_test, lev_test;  // res_* in the split's train/test order
+  VectorXd lev_train;   // leverage of each training row (only when asked for)
+  double train_ss = 0;  // |res_train|²
   std::size_t rank = 0;
 };
+
+// The fit of `s` (its training rows must be a union of blocks, its test rows too).
+FoldFit fit_split(const BlockFactors& F, const MatrixXd& A, const VectorXd& y, const Split& s,
+                  bool train_leverage = false);
+
+// One fit on all rows (gross readings): factored in blocks on `threads` cores; with the
+// leverage of every row.
+FoldFit fit_fold(const MatrixXd& A, const VectorXd& y, const Split& s, unsigned threads = 1);
 
 inline MatrixXd rows_of(const MatrixXd& M, const std::vector<std::size_t>& idx) {
   MatrixXd R(static_cast<Index>(idx.size()), M.cols());
@@ -43,8 +81,6 @@ inline VectorXd rows_of(const VectorXd& v, const std::vector<std::size_t>& idx) 
   return R;
 }
 
-FoldFit fit_fold(const MatrixXd& A, const VectorXd& y, const Split& s);
-
 // The split that trains on every observation (and holds none out).
 inline Split all_rows(std::size_t n) {
   Split s;
@@ -53,30 +89,27 @@ inline Split all_rows(std::size_t n) {
   return s;
 }
 
-struct Engine {
+class Engine {
+ public:
+  Engine(const GapData& d, MatrixXd design, VectorXd values, unsigned threads_)
+      : data(d), A(std::move(design)), y(std::move(values)), threads(threads_) {}
   const GapData& data;
   MatrixXd A;  // baseline (plus accepted effects)
   VectorXd y;
+  unsigned threads = 1;
   std::vector<Split> splits;
+  std::shared_ptr<const BlockFactors> factors;  // of A, in blocks of the splits' parts
   std::vector<FoldFit> folds;
   double full_sse = 0;
   std::size_t full_rank = 0;
   FoldFit full;  // the fit on all data
 
   // The fit on all data (its rank sizes the splits; its SSE is the F tests' reference).
-  void fit_full() {
-    full = fit_fold(A, y, all_rows(static_cast<std::size_t>(y.size())));
-    full_sse = full.res_train.squaredNorm();
-    full_rank = full.rank;
-  }
-  void fit_folds() {
-    folds.clear();
-    for (const Split& s : splits) folds.push_back(fit_fold(A, y, s));
-  }
-  void refit() {
-    fit_full();
-    fit_folds();
-  }
+  void fit_full();
+  // Factors A in the splits' blocks and fits every split (and all data again, from the same
+  // factors) in parallel.
+  void fit_folds();
+  void refit() { fit_folds(); }
   // Held-out residual and leverage per observation.
   void heldout(VectorXd& r, VectorXd& h) const {
     r = VectorXd::Constant(y.size(), kNaN);
@@ -88,6 +121,60 @@ struct Engine {
       }
   }
 };
+
+// Groups of extra columns (a variant's, observations × q each) seen through block factors:
+// G_b = Q_bᵀ E_b for all groups at once (one pass over the blocks), and per group E_bᵀE_b and
+// E_bᵀy_b.
+// The fit from these sums (fit_extra) reads a column's part outside the model's span as the
+// difference |E|² − |P|²; when that part is small (below 1e-3 of the column) the difference has
+// lost digits, and the exact projection (project_exact: one group, the rest E_b − Q_b G_b
+// formed and orthogonalised twice, its Gram matrix summed directly) takes over.
+struct Projection {
+  std::vector<MatrixXd> G;                 // per block: k_b × m
+  std::vector<std::vector<MatrixXd>> EtE;  // per block, per group: q × q
+  std::vector<std::vector<VectorXd>> Ety;  // per block, per group: q
+  std::vector<Index> start, width;         // each group's columns
+  bool exact = false;                      // one group; Perp and Perpy hold the rest's sums
+  std::vector<MatrixXd> Perp;              // per block: (E_b − Q_b G_b)ᵀ(E_b − Q_b G_b)
+  std::vector<VectorXd> Perpy;             // per block: (E_b − Q_b G_b)ᵀ y_b
+};
+Projection project(const BlockFactors& F, const std::vector<MatrixXd>& groups, const VectorXd& y);
+Projection project_exact(const BlockFactors& F, const MatrixXd& E, const VectorXd& y);
+
+// The least-squares fit of one group of projected columns to the training residual of split
+// fold `ff` (the joint fit [A_train E_train], by projection): the columns' coefficients c, their
+// projection P = Uᵀ E_train onto the model's span, and the training SSE after. A column whose
+// part outside the model's span and the group's other columns is below 1e-6 of its norm is
+// dropped (coefficient 0); no usable column: `usable` false. `ill_conditioned`: a kept column's
+// part is below 1e-3 of it and the projection is not exact (fit again from project_exact).
+struct ExtraFit {
+  bool usable = false, ill_conditioned = false;
+  VectorXd coef;
+  MatrixXd P;
+  double train_sse = 0;
+};
+ExtraFit fit_extra(const FoldFit& ff, const Projection& pr, std::size_t group);
+// fit_extra, again from the exact projection of the group's columns E_group (computed once
+// into `exact` when a fit needs it).
+ExtraFit fit_extra(const FoldFit& ff, const Projection& pr, std::size_t group,
+                   const BlockFactors& F, const Eigen::Ref<const MatrixXd>& E_group,
+                   const VectorXd& y, Projection& exact);
+
+// The held-out residual after the extra columns of `fit` (split `s`, fit `ff`): res_test −
+// (E_test − A_test·VS·P)·c.
+VectorXd heldout_after(const FoldFit& ff, const Split& s, const MatrixXd& A, const MatrixXd& E,
+                       const ExtraFit& fit);
+
+// The joint least-squares fit of [A E] on all data, from A's block factors (docs/gap.md, the
+// nested F test): its rank (equilibrated SVD, cut 1e-9), SSE and the coefficients of E.
+struct JointFit {
+  std::size_t rank = 0;
+  double sse = 0;
+  VectorXd coef;  // of E's columns (minimum-norm joint solution)
+};
+JointFit joint_fit(const BlockFactors& F, const MatrixXd& A, const VectorXd& y, const MatrixXd& E);
+// The rank of [A E] alone (the same cut).
+std::size_t joint_rank(const BlockFactors& F, const MatrixXd& E);
 
 // Baseline θ of a split in the parameterisation's full size (effects may append columns).
 inline std::vector<double> split_theta(const VectorXd& theta, std::size_t np) {

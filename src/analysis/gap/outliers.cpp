@@ -2,8 +2,10 @@
 // by 1 − its leverage, so a reading at the edge of the design cannot hide) lies beyond
 // max(6, z_n) robust standard deviations of its output's residuals (z_n: the two-sided normal
 // quantile that n readings exceed by chance with probability 1 %), and whose nearest neighbours
-// in the pose space do not share it. A smooth effect (a bump, a reversal, a drift) moves its
-// neighbours too, so it is not taken for an outlier; a spike is.
+// do not share it: neither those in the pose space nor, when the data have a time, those
+// nearest in time. A smooth effect moves its neighbours too (a bump or a reversal its pose
+// neighbours, a drift its time neighbours: the same pose an hour later is not its neighbour),
+// so it is not taken for an outlier; a spike is.
 #include <algorithm>
 #include <boost/math/distributions/normal.hpp>
 #include <cmath>
@@ -49,6 +51,23 @@ std::vector<GapOutlier> find_outliers(const GapData& d, const VectorXd& r) {
     const boost::math::normal_distribution<double> normal;
     const double z =
         std::max(6.0, boost::math::quantile(boost::math::complement(normal, 0.005 / n)));
+    // Structure when neighbours share a good part of the deviation (a bump or a step moves them
+    // by a similar amount); a spike's neighbours are at most pulled a little by the fit.
+    auto shared = [&](const std::vector<std::size_t>& nb, double dev) {
+      std::vector<double> around;
+      for (std::size_t j : nb)
+        around.push_back(std::abs(r[static_cast<Index>(j)] - centre) / sigma);
+      return !around.empty() && median(around) > std::max(3.0, 0.3 * dev);
+    };
+    // The same output's readings in time order (rows without a time left out).
+    std::vector<std::size_t> by_time;
+    for (std::size_t i : mine)
+      if (std::isfinite(d.time_s[obs[i].row])) by_time.push_back(i);
+    std::stable_sort(by_time.begin(), by_time.end(), [&](std::size_t a, std::size_t b) {
+      return d.time_s[obs[a].row] < d.time_s[obs[b].row];
+    });
+    std::vector<std::size_t> time_rank(obs.size(), SIZE_MAX);
+    for (std::size_t k = 0; k < by_time.size(); ++k) time_rank[by_time[k]] = k;
     for (std::size_t i : mine) {
       const double dev = std::abs(r[static_cast<Index>(i)] - centre) / sigma;
       if (dev <= z) continue;
@@ -65,12 +84,17 @@ std::vector<GapOutlier> find_outliers(const GapData& d, const VectorXd& r) {
       }
       const std::size_t k = std::min<std::size_t>(4, near.size());
       std::partial_sort(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(k), near.end());
-      std::vector<double> around;
-      for (std::size_t m = 0; m < k; ++m)
-        around.push_back(std::abs(r[static_cast<Index>(near[m].second)] - centre) / sigma);
-      // Structure when the neighbours share a good part of it (a bump or a step moves them by a
-      // similar amount); a spike's neighbours are at most pulled a little by the fit.
-      if (k > 0 && median(around) > std::max(3.0, 0.3 * dev)) continue;
+      std::vector<std::size_t> pose_nb;
+      for (std::size_t m = 0; m < k; ++m) pose_nb.push_back(near[m].second);
+      if (shared(pose_nb, dev)) continue;
+      // Its neighbours in time: two before and two after.
+      if (time_rank[i] != SIZE_MAX) {
+        std::vector<std::size_t> time_nb;
+        const std::size_t t = time_rank[i];
+        for (std::size_t m = t >= 2 ? t - 2 : 0; m <= t + 2 && m < by_time.size(); ++m)
+          if (m != t && obs[by_time[m]].row != obs[i].row) time_nb.push_back(by_time[m]);
+        if (shared(time_nb, dev)) continue;
+      }
       GapOutlier g;
       g.observation = i;
       g.line = obs[i].line;
