@@ -228,16 +228,29 @@ struct Builder {
   }
 
   // A coefficient with reciprocals as one fraction over a single divisor when it has one:
-  // 1 + (L01 + x − L04)·_inv0 with _inv0 = 1/(L04 − L01 − x − LW) becomes −LW·_inv0. For each
-  // reciprocal r = 1/D in c = Σ_k a_k r^k (k ≤ K): N = Σ_k a_k D^(K−k), so c = N r^K; D is
-  // divided out of N while it divides exactly. The result replaces c when K ends at 0 or 1;
-  // otherwise c stays as it is. Exact polynomial division, not GiNaC's normal(): the same result
-  // without a gcd per coefficient.
+  // 1 + (L01 + x − L04)·_inv0 with _inv0 = 1/(L04 − L01 − x − LW) becomes −LW·_inv0. With one
+  // reciprocal r = 1/D in c = Σ_k a_k r^k (k ≤ K): N = Σ_k a_k D^(K−k), so c = N r^K; D is divided
+  // out of N while it divides exactly (over_one_divisor: no gcd per coefficient). With several
+  // reciprocals GiNaC's normal(), which may cancel all but one divisor. Anything else (several
+  // divisors left, or a power of one) stays as it is.
   ex as_fraction(const ex& c) const {
-    ex out = c;
+    const Reciprocal* only = nullptr;
+    std::size_t present = 0;
     for (const Reciprocal& r : model.reciprocals)
-      if (out.has(r.symbol)) out = over_one_divisor(out, r);
-    return out;
+      if (c.has(r.symbol)) {
+        only = &r;
+        ++present;
+      }
+    if (present == 0) return c;
+    if (present == 1) return over_one_divisor(c, *only);
+    const ex nd = GiNaC::normal(model.with_divisors(c)).numer_denom();
+    const ex num = nd.op(0).expand(), den = nd.op(1).expand();
+    if (GiNaC::is_a<GiNaC::numeric>(den)) return alg.normalize(num / den);
+    for (const Reciprocal& r : model.reciprocals) {
+      if ((den - r.divisor).expand().is_zero()) return alg.normalize(num * r.symbol);
+      if ((den + r.divisor).expand().is_zero()) return alg.normalize(-num * r.symbol);
+    }
+    return c;
   }
 
   ex over_one_divisor(const ex& c, const Reciprocal& r) const {
