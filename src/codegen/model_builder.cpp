@@ -228,10 +228,21 @@ struct Builder {
   }
 
   // A coefficient with reciprocals as one fraction over a single divisor when it has one:
-  // 1 + (L01 + x − L04)·_inv0 with _inv0 = 1/(L04 − L01 − x − LW) becomes −LW·_inv0. Anything else
-  // (several divisors) stays as it is.
+  // 1 + (L01 + x − L04)·_inv0 with _inv0 = 1/(L04 − L01 − x − LW) becomes −LW·_inv0. With one
+  // reciprocal r = 1/D in c = Σ_k a_k r^k (k ≤ K): N = Σ_k a_k D^(K−k), so c = N r^K; D is divided
+  // out of N while it divides exactly (over_one_divisor: no gcd per coefficient). With several
+  // reciprocals GiNaC's normal(), which may cancel all but one divisor. Anything else (several
+  // divisors left, or a power of one) stays as it is.
   ex as_fraction(const ex& c) const {
-    if (model.reciprocals.empty()) return c;
+    const Reciprocal* only = nullptr;
+    std::size_t present = 0;
+    for (const Reciprocal& r : model.reciprocals)
+      if (c.has(r.symbol)) {
+        only = &r;
+        ++present;
+      }
+    if (present == 0) return c;
+    if (present == 1) return over_one_divisor(c, *only);
     const ex nd = GiNaC::normal(model.with_divisors(c)).numer_denom();
     const ex num = nd.op(0).expand(), den = nd.op(1).expand();
     if (GiNaC::is_a<GiNaC::numeric>(den)) return alg.normalize(num / den);
@@ -240,6 +251,23 @@ struct Builder {
       if ((den + r.divisor).expand().is_zero()) return alg.normalize(-num * r.symbol);
     }
     return c;
+  }
+
+  ex over_one_divisor(const ex& c, const Reciprocal& r) const {
+    const ex e = c.expand();
+    int k_max = e.degree(r.symbol);
+    if (k_max <= 0) return c;
+    const ex den = r.divisor.expand();
+    ex num = 0;
+    for (int k = 0; k <= k_max; ++k) num += e.coeff(r.symbol, k) * GiNaC::pow(den, k_max - k);
+    num = num.expand();
+    try {
+      for (ex q; k_max > 0 && GiNaC::divide(num, den, q); --k_max) num = q;
+    } catch (const std::exception&) {
+      return c;  // not a polynomial over the rationals (a function of a linked angle): as it is
+    }
+    if (k_max > 1) return c;
+    return alg.normalize(k_max == 0 ? num : num * r.symbol);
   }
 
   // P = Π steps · Trans(point), with the chain points' deviations P(e) − P(0) (base frame) and the

@@ -86,6 +86,45 @@ std::string ExprPrinter::print(const ex& e) {
   return neg ? "-" + t : t;
 }
 
+namespace {
+bool is_divisor(const ex& e) {
+  return GiNaC::is_a<GiNaC::power>(e) && GiNaC::is_a<GiNaC::numeric>(e.op(1)) &&
+         GiNaC::ex_to<GiNaC::numeric>(e.op(1)).is_negative();
+}
+// (a + b)^n, n odd and positive: its sign, like a sum's, is GiNaC's hash-order choice.
+bool is_odd_power_of_sum(const ex& e) {
+  return GiNaC::is_a<GiNaC::power>(e) && GiNaC::is_a<GiNaC::add>(e.op(0)) &&
+         GiNaC::is_a<GiNaC::numeric>(e.op(1)) &&
+         GiNaC::ex_to<GiNaC::numeric>(e.op(1)).is_pos_integer() &&
+         GiNaC::ex_to<GiNaC::numeric>(e.op(1)).is_odd();
+}
+}  // namespace
+
+GiNaC::numeric ExprPrinter::printed_coefficient(const ex& e) {
+  if (GiNaC::is_a<GiNaC::numeric>(e)) return GiNaC::ex_to<GiNaC::numeric>(e);
+  const bool divisor = is_divisor(e);
+  if (!GiNaC::is_a<GiNaC::mul>(e) && !divisor) return 1;
+  GiNaC::numeric coeff = 1;
+  for (std::size_t i = 0; i < (divisor ? 1 : e.nops()); ++i) {
+    const ex op = divisor ? e : e.op(i);
+    if (GiNaC::is_a<GiNaC::numeric>(op)) {
+      coeff *= GiNaC::ex_to<GiNaC::numeric>(op);
+    } else if (is_divisor(op) && GiNaC::is_a<GiNaC::add>(op.op(0))) {
+      // the divisor's sign as CanonicalText chooses it
+      if (canon_.canonical_sign(op.op(0)).negated &&
+          GiNaC::ex_to<GiNaC::numeric>(op.op(1)).is_odd())
+        coeff = -coeff;
+    } else if (GiNaC::is_a<GiNaC::add>(op)) {
+      if (canon_.canonical_sign(op).negated) coeff = -coeff;
+    } else if (is_odd_power_of_sum(op)) {
+      if (canon_.canonical_sign(op.op(0)).negated) coeff = -coeff;
+    }
+  }
+  return coeff;
+}
+
+bool ExprPrinter::prints_negative(const ex& e) { return printed_coefficient(e).is_negative(); }
+
 std::string ExprPrinter::term(const ex& e, bool& negative) {
   negative = false;
   if (GiNaC::is_a<GiNaC::numeric>(e)) {
@@ -96,27 +135,23 @@ std::string ExprPrinter::term(const ex& e, bool& negative) {
     }
     return number(n);
   }
-  const bool divisor = GiNaC::is_a<GiNaC::power>(e) && GiNaC::is_a<GiNaC::numeric>(e.op(1)) &&
-                       GiNaC::ex_to<GiNaC::numeric>(e.op(1)).is_negative();
+  const bool divisor = is_divisor(e);
   if (!GiNaC::is_a<GiNaC::mul>(e) && !divisor) return factor(e);
-  GiNaC::numeric coeff = 1;
+  GiNaC::numeric coeff = printed_coefficient(e);
   std::vector<std::string> num, den;
   for (const ex& op : divisor ? std::vector<ex>{e} : canon_.sorted_ops(e)) {
-    if (GiNaC::is_a<GiNaC::numeric>(op)) {
-      coeff *= GiNaC::ex_to<GiNaC::numeric>(op);
-    } else if (GiNaC::is_a<GiNaC::power>(op) && GiNaC::is_a<GiNaC::numeric>(op.op(1)) &&
-               GiNaC::ex_to<GiNaC::numeric>(op.op(1)).is_negative()) {
-      ex base = op.op(0);
-      if (GiNaC::is_a<GiNaC::add>(base)) {  // the divisor's sign as CanonicalText chooses it
-        const CanonicalText::Signed r = canon_.canonical_sign(base);
-        if (r.negated && GiNaC::ex_to<GiNaC::numeric>(op.op(1)).is_odd()) coeff = -coeff;
-        base = r.value;
-      }
-      den.push_back(factor(GiNaC::pow(base, -op.op(1))));
+    if (GiNaC::is_a<GiNaC::numeric>(op)) continue;
+    if (is_divisor(op)) {
+      const ex base =
+          GiNaC::is_a<GiNaC::add>(op.op(0)) ? canon_.canonical_sign(op.op(0)).value : op.op(0);
+      // Printed as base^n directly: GiNaC::pow(base, n) would take an odd power's sign out of a
+      // sum by its hash order, which differs between runs.
+      den.push_back(power(base, -GiNaC::ex_to<GiNaC::numeric>(op.op(1)).to_long()));
     } else if (GiNaC::is_a<GiNaC::add>(op)) {
-      const CanonicalText::Signed r = canon_.canonical_sign(op);
-      if (r.negated) coeff = -coeff;
-      num.push_back(factor(r.value));
+      num.push_back(factor(canon_.canonical_sign(op).value));
+    } else if (is_odd_power_of_sum(op)) {
+      num.push_back(power(canon_.canonical_sign(op.op(0)).value,
+                          GiNaC::ex_to<GiNaC::numeric>(op.op(1)).to_long()));
     } else {
       num.push_back(factor(op));
     }
@@ -149,6 +184,20 @@ std::string ExprPrinter::term(const ex& e, bool& negative) {
   return s;
 }
 
+std::string ExprPrinter::power(const ex& base, long n) {
+  const std::string b = factor(base);
+  if (n == 1) return b;
+  if (style_ != Style::Cpp)
+    return b + (style_ == Style::Latex ? "^{" : "^") + std::to_string(n) +
+           (style_ == Style::Latex ? "}" : "");
+  std::string s = b;
+  for (long i = 1; i < n; ++i) {
+    s += " * " + b;
+    ++ops_.muls;
+  }
+  return "(" + s + ")";
+}
+
 std::string ExprPrinter::factor(const ex& e) {
   if (GiNaC::is_a<GiNaC::symbol>(e)) return symbol(e);
   if (!has_symbol(e)) {  // constants such as cos(Pi/9) or sqrt(2)
@@ -177,24 +226,15 @@ std::string ExprPrinter::factor(const ex& e) {
       const long n = GiNaC::ex_to<GiNaC::numeric>(expo).to_long();
       // An even power of a sum: GiNaC picks the base's sign by hash order; print the canonical
       // one (the sign does not matter).
-      const std::string b = GiNaC::is_a<GiNaC::add>(base) && n % 2 == 0
-                                ? factor(canon_.canonical_sign(base).value)
-                                : factor(base);
-      if (style_ != Style::Cpp)
-        return b + (style_ == Style::Latex ? "^{" : "^") + std::to_string(n) +
-               (style_ == Style::Latex ? "}" : "");
-      std::string s = b;
-      for (long i = 1; i < n; ++i) {
-        s += " * " + b;
-        ++ops_.muls;
-      }
-      return "(" + s + ")";
+      return power(
+          GiNaC::is_a<GiNaC::add>(base) && n % 2 == 0 ? canon_.canonical_sign(base).value : base,
+          n);
     }
     if (GiNaC::is_a<GiNaC::numeric>(expo) && GiNaC::ex_to<GiNaC::numeric>(expo).is_integer() &&
         GiNaC::ex_to<GiNaC::numeric>(expo).is_negative()) {
       // A divisor (derived ratios): 1 / b^n.
       ++ops_.divs;
-      const std::string den = factor(GiNaC::pow(base, -expo));
+      const std::string den = power(base, -GiNaC::ex_to<GiNaC::numeric>(expo).to_long());
       if (style_ == Style::Latex) return "\\frac{1}{" + den + "}";
       return (style_ == Style::Cpp ? "Scalar(1) / " : "1 / ") + den;
     }

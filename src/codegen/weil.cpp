@@ -19,6 +19,8 @@ bool divides(const Monomial& divisor, const Monomial& m) {
 
 Algebra::Algebra(int order, std::vector<Monomial> relations, GiNaC::exmap trig_rules)
     : order_(order), trig_rules_(std::move(trig_rules)) {
+  for (const auto& [from, to] : trig_rules_)
+    if (GiNaC::is_a<GiNaC::power>(from)) trig_bases_.push_back(from.op(0));
   // Keep only minimal generators: drop those of degree > r (already vanish) and multiples.
   for (auto& r : relations) std::sort(r.begin(), r.end());
   std::sort(relations.begin(), relations.end(), [](const Monomial& a, const Monomial& b) {
@@ -38,9 +40,27 @@ bool Algebra::vanishes(const Monomial& m) const {
                      [&](const Monomial& g) { return divides(g, m); });
 }
 
+namespace {
+// True when e has a power (exponent >= 2) of one of `bases`: the only case cos² → 1 − sin² can
+// change. A walk is far cheaper than GiNaC's algebraic substitution, which most coefficients do
+// not need.
+bool has_square_of(const ex& e, const GiNaC::exvector& bases) {
+  if (GiNaC::is_a<GiNaC::power>(e)) {
+    for (const ex& b : bases)
+      if (e.op(0).is_equal(b)) return true;
+    return has_square_of(e.op(0), bases);
+  }
+  if (GiNaC::is_a<GiNaC::symbol>(e) || GiNaC::is_a<GiNaC::numeric>(e)) return false;
+  for (std::size_t i = 0; i < e.nops(); ++i)
+    if (has_square_of(e.op(i), bases)) return true;
+  return false;
+}
+}  // namespace
+
 ex Algebra::normalize(const ex& c) const {
   ex e = c.expand();
   if (trig_rules_.empty()) return e;
+  if (trig_bases_.size() == trig_rules_.size() && !has_square_of(e, trig_bases_)) return e;
   // Repeat: one algebraic pass lowers cos^n to cos^(n-2)·(1 − sin²).
   for (int pass = 0; pass < 8; ++pass) {
     ex reduced = e.subs(trig_rules_, GiNaC::subs_options::algebraic).expand();
@@ -112,20 +132,28 @@ Poly Poly::scaled(const ex& c, const Algebra& alg) const {
 
 Poly Poly::mul(const Poly& o, const Algebra& alg) const {
   if (is_zero() || o.is_zero()) return {};
+  // o's terms by degree: a term of degree d meets only those of degree <= r - d, so the pairs
+  // that truncation drops are never visited.
+  const int r = alg.order();
+  std::vector<std::vector<const Terms::value_type*>> by_degree(static_cast<std::size_t>(r) + 1);
+  for (const auto& t : o.terms_)
+    if (static_cast<int>(t.first.size()) <= r) by_degree[t.first.size()].push_back(&t);
   // Sum raw products per monomial, normalise each sum once.
   std::map<Monomial, GiNaC::exvector> raw;
   for (const auto& [ma, ca] : terms_) {
-    for (const auto& [mb, cb] : o.terms_) {
-      if (static_cast<int>(ma.size() + mb.size()) > alg.order()) continue;
-      Monomial m = monomial_product(ma, mb);
-      if (alg.vanishes(m)) continue;  // never formed: truncation inside the product
-      raw[m].push_back(ca * cb);
+    const int room = r - static_cast<int>(ma.size());
+    for (int d = 0; d <= room; ++d) {
+      for (const auto* tb : by_degree[static_cast<std::size_t>(d)]) {
+        Monomial m = monomial_product(ma, tb->first);
+        if (alg.vanishes(m)) continue;  // never formed: truncation inside the product
+        raw[std::move(m)].push_back(ca * tb->second);
+      }
     }
   }
   Poly p;
   for (auto& [m, parts] : raw) {
     ex c = alg.normalize(GiNaC::add(parts));
-    if (!c.is_zero()) p.terms_.emplace(m, c);
+    if (!c.is_zero()) p.terms_.emplace_hint(p.terms_.end(), m, c);
   }
   return p;
 }

@@ -25,12 +25,18 @@ class ExprPrinter {
   // `names` maps symbol names to the text printed for them (others print as their name).
   ExprPrinter(Style style, std::map<std::string, std::string> names = {});
   std::string print(const GiNaC::ex& e);
+  // True when print(e) of a single term starts with '-' (its printed numeric factor is negative).
+  bool prints_negative(const GiNaC::ex& e);
   const OpCount& ops() const { return ops_; }
   void reset_ops() { ops_ = {}; }
 
  private:
   std::string term(const GiNaC::ex& e, bool& negative);  // one summand, sign split off
-  std::string factor(const GiNaC::ex& e);                // operand of a product
+  // The numeric factor term() prints: the product's numbers, with the sign flips of sums and
+  // odd divisors taken in their canonical sign.
+  GiNaC::numeric printed_coefficient(const GiNaC::ex& e);
+  std::string factor(const GiNaC::ex& e);            // operand of a product
+  std::string power(const GiNaC::ex& base, long n);  // base^n, n >= 1, as a factor
   std::string number(const GiNaC::numeric& n);
   std::string symbol(const GiNaC::ex& e);
   Style style_;

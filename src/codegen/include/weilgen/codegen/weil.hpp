@@ -37,6 +37,7 @@ class Algebra {
   int order_;
   std::vector<Monomial> relations_;  // minimal generators besides the degree bound
   GiNaC::exmap trig_rules_;
+  GiNaC::exvector trig_bases_;  // x of every rule x^2 -> ...
 };
 
 // An algebra element: Σ coefficient · monomial. Zero coefficients are never stored.
