@@ -2,6 +2,8 @@
 // numeric-chain fallback without a compiler; all engines agree.
 #include <doctest/doctest.h>
 
+#include <algorithm>
+
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -159,8 +161,12 @@ TEST_CASE("model loader: a cached model of an older ABI version is compiled agai
   std::vector<std::string> log;
   const auto model = load_model(d, options_in(cache, &log));
   CHECK(model->engine() == ModelEngine::Compiled);
+  // Without the cache's integrity trailer the entry is first discarded as damaged (a note);
+  // either way it is compiled again.
   REQUIRE_FALSE(log.empty());
-  CHECK(log.front().find("compiling model two_axis") == 0);
+  CHECK(std::any_of(log.begin(), log.end(), [](const std::string& l) {
+    return l.find("compiling model two_axis") == 0;
+  }));
   CHECK(batch_matches(*model));
   // The new object replaced the stale one: the next load is a cache hit.
   std::vector<std::string> log2;

@@ -69,7 +69,7 @@ Line table_line(const Description& d, const AxisCompTableOptions& options) {
 
 void check_comp_table_flags(const std::string& path, const AxisCompTableOptions& options,
                             const std::vector<std::string>& given,
-                            const std::vector<std::string>& inputs, bool model_axis) {
+                            const std::vector<PathArg>& inputs, bool model_axis) {
   if (path.empty()) {
     if (!given.empty()) throw std::invalid_argument(given.front() + " needs --comp-table FILE");
     return;
@@ -78,9 +78,7 @@ void check_comp_table_flags(const std::string& path, const AxisCompTableOptions&
     options.validate();
   else
     options.table.validate();
-  std::vector<PathArg> in;
-  for (const std::string& i : inputs) in.push_back({"", i});
-  check_output_paths(in, {{"--comp-table", path}});
+  check_output_paths(inputs, {{"--comp-table", path}});
 }
 
 void check_axis_comp_table(const Description& desc, const AxisCompTableOptions& options) {

@@ -45,7 +45,7 @@ int verb_sensitivity(const Args& args) {
       "replicates", ranged(&replicates, NumberRange::whole_numbers(2, 1024)),
       "R independent randomised replicates of N/R rows each (default 8): each index is their "
       "mean, its interval mean +- t sd/sqrt(R); N must be a multiple of R")(
-      "bootstrap", ranged(&bootstrap, NumberRange::whole_numbers(0, 1e6)),
+      "bootstrap", ranged(&bootstrap, NumberRange::whole_numbers(0, 1e5)),
       "percentile bootstrap with B resamples instead of replicates (0 = no intervals); on QMC a "
       "conservative bound")("confidence",
                             ranged(&confidence, NumberRange::open(0, 1))->default_value(confidence),

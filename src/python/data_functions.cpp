@@ -49,7 +49,7 @@ struct CompTableCall {
   std::string path;
   AxisCompTableOptions options;
 
-  CompTableCall(const Keywords& kw, bool model_axis, const std::vector<std::string>& inputs) {
+  CompTableCall(const Keywords& kw, bool model_axis, const std::vector<PathArg>& inputs) {
     kw.set("comp_table", path);
     kw.set("comp_type", options.table.type);
     kw.set("comp_units", options.table.linear_unit);
@@ -98,7 +98,7 @@ py::object iso230_2(py::handle data, const py::kwargs& kwargs) {
   std::string plot;
   kw.set("plot", plot);
   if (!plot.empty()) check_plot_target(plot);
-  const CompTableCall comp(kw, false, {path});
+  const CompTableCall comp(kw, false, {{"data file", path}});
   Messages messages(true);
   const nlohmann::json doc = without_gil([&] {
     const MeasurementTable table = read_measurements(path, ro);
@@ -163,8 +163,9 @@ py::object identify(py::handle machine, const py::kwargs& kwargs) {
   std::string emit;
   kw.set("emit_params", emit);
   rq.validate();
-  std::vector<std::string> inputs = rq.data;
-  inputs.insert(inputs.end(), rq.predict.begin(), rq.predict.end());
+  std::vector<PathArg> inputs;
+  for (const std::string& d : rq.data) inputs.push_back({"--data", d});
+  for (const std::string& p : rq.predict) inputs.push_back({"--predict", p});
   const CompTableCall comp(kw, true, inputs);
   const nlohmann::json doc = without_gil([&] {
     if (!comp.path.empty()) check_axis_comp_table(rq.description(), comp.options);

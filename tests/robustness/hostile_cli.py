@@ -79,7 +79,8 @@ NUMERIC = [
 CASES = [
     # Memory and size estimates, before allocating anything.
     (SENS + " --samples 4000000000", 2, ["--samples 4000000000", "memory"]),
-    (SENS + " --samples 400000000 --bootstrap 1000000", 2, ["--bootstrap", "memory"]),
+    (SENS + " --samples 400000000 --bootstrap 100000", 2, ["memory"]),
+    (SENS + " --samples 1024 --bootstrap 1000000", 2, ["--bootstrap", "out of range"]),
     ("show pipe_cutter --order 9", 2, ["--order 9", "error monomials"]),
     ("generate pipe_cutter --order 20 --out out", 2, ["--order 20", "error monomials"]),
     ("sensitivity pipe_cutter --order 12 --at X=0 --quiet", 2, ["--order 12"]),

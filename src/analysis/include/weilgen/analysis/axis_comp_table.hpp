@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "weilgen/analysis/identify.hpp"
+#include "weilgen/base/output_paths.hpp"
 #include "weilgen/measure/comp_table.hpp"
 #include "weilgen/model/model.hpp"
 
@@ -39,7 +40,7 @@ struct AxisCompTableOptions {
 // flag).
 void check_comp_table_flags(const std::string& path, const AxisCompTableOptions& options,
                             const std::vector<std::string>& given,
-                            const std::vector<std::string>& inputs, bool model_axis);
+                            const std::vector<PathArg>& inputs, bool model_axis);
 
 // Checks the options against the machine before any work: validate(), the axis a coordinate
 // of the model with a finite range, --comp-at naming the other axes within their ranges
