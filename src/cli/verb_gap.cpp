@@ -24,7 +24,7 @@ int verb_gap(const Args& args) {
       "(by output, coordinate, time, direction, cycle, temperatures, covariates), ranks the\n"
       "candidate unmodelled effects by held-out improvement with a test corrected for the extra\n"
       "parameters, and says how far the gap shrinks. docs/gap.md.\n\nOptions");
-  std::string data, holdout = "auto", json_path, report_path, plot_dir;
+  std::string data, holdout = "auto", json_path, csv_path, report_path, plot_dir;
   std::vector<std::string> effects, pdge, at;
   double alpha = 0.01;
   unsigned threads = 0;
@@ -43,6 +43,8 @@ int verb_gap(const Args& args) {
       "alpha", ranged(&alpha, NumberRange::open(0, 0.5))->default_value(alpha),
       "family-wise false-positive rate of each decision")(
       "json", po::value<std::string>(&json_path), "write the results as JSON to FILE")(
+      "csv", po::value<std::string>(&csv_path),
+      "write the candidate effects, one row each in ranking order, to FILE (CSV)")(
       "report", po::value<std::string>(&report_path), "write a Markdown report to FILE")(
       "plot", po::value<std::string>(&plot_dir),
       "draw residual-versus-coordinate and effect-ranking plots into DIR (PNG)")(
@@ -60,7 +62,8 @@ int verb_gap(const Args& args) {
   flags.machine = vm["machine"].as<std::string>();
   std::vector<PathArg> inputs = study_inputs(flags);
   inputs.push_back({"--data", data});
-  check_output_paths(inputs, {{"--json", json_path}, {"--report", report_path}});
+  check_output_paths(inputs,
+                     {{"--json", json_path}, {"--csv", csv_path}, {"--report", report_path}});
   check_output_dir(inputs, {"--plot", plot_dir});
   GapOptions go;
   for (const std::string& e : effects)
@@ -105,6 +108,7 @@ int verb_gap(const Args& args) {
     write_file_atomically(report_path, gap_markdown(r, *model, data, pngs, report_path));
   if (!json_path.empty())
     write_file_atomically(json_path, gap_json(r, *model, data).dump(2) + "\n");
+  if (!csv_path.empty()) write_file_atomically(csv_path, gap_csv(r, data));
   return 0;
 }
 

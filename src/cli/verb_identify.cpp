@@ -7,7 +7,9 @@
 #include "verbs.hpp"
 #include "weilgen/analysis/identify.hpp"
 #include "weilgen/analysis/prediction.hpp"
+#include "weilgen/analysis/study_spec.hpp"
 #include "weilgen/base/atomic_file.hpp"
+#include "weilgen/base/text.hpp"
 #include "weilgen/machine/yaml_loader.hpp"
 #include "weilgen/report/identify_document.hpp"
 #include "weilgen/report/params_header.hpp"
@@ -29,7 +31,7 @@ int verb_identify(const Args& args) {
       "other measurements (points, ballbar circles) and writes the parameters as a standalone\n"
       "controller header. docs/identify.md.\n\nOptions");
   std::vector<std::string> data, pdge, fixed, predict;
-  std::string json_path, emit, predict_out;
+  std::string json_path, csv_path, plot_path, emit, predict_out;
   BallbarFlags circle;
   double rank_tol = 1e-9;
   opts.add_options()("help,h", "show this help")(
@@ -39,7 +41,7 @@ int verb_identify(const Args& args) {
       "basis of every PDGE (poly:3, fourier:2, legendre:4, chebyshev:4, fourier:2:20 = period "
       "20 mm) or of one error (E_YY=fourier:3); repeatable, applied in order")(
       "fix", po::value<std::vector<std::string>>(&fixed)->composing(),
-      "hold an error at zero (name or alias); repeatable")(
+      "hold an error at zero: a name, an alias or group:<group> (as --set); repeatable")(
       "rank-tol", ranged(&rank_tol, NumberRange::open(0, 1))->default_value(rank_tol, "1e-9"),
       "singular values below rank-tol x the largest (equilibrated columns) count as zero")(
       "predict", po::value<std::vector<std::string>>(&predict)->composing(),
@@ -48,6 +50,11 @@ int verb_identify(const Args& args) {
       "predict-out", po::value<std::string>(&predict_out),
       "write the predictions of the last --predict file to FILE (CSV)")(
       "json", po::value<std::string>(&json_path), "write the results as JSON to FILE")(
+      "csv", po::value<std::string>(&csv_path),
+      "write the parameters (value, standard error, unit, identifiable) to FILE (CSV)")(
+      "plot", po::value<std::string>(&plot_path),
+      "draw the residuals per output before and after, and the parameters with their 95 %\n"
+      "intervals, to FILE (.png or .svg, gnuplot)")(
       "emit-params", po::value<std::string>(&emit),
       "write the identified parameters as a standalone C++ header to FILE")(
       "allow-unknown", "warn about unknown columns instead of failing")(
@@ -64,16 +71,30 @@ int verb_identify(const Args& args) {
   std::vector<PathArg> inputs = study_inputs(flags);
   for (const std::string& d : data) inputs.push_back({"--data", d});
   for (const std::string& p : predict) inputs.push_back({"--predict", p});
-  check_output_paths(
-      inputs, {{"--json", json_path}, {"--emit-params", emit}, {"--predict-out", predict_out}});
+  check_output_paths(inputs, {{"--json", json_path},
+                              {"--csv", csv_path},
+                              {"--plot", plot_path},
+                              {"--emit-params", emit},
+                              {"--predict-out", predict_out}});
+  if (!plot_path.empty()) check_plot_target(plot_path);
 
+  // Every input read and every output checked before the work, so that nothing fails after it.
   const Description desc = load_machine_file(resolve_machine(flags.machine));
   const PdgeBasisChoice choice = parse_pdge_flags(desc, pdge);
+  const ReadOptions ro = machine_read_options(desc, vm.count("allow-unknown") > 0);
+  const auto warn = [](const std::string& w) { std::cerr << w << "\n"; };
+  const PointData points = merged_point_data(data, desc, ro, warn);
+  std::vector<MeasurementTable> predict_tables;
+  for (const std::string& p : predict) {
+    predict_tables.push_back(read_measurements(p, ro));
+    for (const auto& w : predict_tables.back().warnings) warn(w);
+  }
+  if (!predict_out.empty() && is_ballbar_table(predict_tables.back()))
+    throw std::invalid_argument("--predict-out: " + predict.back() +
+                                " is a ballbar trace; the JSON carries its predicted trace");
+  for (const std::string& f : fixed) select_errors(desc, f, "--fix " + quoted(f));
   const std::shared_ptr<Model> model = open_model(flags, desc);
   const ErrorParameterisation param(model->description(), choice, model->parameters());
-  const ReadOptions ro = machine_read_options(desc, vm.count("allow-unknown") > 0);
-  const PointData points =
-      merged_point_data(data, desc, ro, [](const std::string& w) { std::cerr << w << "\n"; });
 
   IdentifyOptions io;
   io.rank_tolerance = rank_tol;
@@ -84,12 +105,8 @@ int verb_identify(const Args& args) {
   nlohmann::json j = identify_json(*model, param, r, data);
   j["predictions"] = nlohmann::json::array();
   for (std::size_t i = 0; i < predict.size(); ++i) {
-    const MeasurementTable t = read_measurements(predict[i], ro);
-    for (const auto& w : t.warnings) std::cerr << w << "\n";
+    const MeasurementTable& t = predict_tables[i];
     if (is_ballbar_table(t)) {
-      if (i + 1 == predict.size() && !predict_out.empty())
-        throw std::invalid_argument("--predict-out: " + predict[i] +
-                                    " is a ballbar trace; the JSON carries its predicted trace");
       const BallbarPrediction bp = predict_ballbar_table(*model, param, r.theta, t, circle);
       std::cout << "\n" << ballbar_prediction_text(bp);
       j["predictions"].push_back(ballbar_prediction_json(bp));
@@ -106,6 +123,9 @@ int verb_identify(const Args& args) {
     std::cout << "\nwrote " << emit << "\n";
   }
   if (!json_path.empty()) write_file_atomically(json_path, j.dump(2) + "\n");
+  if (!csv_path.empty()) write_file_atomically(csv_path, identify_csv(*model, param, r));
+  if (!plot_path.empty())
+    write_plot(plot_path, identify_panels(param, r), "weilgen identify: " + model->name());
   return 0;
 }
 

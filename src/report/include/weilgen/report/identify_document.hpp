@@ -1,6 +1,6 @@
 // The documents of an identification: the text of `weilgen identify` (observations, rank,
 // residuals per output, parameters with standard errors, the unidentifiable combinations) and
-// its JSON (docs/identify.md).
+// its JSON, CSV and chart (docs/identify.md).
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "weilgen/analysis/identify.hpp"
+#include "weilgen/report/plot.hpp"
 
 namespace weilgen {
 
@@ -16,5 +17,14 @@ std::string identify_text(const Model& model, const ErrorParameterisation& param
 // `files`: the --data files; the verb adds "predictions".
 nlohmann::json identify_json(const Model& model, const ErrorParameterisation& param,
                              const IdentifyResult& result, const std::vector<std::string>& files);
+
+// One row per parameter: label, error, basis, term, value and standard error in `unit`,
+// identifiable, fixed.
+std::string identify_csv(const Model& model, const ErrorParameterisation& param,
+                         const IdentifyResult& result);
+// The RMS residual per output before and after (µm, µrad), and per unit the identified
+// parameters with their 95 % intervals (value ± 1.96 standard errors).
+std::vector<Panel> identify_panels(const ErrorParameterisation& param,
+                                   const IdentifyResult& result);
 
 }  // namespace weilgen
