@@ -7,6 +7,7 @@ packages=(
   libginac-dev libeigen3-dev libboost-program-options-dev libboost-dev
   libyaml-cpp-dev nlohmann-json3-dev doctest-dev libbenchmark-dev
   libnlopt-cxx-dev time gnuplot-nox
+  clang libclang-rt-14-dev  # libFuzzer and the sanitizer runtimes (fuzz/, scripts/fuzz.sh)
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -1,7 +1,7 @@
-// Ballbar circle prediction and evaluation (weilgen/measure/ballbar.hpp, docs/ballbar.md): closed-form
-// traces of a centre offset, a squareness, scale errors and a constant tangential deviation;
-// feed order; the vmc_3axis model against the closed form and the exact numeric chain; the
-// circle's header keys and flags with their messages; measured traces; the comparison; and the
+// Ballbar circle prediction and evaluation (weilgen/measure/ballbar.hpp, docs/ballbar.md):
+// closed-form traces of a centre offset, a squareness, scale errors and a constant tangential
+// deviation; feed order; the vmc_3axis model against the closed form and the exact numeric chain;
+// the circle's header keys and flags with their messages; measured traces; the comparison; and the
 // synthetic example file against an independent generator.
 #include <doctest/doctest.h>
 
@@ -130,7 +130,7 @@ TEST_CASE("ballbar: squareness dx = S·y gives (S R/2) sin 2θ and G = S R") {
   CHECK(std::abs(e.scale_mismatch_um_per_m) < 1e-9);
 }
 
-TEST_CASE("ballbar: scale errors change the radius; a scale mismatch is a cos 2θ term") {
+TEST_CASE("ballbar: scale errors change the radius, and a scale mismatch is a cos 2θ term") {
   const double k = 10e-6, r = 150, cx = 200, cy = -100;
   const BallbarCircle c = circle_xy(cx, cy, r);
   SUBCASE("equal scale dx = k x, dy = k y: radius deviation k R, centre offset k c, G = 0") {
@@ -452,7 +452,7 @@ TEST_CASE("ballbar: measured traces from a table") {
   CHECK(input_error([&] {
           ballbar_traces(parse_measurements(head + "angle_deg,dr_um\n0,1\n,2\n", "t.csv"), c);
         }) ==
-        "t.csv:7: ballbar: angle_deg is empty in a row with dr_um (every measured point "
+        "t.csv:7:1: ballbar: angle_deg is empty in a row with dr_um (every measured point "
         "needs its angle)");
   CHECK(input_error([&] {
           ballbar_traces(parse_measurements(head + "angle_deg,dx_um\n0,1\n", "t.csv"), c);

@@ -316,9 +316,10 @@ TEST_CASE("gap: bad data get a message, not a verdict") {
     } catch (const InputError& e) {
       message = e.what();
     }
-    CHECK(message ==
-          "r.csv:13: column 'C' looks like radians: every value lies within ±2π (0 .. 5.5) while "
-          "C is in deg over [-360, 360] deg; write it in degrees");
+    CHECK(
+        message ==
+        "r.csv:13:13: column 'C' looks like radians: every value lies within ±2π (0 .. 5.5) while "
+        "C is in deg over [-360, 360] deg; write it in degrees");
   }
   CHECK_THROWS_WITH_AS(parse_holdout("weekly"),
                        "--holdout \"weekly\": unknown scheme 'weekly' (expected cycle[:K], "
@@ -450,7 +451,7 @@ std::string ballbar_synth(std::uint32_t seed, const EffectFn& extra, int cycles 
 
 }  // namespace
 
-TEST_CASE("gap: ballbar traces are dr observations; reversal on X is read from them") {
+TEST_CASE("gap: ballbar traces are dr observations, and reversal on X is read from them") {
   const MeasurementTable t = parse_measurements(ballbar_synth(21, none), "bb.csv");
   const GapData d = gap_data(t, vmc()->description());
   REQUIRE(d.circle);
@@ -493,8 +494,10 @@ TEST_CASE("gap: ballbar traces are dr observations; reversal on X is read from t
     return at;
   }();
   no_angle.erase(c4, no_angle.find(',', c4) - c4);
+  const std::string no_angle_message = "bb.csv:7:" + std::to_string(c4 - row7 + 1) +
+                                       ": column 'angle_deg' is empty but dr_um is measured";
   CHECK_THROWS_WITH(gap_data(parse_measurements(no_angle, "bb.csv"), vmc()->description()),
-                    "bb.csv:7: column 'angle_deg' is empty but dr_um is measured");
+                    no_angle_message.c_str());
 
   const MeasurementTable tr = parse_measurements(
       ballbar_synth(22,
@@ -612,7 +615,7 @@ std::string with_gross_readings(const std::string& csv, const std::vector<int>& 
 
 }  // namespace
 
-TEST_CASE("gap: five gross readings are reported and removed; the reversal is still named") {
+TEST_CASE("gap: five gross readings are reported and removed, and the reversal is still named") {
   const std::string clean = synth(1, [](const Row& w) {
     return std::array<double, 3>{2.0 * w.dir_X, 0, 0};  // B = 4 µm in dx
   });
@@ -782,4 +785,20 @@ TEST_CASE("gap: on a tilting table, a spindle drift fixed in the machine frame i
   REQUIRE(e->params.count("machine_z_um"));
   CHECK(std::abs(e->params.at("machine_z_um")) == doctest::Approx(8).epsilon(0.15));
   CHECK(std::abs(e->params.at("machine_x_um")) < 1);
+}
+
+TEST_CASE("gap: a basis term that vanishes at every sample is not fitted") {
+  // As in identify (test_identify.cpp): sin(2π·2·y/L) is rounding noise at the five Y positions.
+  // Each fold's equilibrated SVD used to count it in the rank (47) and fit it with ~1e16.
+  const std::filesystem::path dir = test::fresh_dir("gap_vanishing_term");
+  const std::string json = (dir / "g.json").string();
+  const test::Run ok = test::run(test::cli("gap vmc_3axis -q --pdge E_YY=fourier:3 --data " +
+                                           std::string(WEILGEN_SOURCE_DIR) +
+                                           "/examples/data/vmc_3axis_points.csv --json " + json));
+  REQUIRE_MESSAGE(ok.status == 0, ok.out);
+  std::ifstream in(json);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  CHECK(j["baseline"]["parameters"] == 78);
+  CHECK(j["baseline"]["rank"] == 46);
+  CHECK(j["baseline"]["heldout_rms_all_um"].get<double>() < 10);
 }

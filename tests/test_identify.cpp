@@ -316,7 +316,7 @@ TEST_CASE("identify: point data name the file and line of bad rows") {
         "p.csv:1: no deviation column (dx_um, dy_um, dz_um, da_urad, db_urad, dc_urad; "
         "columns: X, Y, Z, t_s)");
   CHECK(error_of("X,Y,Z,dx_um\n0,0,0,1\n0,,0,2\n") ==
-        "p.csv:3: column 'Y' is empty but a deviation is measured (every observation needs the "
+        "p.csv:3:3: column 'Y' is empty but a deviation is measured (every observation needs the "
         "machine's coordinates)");
   CHECK(error_of("X,Y,Z,dx_um\n0,0,0,\n") ==
         "p.csv: no observations (no row has a measured deviation)");
@@ -389,4 +389,39 @@ TEST_CASE("identify CLI: points, a ballbar prediction of the same machine, JSON 
       test::cli("identify vmc_3axis -q --data " + src + "vmc_3axis_points.csv --pdge E_QQ=poly:2"));
   CHECK(r3.status == 2);
   CHECK(r3.out.find("unknown error 'E_QQ'") != std::string::npos);
+}
+
+TEST_CASE("identify CLI: a basis term that vanishes at every sample is not identifiable") {
+  // Y is measured at five positions L/4 apart: sin(2π·2·y/L) is rounding noise (~1e-16) at each.
+  // It used to be scaled to unit norm by the equilibration and fitted as 3.06e16 ± 3e14 µm, and
+  // the ballbar prediction was 1e16 µm.
+  const std::filesystem::path dir = test::fresh_dir("identify_vanishing_term");
+  const std::string src = std::string(WEILGEN_SOURCE_DIR) + "/examples/data/";
+  const std::string json = (dir / "id.json").string();
+  const test::Run ok =
+      test::run(test::cli("identify vmc_3axis -q --data " + src + "vmc_3axis_points.csv --pdge " +
+                          "E_YY=fourier:3 --predict " + src + "ballbar_xy.csv --json " + json));
+  REQUIRE_MESSAGE(ok.status == 0, ok.out);
+  CHECK(ok.out.find("E_YY[sin(2pi*2*x/L)]             0      n.i.  um") != std::string::npos);
+  std::ifstream in(json);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  CHECK(j["rank"] == 46);  // the default poly:3 fit's rank too: the term adds nothing
+  bool found = false;
+  for (const nlohmann::json& p : j["parameters"]) {
+    CAPTURE(p["label"].get<std::string>());
+    CHECK(std::abs(p["value"].get<double>()) < 100);  // µm, µrad: every value of its size
+    if (p["label"] != "E_YY[sin(2pi*2*x/L)]") continue;
+    found = true;
+    CHECK(p["identifiable"] == false);
+    CHECK(p["value"].get<double>() == 0.0);
+    CHECK(p["standard_error"].is_null());
+  }
+  CHECK(found);
+  bool alone = false;  // a null-space combination of its own
+  for (const nlohmann::json& c : j["unidentifiable"])
+    alone = alone || c["text"] == "E_YY[sin(2pi*2*x/L)]";
+  CHECK(alone);
+  const nlohmann::json& bb = j["predictions"][0]["predicted"];
+  CHECK(bb["circular_deviation_um"].get<double>() < 20);
+  CHECK(bb["max_minus_min_um"].get<double>() < 100);
 }

@@ -1,7 +1,8 @@
-// ISO 230-2 evaluation and the drift seed's thermal-drift elimination (weilgen/measure/iso230_2.hpp,
-// docs/iso230-2.md): a hand-computed example with every figure pinned, invariants on random
-// data, drift recovery on synthetic data, the seed's sqrt(2) Monte Carlo check, the anomaly
-// test's false-positive rate and power, grouping errors, and the CLI end to end.
+// ISO 230-2 evaluation and the drift seed's thermal-drift elimination
+// (weilgen/measure/iso230_2.hpp, docs/iso230-2.md): a hand-computed example with every figure
+// pinned, invariants on random data, drift recovery on synthetic data, the seed's sqrt(2) Monte
+// Carlo check, the anomaly test's false-positive rate and power, grouping errors, and the CLI end
+// to end.
 #include <doctest/doctest.h>
 
 #include <Eigen/Dense>
@@ -496,7 +497,7 @@ TEST_CASE("iso230-2: grouping of targets and bad runs name the file and line") {
         "(column dir or dir_<axis>)");
   CHECK(error_of(head + "0,1,1,\n") == "d.csv: no observations (no row has a measured deviation)");
   CHECK(error_of(head + "0,,1,2\n") ==
-        "d.csv:2: column 'dir' is empty but 'dx_um' is measured (every observation needs its "
+        "d.csv:2:3: column 'dir' is empty but 'dx_um' is measured (every observation needs its "
         "position, direction and cycle)");
   CHECK(error_of("X,cycle,dx_um\n0,1,2\n") ==
         "d.csv:1: missing column 'dir' or 'dir_X' (the approach direction, +1 or -1; columns: "

@@ -1,6 +1,8 @@
 // The column-equilibrated SVD (weilgen/uq/lsq.hpp) that identify and the gap folds share.
 #include <doctest/doctest.h>
 
+#include <cmath>
+
 #include "test_support.hpp"
 #include "weilgen/analysis/identify.hpp"
 #include "weilgen/uq/lsq.hpp"
@@ -45,4 +47,34 @@ TEST_CASE("lsq: a line run's design matrix (rank 4 of 75) gets a finite SVD") {
   CHECK(x.allFinite());
   // The residual is orthogonal to the columns (normal equations).
   CHECK((A.transpose() * (y - A * x)).norm() < 1e-8 * A.norm() * y.norm());
+}
+
+TEST_CASE("lsq: a column of rounding noise counts as zero, a small real column does not") {
+  // Column 1 is sin(2π·2·y/L) at y = 0, L/4, ..., L, as double rounding leaves it (~1e-16):
+  // scaled to unit norm it looked like data and was fitted with a coefficient of 1e16.
+  Eigen::MatrixXd A(5, 3);
+  const double pi = std::acos(-1.0);
+  for (int k = 0; k < 5; ++k) {
+    A(k, 0) = 1;
+    A(k, 1) = std::sin(2 * pi * 2 * k / 4.0);
+    A(k, 2) = 1e-6 * k;  // small, but the data excite it: kept (equilibration's purpose)
+  }
+  REQUIRE(A.col(1).norm() > 0);
+  REQUIRE(A.col(1).norm() < 1e-14);
+  const Eigen::VectorXd y = (Eigen::VectorXd(5) << 1, -2, 3, -4, 5).finished();
+  const EquilibratedSvd svd(A, 1e-9, true);
+  CHECK(svd.rank() == 2);
+  const Eigen::VectorXd x = svd.solve(y);
+  CHECK(x[1] == 0.0);
+  CHECK(svd.scale()[1] == 1.0);
+  // The other two columns get the least-squares fit of y on them alone.
+  Eigen::MatrixXd B(5, 2);
+  B << A.col(0), A.col(2);
+  const Eigen::VectorXd xb = B.colPivHouseholderQr().solve(y);
+  CHECK(x[0] == doctest::Approx(xb[0]));
+  CHECK(x[2] == doctest::Approx(xb[1]));
+  // The noise column is the null space: V's last column is e_1.
+  CHECK(std::abs(svd.V()(1, 2)) == doctest::Approx(1.0));
+  // The rule is relative to the largest column: alone, the same column is the data's scale.
+  CHECK(EquilibratedSvd(A.col(1), 1e-9, true).rank() == 1);
 }

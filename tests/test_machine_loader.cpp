@@ -77,6 +77,13 @@ TEST_CASE("expr: parses, evaluates and prints") {
   CHECK(parse_expr("(1 + 2)*3").str() == "(1 + 2)*3");
   CHECK(parse_expr("a - (b - c)").str() == "a - (b - c)");
   CHECK(parse_expr("-(a + b)").str() == "-(a + b)");
+  CHECK(parse_expr("-(-(-a))").str() == "---a");  // not "-(-(-a))": twice as deep to read back
+  CHECK(parse_expr("-(-a^2)").str() == "--a^2");
+  CHECK(parse_expr("--a^2").eval({{"a", 3}}) == 9);
+  CHECK(parse_expr("-(-a*b)").str() == "-(-a*b)");
+  // 150 signs read back from their printed form (the parser allows 200 levels).
+  const Expr signs = parse_expr(std::string(150, '-') + "a");
+  CHECK(parse_expr(signs.str()).eval({{"a", 2}}) == 2);
   CHECK(parse_expr("1 - -2").eval({}) == 3);
   CHECK(parse_expr("-5").is_number());
   CHECK(parse_expr("-5").number == -5);
@@ -691,7 +698,8 @@ workpiece: {body: bed}
 TEST_CASE("bad: algebra order") {
   const std::string body =
       "weilgen: 1\nname: bad\nbodies: {bed: {}}\ntool: {body: bed}\nworkpiece: {body: bed}\n";
-  expect_error(body + "algebra: {order: 0}\n", "bad.yaml:6:18", {"algebra.order", ">= 1"});
+  expect_error(body + "algebra: {order: 0}\n", "bad.yaml:6:18", {"algebra.order", "from 1 to 20"});
+  expect_error(body + "algebra: {order: 21}\n", "bad.yaml:6:18", {"algebra.order", "from 1 to 20"});
   expect_error(body + "algebra: {order: 1.5}\n", "bad.yaml:6:18",
                {"algebra.order", "whole number"});
   expect_error(body + "algebra: {order: two}\n", "bad.yaml:6:18",

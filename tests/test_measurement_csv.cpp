@@ -1,5 +1,6 @@
-// The measurement CSV reader (weilgen/measure/measurement_csv.hpp, docs/data-format.md): every column
-// role, comments and header keys, CRLF, and each kind of bad input with its exact file:line:column.
+// The measurement CSV reader (weilgen/measure/measurement_csv.hpp, docs/data-format.md): every
+// column role, comments and header keys, CRLF, and each kind of bad input with its exact
+// file:line:column.
 #include <doctest/doctest.h>
 
 #include <cmath>

@@ -70,7 +70,7 @@ TEST_CASE("robustness #1: --bootstrap -1 is refused naming the flag and its rang
           {"--bootstrap: '-1' is out of range (allowed: a whole number from 0 to 1000000)"});
 }
 
-TEST_CASE("robustness #2: numeric flags range-checked; memory estimated before allocation") {
+TEST_CASE("robustness #2: numeric flags range-checked and memory estimated before allocation") {
   const auto dir = test::fresh_dir("robust_2");
   write(dir / "keep.json", "previous");
   const std::string s = std::string("sensitivity gantry_grinder") + kPose + " --json keep.json";
@@ -311,7 +311,7 @@ TEST_CASE("robustness #7: a truncated cache entry is discarded and recompiled wi
   CHECK(again.out.find("compiling") == std::string::npos);
 }
 
-TEST_CASE("robustness #8: --order 0 is refused; large orders are estimated before starting") {
+TEST_CASE("robustness #8: --order 0 is refused and large orders are estimated before starting") {
   const auto dir = test::fresh_dir("robust_8");
   refused(dir, "generate two_axis --order 0 --out .", 2,
           {"--order: '0' is out of range (allowed: a whole number from 1 to 20)"});

@@ -47,7 +47,7 @@ TEST_CASE("relations: the seed's algebra (40), squares vanish but cross products
   CHECK(v.relations().size() == 1);
 }
 
-TEST_CASE("small rotations: sin/cos series truncated in the algebra; inverse by negation") {
+TEST_CASE("small rotations: sin/cos series truncated in the algebra, inverse by negation") {
   const ex u[3] = {0, 0, 1};
   for (int r = 1; r <= 3; ++r) {
     CAPTURE(r);

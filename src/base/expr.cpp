@@ -291,7 +291,9 @@ std::string Expr::str() const {
     case Kind::Param:
       return name;
     case Kind::Neg:
-      return "-" + wrap(*a, precedence(*a) <= p);
+      // "--x", not "-(-x)": the parenthesised form nests twice as deep, and a long chain of
+      // signs printed that way no longer read back (kMaxDepth; found by fuzz_expression).
+      return "-" + wrap(*a, precedence(*a) < p);
     case Kind::Pow:
       // Right-associative: the base needs parentheses when it is itself a power or signed.
       return wrap(*a, precedence(*a) <= p) + "^" + wrap(*b, precedence(*b) < 3);

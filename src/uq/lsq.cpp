@@ -9,12 +9,18 @@ using Eigen::VectorXd;
 EquilibratedSvd::EquilibratedSvd(const MatrixXd& A, double rank_tolerance, bool full_v) {
   const Index n = A.cols();
   scale_ = A.colwise().norm().transpose();
+  // A column that is rounding noise (a basis function that vanishes at every sample, such as
+  // sin(2π·2x/L) on samples L/4 apart) would be scaled up to unit norm and fitted as if the data
+  // excited it: it counts as zero, like an exactly zero column.
+  const double largest = n ? scale_.maxCoeff() : 0;
   zero_column_.resize(static_cast<std::size_t>(n));
   for (Index p = 0; p < n; ++p) {
-    zero_column_[static_cast<std::size_t>(p)] = !(scale_[p] > 0);
+    zero_column_[static_cast<std::size_t>(p)] = !(scale_[p] > kNegligibleColumn * largest);
     if (zero_column_[static_cast<std::size_t>(p)]) scale_[p] = 1;
   }
-  const MatrixXd As = A * scale_.cwiseInverse().asDiagonal();
+  MatrixXd As = A * scale_.cwiseInverse().asDiagonal();
+  for (Index p = 0; p < n; ++p)
+    if (zero_column_[static_cast<std::size_t>(p)]) As.col(p).setZero();
   const unsigned options =
       Eigen::ComputeThinU | (full_v ? Eigen::ComputeFullV : Eigen::ComputeThinV);
   Eigen::BDCSVD<MatrixXd> svd(As, options);

@@ -6,7 +6,9 @@
   - no source folder holds more than 20 .cpp files;
   - every src/cli/verb_*.cpp has at most 200 lines;
   - the codegen layer's CMake file links no NLopt and no Eigen;
-  - nothing under src/ includes another layer's internal headers ("../", "src/").
+  - nothing under src/ includes another layer's internal headers ("../", "src/");
+  - no doctest case name in tests/*.cpp contains ';' (CMake splits the name at it, and CTest
+    then runs no test of that case).
 
 Usage: check_layout.py SOURCE_DIR. Prints each violation as file:line: message; exit 1 if any.
 """
@@ -26,6 +28,7 @@ ALLOWED = {
     "cli": {"report", "analysis", "model", "uq", "measure", "codegen", "machine", "base"},
 }
 INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"')
+TEST_CASE = re.compile(r'^\s*TEST_CASE\("((?:[^"\\]|\\.)*)"')
 
 
 def main(root):
@@ -75,6 +78,16 @@ def main(root):
     for lib in ("NLopt", "Eigen3", "nlopt"):
         if lib in text:
             problems.append(f"src/codegen/CMakeLists.txt: links {lib} (codegen uses GiNaC only)")
+    tests = os.path.join(root, "tests")
+    for name in sorted(os.listdir(tests)):
+        if not name.endswith(".cpp"):
+            continue
+        with open(os.path.join(tests, name), encoding="utf-8") as fh:
+            for number, line in enumerate(fh, 1):
+                m = TEST_CASE.match(line)
+                if m and ";" in m.group(1):
+                    problems.append(f"tests/{name}:{number}: test case name contains ';' (CMake "
+                                    "splits it and CTest never runs the case): use ','")
     for p in problems:
         print(p)
     print(f"layout: {len(problems)} problem(s)")

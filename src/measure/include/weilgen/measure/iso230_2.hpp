@@ -30,7 +30,7 @@ struct IsoObservation {
   long cycle = 0;          // repetition j
   double deviation = 0;    // x_ij = actual - target (um)
   double time_s = std::numeric_limits<double>::quiet_NaN();  // optional
-  int line = 0;  // 1-based source line (messages), 0 when not from a file
+  int line = 0;    // 1-based source line (messages), 0 when not from a file
   int column = 0;  // 1-based source column of the deviation cell (messages), 0 when unknown
 };
 
