@@ -1,4 +1,4 @@
-# weilgen_add_model(<target> <machine> [ORDER r] [NAME model] [OUTPUT_DIR dir])
+# weilgen_add_model(<target> <machine> [ORDER r] [NAME model] [OUTPUT_DIR dir] [C_API])
 #
 # Regenerates a machine's error-model header at build time and exposes it as the INTERFACE
 # library <target>: link it and `#include "<model>.hpp"` (namespace weilgen_models::<model>).
@@ -14,12 +14,17 @@
 #               line (anchors, multi-line flow maps, blank lines inside the block are not
 #               understood). Pass NAME when the file is written differently; the build checks
 #               that the header it expects was written.
+#   C_API       also generates the C API (<model>_c.h, C99; <model>_c.cpp, its implementation;
+#               docs/controllers.md) and adds the STATIC library <target>_c compiled from
+#               <model>_c.cpp (C++17, no exceptions, no RTTI): a C program links <target>_c and
+#               includes "<model>_c.h". The C++ language must be enabled in the project.
 #   OUTPUT_DIR  where the header (and its .md report) go; default
 #               ${CMAKE_CURRENT_BINARY_DIR}/weilgen_models/<target>. One directory per target
 #               keeps two models of the same machine from sharing an output.
 #
 # Sets on <target> the properties WEILGEN_MODEL_NAME (e.g. vmc_3axis_o2) and WEILGEN_HEADER
-# (full path), and in the caller's scope <target>_MODEL_NAME and <target>_HEADER.
+# (full path), and in the caller's scope <target>_MODEL_NAME and <target>_HEADER; with C_API also
+# WEILGEN_C_HEADER and <target>_C_HEADER.
 #
 # Works from the installed package (weilgen::weilgen) and inside the weilgen build tree
 # (target weilgen), where the generator is rebuilt before it runs.
@@ -47,7 +52,7 @@ if(NOT DEFINED WEILGEN_MACHINES_DIR AND DEFINED weilgen_SOURCE_DIR)
 endif()
 
 function(weilgen_add_model target machine)
-  cmake_parse_arguments(PARSE_ARGV 2 ARG "" "ORDER;NAME;OUTPUT_DIR" "")
+  cmake_parse_arguments(PARSE_ARGV 2 ARG "C_API" "ORDER;NAME;OUTPUT_DIR" "")
   if(ARG_UNPARSED_ARGUMENTS)
     message(FATAL_ERROR "weilgen_add_model: unexpected arguments: ${ARG_UNPARSED_ARGUMENTS}")
   endif()
@@ -113,8 +118,13 @@ function(weilgen_add_model target machine)
   if(DEFINED ARG_ORDER)
     set(order_args --order ${ARG_ORDER})
   endif()
+  set(c_api_outputs)
+  if(ARG_C_API)
+    list(APPEND order_args --c-api)
+    set(c_api_outputs "${out_dir}/${model}_c.h" "${out_dir}/${model}_c.cpp")
+  endif()
   add_custom_command(
-    OUTPUT "${header}" "${out_dir}/${model}.md"
+    OUTPUT "${header}" "${out_dir}/${model}.md" ${c_api_outputs}
     COMMAND "$<TARGET_FILE:${exe}>" generate "${machine}" ${order_args} --out "${out_dir}"
     COMMAND "${CMAKE_COMMAND}" "-DWEILGEN_EXPECTED_HEADER=${header}"
             -P "${_WEILGEN_ADD_MODEL_FILE}"
@@ -133,4 +143,18 @@ function(weilgen_add_model target machine)
   set_target_properties(${target} PROPERTIES WEILGEN_MODEL_NAME "${model}" WEILGEN_HEADER "${header}")
   set(${target}_MODEL_NAME "${model}" PARENT_SCOPE)
   set(${target}_HEADER "${header}" PARENT_SCOPE)
+
+  if(ARG_C_API)
+    # The C API's implementation compiles against the C++ header; it needs no C++ runtime
+    # (no exceptions, no RTTI, no allocation), only libm.
+    add_library(${target}_c STATIC "${out_dir}/${model}_c.cpp")
+    target_link_libraries(${target}_c PUBLIC ${target})
+    target_compile_features(${target}_c PRIVATE cxx_std_17)
+    if(NOT MSVC)
+      target_compile_options(${target}_c PRIVATE -fno-exceptions -fno-rtti)
+      target_link_libraries(${target}_c PUBLIC m)
+    endif()
+    set_target_properties(${target} PROPERTIES WEILGEN_C_HEADER "${out_dir}/${model}_c.h")
+    set(${target}_C_HEADER "${out_dir}/${model}_c.h" PARENT_SCOPE)
+  endif()
 endfunction()

@@ -1,7 +1,7 @@
 # The shipped machines' generated models.
 #
-# The build generates them into its own tree (${WEILGEN_GENERATED_DIR}) and compiles those into
-# weilgen; it never writes into the source tree. The committed copies in generated/ are golden
+# The build generates them, with their C APIs (<machine>_c.h, <machine>_c.cpp), into its own tree
+# (${WEILGEN_GENERATED_DIR}) and compiles those into weilgen; it never writes into the source tree. The committed copies in generated/ are golden
 # files: the CTest `generated_files_current` fails when any differs from fresh generation, and
 # the target `update_generated` (cmake --build build --target update_generated) rewrites them.
 file(GLOB WEILGEN_SHIPPED_MACHINES CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/machines/*.yaml)
@@ -11,11 +11,12 @@ set(outputs)
 foreach(machine_file IN LISTS WEILGEN_SHIPPED_MACHINES)
   get_filename_component(machine ${machine_file} NAME_WE)
   list(APPEND WEILGEN_SHIPPED_MODELS ${machine})
-  list(APPEND outputs ${WEILGEN_GENERATED_DIR}/${machine}.hpp ${WEILGEN_GENERATED_DIR}/${machine}.md)
+  list(APPEND outputs ${WEILGEN_GENERATED_DIR}/${machine}.hpp ${WEILGEN_GENERATED_DIR}/${machine}.md
+    ${WEILGEN_GENERATED_DIR}/${machine}_c.h ${WEILGEN_GENERATED_DIR}/${machine}_c.cpp)
 endforeach()
 add_custom_command(
   OUTPUT ${outputs}
-  COMMAND weilgen_generate generate ${WEILGEN_SHIPPED_MACHINES} --out ${WEILGEN_GENERATED_DIR}
+  COMMAND weilgen_generate generate ${WEILGEN_SHIPPED_MACHINES} --out ${WEILGEN_GENERATED_DIR} --c-api
   # generate leaves unchanged files alone; touch them so the outputs are newer than the inputs.
   COMMAND ${CMAKE_COMMAND} -E touch_nocreate ${outputs}
   DEPENDS weilgen_generate ${WEILGEN_SHIPPED_MACHINES}
@@ -27,7 +28,7 @@ add_custom_target(weilgen_generated ALL DEPENDS ${outputs})
 set(WEILGEN_PARAMS_HEADER ${WEILGEN_GENERATED_DIR}/vmc_3axis_params.hpp)
 
 add_custom_target(update_generated
-  COMMAND weilgen generate ${WEILGEN_SHIPPED_MACHINES} --out ${PROJECT_SOURCE_DIR}/generated
+  COMMAND weilgen generate ${WEILGEN_SHIPPED_MACHINES} --out ${PROJECT_SOURCE_DIR}/generated --c-api
   COMMAND weilgen identify vmc_3axis --data ${PROJECT_SOURCE_DIR}/examples/data/vmc_3axis_points.csv
           --emit-params ${PROJECT_SOURCE_DIR}/generated/vmc_3axis_params.hpp --quiet
   WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}

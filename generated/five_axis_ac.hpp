@@ -124,6 +124,65 @@ inline constexpr std::array<ParamInfo, kNumParams> kParams = {{
 inline constexpr std::array<const char*, kNumOutputs> kOutputs = {{"dx", "dy", "dz", "da", "db", "dc"}};
 inline constexpr std::array<const char*, kNumOutputs> kOutputUnits = {{"mm", "mm", "mm", "rad", "rad", "rad"}};
 
+// Named indices into the axes, errors and params arrays (kAxes, kErrors, kParams order),
+// e.g. axes[axis::X], errors[error::E_C0C].
+namespace axis {
+inline constexpr std::size_t X = 0;
+inline constexpr std::size_t Z = 1;
+inline constexpr std::size_t Y = 2;
+inline constexpr std::size_t A = 3;
+inline constexpr std::size_t C = 4;
+}  // namespace axis
+namespace error {
+inline constexpr std::size_t E_XX = 0;
+inline constexpr std::size_t E_YX = 1;
+inline constexpr std::size_t E_ZX = 2;
+inline constexpr std::size_t E_AX = 3;
+inline constexpr std::size_t E_BX = 4;
+inline constexpr std::size_t E_CX = 5;
+inline constexpr std::size_t E_XZ = 6;
+inline constexpr std::size_t E_YZ = 7;
+inline constexpr std::size_t E_ZZ = 8;
+inline constexpr std::size_t E_AZ = 9;
+inline constexpr std::size_t E_BZ = 10;
+inline constexpr std::size_t E_CZ = 11;
+inline constexpr std::size_t E_B0Z = 12;
+inline constexpr std::size_t E_A0Z = 13;
+inline constexpr std::size_t E_XY = 14;
+inline constexpr std::size_t E_YY = 15;
+inline constexpr std::size_t E_ZY = 16;
+inline constexpr std::size_t E_AY = 17;
+inline constexpr std::size_t E_BY = 18;
+inline constexpr std::size_t E_CY = 19;
+inline constexpr std::size_t E_C0Y = 20;
+inline constexpr std::size_t E_XA = 21;
+inline constexpr std::size_t E_YA = 22;
+inline constexpr std::size_t E_ZA = 23;
+inline constexpr std::size_t E_AA = 24;
+inline constexpr std::size_t E_BA = 25;
+inline constexpr std::size_t E_CA = 26;
+inline constexpr std::size_t E_Y0A = 27;
+inline constexpr std::size_t E_Z0A = 28;
+inline constexpr std::size_t E_B0A = 29;
+inline constexpr std::size_t E_C0A = 30;
+inline constexpr std::size_t E_A0A = 31;
+inline constexpr std::size_t E_XC = 32;
+inline constexpr std::size_t E_YC = 33;
+inline constexpr std::size_t E_ZC = 34;
+inline constexpr std::size_t E_AC = 35;
+inline constexpr std::size_t E_BC = 36;
+inline constexpr std::size_t E_CC = 37;
+inline constexpr std::size_t E_X0C = 38;
+inline constexpr std::size_t E_Y0C = 39;
+inline constexpr std::size_t E_A0C = 40;
+inline constexpr std::size_t E_B0C = 41;
+inline constexpr std::size_t E_C0C = 42;
+}  // namespace error
+namespace param {
+inline constexpr std::size_t tool_length = 0;
+inline constexpr std::size_t c_above_a = 1;
+}  // namespace param
+
 // Monomials of degree >= 2 with a non-zero coefficient: error indices, padded with -1.
 inline constexpr std::array<std::array<int, 1>, kNumHigherTerms> kHigherTerms = {{
 }};

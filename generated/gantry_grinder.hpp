@@ -99,6 +99,40 @@ inline constexpr std::array<ParamInfo, kNumParams> kParams = {{
 inline constexpr std::array<const char*, kNumOutputs> kOutputs = {{"dx", "dy", "dz", "da", "db", "dc"}};
 inline constexpr std::array<const char*, kNumOutputs> kOutputUnits = {{"mm", "mm", "mm", "rad", "rad", "rad"}};
 
+// Named indices into the axes, errors and params arrays (kAxes, kErrors, kParams order),
+// e.g. axes[axis::X], errors[error::E_CY].
+namespace axis {
+inline constexpr std::size_t X = 0;
+inline constexpr std::size_t Z = 1;
+inline constexpr std::size_t Y = 2;
+}  // namespace axis
+namespace error {
+inline constexpr std::size_t E_XX = 0;
+inline constexpr std::size_t E_YX = 1;
+inline constexpr std::size_t E_ZX = 2;
+inline constexpr std::size_t E_AX = 3;
+inline constexpr std::size_t E_BX = 4;
+inline constexpr std::size_t E_CX = 5;
+inline constexpr std::size_t E_C0X = 6;
+inline constexpr std::size_t E_XZ = 7;
+inline constexpr std::size_t E_YZ = 8;
+inline constexpr std::size_t E_ZZ = 9;
+inline constexpr std::size_t E_AZ = 10;
+inline constexpr std::size_t E_BZ = 11;
+inline constexpr std::size_t E_CZ = 12;
+inline constexpr std::size_t E_B0Z = 13;
+inline constexpr std::size_t E_A0Z = 14;
+inline constexpr std::size_t E_XY = 15;
+inline constexpr std::size_t E_YY = 16;
+inline constexpr std::size_t E_ZY = 17;
+inline constexpr std::size_t E_AY = 18;
+inline constexpr std::size_t E_BY = 19;
+inline constexpr std::size_t E_CY = 20;
+}  // namespace error
+namespace param {
+inline constexpr std::size_t tool_length = 0;
+}  // namespace param
+
 // Monomials of degree >= 2 with a non-zero coefficient: error indices, padded with -1.
 inline constexpr std::array<std::array<int, 1>, kNumHigherTerms> kHigherTerms = {{
 }};

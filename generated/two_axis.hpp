@@ -21,7 +21,7 @@ namespace two_axis {
 inline constexpr const char* kMachineName = "two_axis";
 inline constexpr int kOrder = 1;
 // Machine-file text, order and weilgen version: identifies the model (weilgen/machine/model_key.hpp).
-inline constexpr const char* kModelKey = "e228966ee2c2736e";
+inline constexpr const char* kModelKey = "08e8c0af2795f48d";
 inline constexpr std::size_t kNumAxes = 2;
 inline constexpr std::size_t kNumErrors = 12;
 inline constexpr std::size_t kNumParams = 1;
@@ -88,6 +88,30 @@ inline constexpr std::array<ParamInfo, kNumParams> kParams = {{
 
 inline constexpr std::array<const char*, kNumOutputs> kOutputs = {{"dx", "dy", "dz", "da", "db", "dc"}};
 inline constexpr std::array<const char*, kNumOutputs> kOutputUnits = {{"mm", "mm", "mm", "rad", "rad", "rad"}};
+
+// Named indices into the axes, errors and params arrays (kAxes, kErrors, kParams order),
+// e.g. axes[axis::Y], errors[error::E_CA].
+namespace axis {
+inline constexpr std::size_t Y = 0;
+inline constexpr std::size_t A = 1;
+}  // namespace axis
+namespace error {
+inline constexpr std::size_t E_XY = 0;
+inline constexpr std::size_t E_YY = 1;
+inline constexpr std::size_t E_ZY = 2;
+inline constexpr std::size_t E_AY = 3;
+inline constexpr std::size_t E_BY = 4;
+inline constexpr std::size_t E_CY = 5;
+inline constexpr std::size_t E_XA = 6;
+inline constexpr std::size_t E_YA = 7;
+inline constexpr std::size_t E_ZA = 8;
+inline constexpr std::size_t E_AA = 9;
+inline constexpr std::size_t E_BA = 10;
+inline constexpr std::size_t E_CA = 11;
+}  // namespace error
+namespace param {
+inline constexpr std::size_t tool_length = 0;
+}  // namespace param
 
 // Monomials of degree >= 2 with a non-zero coefficient: error indices, padded with -1.
 inline constexpr std::array<std::array<int, 1>, kNumHigherTerms> kHigherTerms = {{

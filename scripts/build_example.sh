@@ -19,3 +19,4 @@ cmake -S "$root/examples/controller_model" -B "$work/example" -DCMAKE_PREFIX_PAT
   -DCMAKE_BUILD_TYPE=Release
 cmake --build "$work/example" -j"$(nproc)"
 "$work/example/controller"
+"$work/example/controller_c"

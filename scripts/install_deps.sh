@@ -7,7 +7,11 @@ packages=(
   libginac-dev libeigen3-dev libboost-program-options-dev libboost-dev
   libyaml-cpp-dev nlohmann-json3-dev doctest-dev libbenchmark-dev
   libnlopt-cxx-dev time gnuplot-nox
+  # LinuxCNC (halrun, halcompile, hal.h): the HAL compensation component's test (docs/controllers.md)
+  linuxcnc-uspace linuxcnc-uspace-dev
   clang libclang-rt-14-dev  # libFuzzer and the sanitizer runtimes (fuzz/, scripts/fuzz.sh)
+  # headless chromium and PIL: the ISO 230-2 HTML report's browser test (tests/browser)
+  chromium fonts-dejavu-core python3-pil
 )
 missing=()
 for p in "${packages[@]}"; do

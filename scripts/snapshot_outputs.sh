@@ -50,7 +50,7 @@ run sens_grinder_grid sensitivity gantry_grinder --grid X=0,Y=-1500:1500:3,Z=600
 run sens_grinder_mc sensitivity gantry_grinder --at X=0,Y=1500,Z=600 --sampling mc --samples 2048 --bootstrap 50 --seed 3 --json @.json
 run sens_vmc sensitivity vmc_3axis --at X=250,Y=-200,Z=-150 --samples 2048 --json @.json
 run sens_5ax sensitivity five_axis_ac --at X=100,Y=50,Z=-100,A=30,C=45 --samples 2048 --json @.json
-run sens_pipe sensitivity pipe_cutter --at X=800,A12=0,Y231=20,A04=0,Y451=20,Z453=20 --samples 1024 --json @.json
+run sens_pipe sensitivity pipe_cutter --at X=800,Y231=20,A04=0,Y451=20,Z453=20 --samples 1024 --json @.json
 run sens_two sensitivity two_axis --at Y=100,A=30 --samples 1024 --json @.json --outputs dx,dy,dz,dp
 
 # Reliability.

@@ -301,6 +301,82 @@ workpiece: {body: bed, point: [0, 0, 0]}
         "whole number 0..200 (e.g. fourier:3)");
 }
 
+TEST_CASE("identify: rotary PDGEs default to a Fourier basis over one turn") {
+  // A linear axis X and two rotary axes, C in degrees over ±360 and B in radians.
+  const std::string yaml = R"(weilgen: 1
+name: turns
+error_defaults:
+  positioning: {sigma: 5, unit: um}
+  angular: {sigma: 5, unit: urad}
+  tilt: {sigma: 5, unit: urad}
+  radial: {sigma: 1, unit: um}
+bodies:
+  bed: {}
+  x:
+    parent: bed
+    joint: {type: prismatic, axis: x, coordinate: X, unit: mm, range: [0, 200]}
+    errors: {E_XX: {}}
+  c:
+    parent: x
+    joint: {type: revolute, axis: z, coordinate: C, unit: deg, range: [-360, 360]}
+    errors: {E_XC: {}, E_CC: {sigma: 5, unit: urad}, E_BC: {basis: fourier:3}}
+  b:
+    parent: c
+    joint: {type: revolute, axis: y, coordinate: B, unit: rad, range: [-1, 1]}
+    errors: {E_AB: {}}
+tool: {body: bed, point: [0, 0, 0]}
+workpiece: {body: b, point: [0, 0, 0]}
+)";
+  const Description d = load_machine_text(yaml, "turns.yaml");
+  const ErrorParameterisation p(d, {});
+  CHECK(p.basis_of(0)->name() == "poly:3");         // E_XX on the linear axis
+  CHECK(p.basis_of(1)->name() == "fourier:2:360");  // E_XC: one turn, not the 720 deg travel
+  CHECK(p.basis_of(2)->name() == "fourier:2:360");
+  CHECK(p.basis_of(3)->name() == "fourier:3:360");  // the error's own Fourier order, same period
+  CHECK(p.basis_of(4)->period() == doctest::Approx(2 * M_PI));  // B in rad
+  // Periodic: a PDGE of C takes the same value a turn apart, which poly:3 over ±360 could not.
+  std::vector<double> theta(p.size(), 0.0);
+  for (std::size_t k = 0; k < p.size(); ++k) theta[k] = 0.1 * static_cast<double>(k + 1);
+  std::vector<double> e1(d.errors.size()), e2(d.errors.size());
+  const double pose1[] = {50, -300, 0.2}, pose2[] = {50, 60, 0.2};
+  p.errors_at(pose1, theta.data(), e1.data());
+  p.errors_at(pose2, theta.data(), e2.data());
+  CHECK(e1[1] == doctest::Approx(e2[1]).epsilon(1e-12));
+  CHECK(e1[0] == doctest::Approx(e2[0]).epsilon(1e-12));  // same X
+  // The run-wide flag still wins; a Fourier flag without a period takes one turn on C and the
+  // travel on X.
+  const ErrorParameterisation q(d, parse_pdge_flags(d, {"fourier:1"}));
+  CHECK(q.basis_of(0)->name() == "fourier:1");
+  CHECK(q.basis_of(0)->period() == doctest::Approx(200));
+  CHECK(q.basis_of(1)->name() == "fourier:1:360");
+  // The machine's pdge_basis: one spelling for all PDGEs, or one per joint type.
+  std::string all = yaml;
+  all.insert(all.find("bodies:"), "pdge_basis: legendre:2\n");
+  const Description da = load_machine_text(all, "turns.yaml");
+  CHECK(ErrorParameterisation(da, {}).basis_of(1)->name() == "legendre:2");
+  std::string per = yaml;
+  per.insert(per.find("bodies:"), "pdge_basis: {prismatic: chebyshev:2, revolute: fourier:1}\n");
+  const Description dp = load_machine_text(per, "turns.yaml");
+  const ErrorParameterisation pp(dp, {});
+  CHECK(pp.basis_of(0)->name() == "chebyshev:2");
+  CHECK(pp.basis_of(1)->name() == "fourier:1:360");
+  std::string only = yaml;
+  only.insert(only.find("bodies:"), "pdge_basis: {prismatic: legendre:4}\n");
+  const ErrorParameterisation po(load_machine_text(only, "turns.yaml"), {});
+  CHECK(po.basis_of(0)->name() == "legendre:4");
+  CHECK(po.basis_of(1)->name() == "fourier:2:360");
+  // Bad input: an unknown joint type, a misspelt basis, each at its position.
+  std::string bad = yaml;
+  bad.insert(bad.find("bodies:"), "pdge_basis: {prismatic: poly:2, rotary: fourier:2}\n");
+  CHECK(test::load_error(bad, "turns.yaml") ==
+        "turns.yaml:8:33: pdge_basis: unknown key 'rotary' (allowed: prismatic, revolute)");
+  bad = yaml;
+  bad.insert(bad.find("bodies:"), "pdge_basis: {revolute: fourier:two}\n");
+  CHECK(test::load_error(bad, "turns.yaml") ==
+        "turns.yaml:8:24: pdge_basis.revolute: basis \"fourier:two\": order \"two\" must be a "
+        "whole number 0..200 (e.g. fourier:3)");
+}
+
 TEST_CASE("identify: point data name the file and line of bad rows") {
   const Description d = load_machine_file(test::machine_path("vmc_3axis"));
   auto error_of = [&](const std::string& text) {

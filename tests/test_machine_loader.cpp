@@ -337,6 +337,72 @@ workpiece: {body: bed}
   CHECK(d.errors.at(0).distribution.b == doctest::Approx(0.005));
 }
 
+// A rotary table whose location group holds a length (E_X0C) and an angle (E_C0C).
+std::string location_machine(const std::string& location_default) {
+  return "weilgen: 1\nname: m\nerror_defaults:\n  location: " + location_default +
+         "\n  radial: {sigma: 1, unit: um}\n  axial: {sigma: 1, unit: um}\n"
+         "  positioning: {sigma: 5, unit: urad}\n  tilt: {sigma: 5, unit: urad}\n"
+         "bodies:\n  bed: {}\n  table:\n    parent: bed\n"
+         "    joint: {type: revolute, axis: z, coordinate: C, range: [-360, 360]}\n"
+         "    errors:\n      E_X0C: {}\n      E_C0C: {}\n      E_CC: {}\n"
+         "tool: {body: bed}\nworkpiece: {body: table}\n";
+}
+
+TEST_CASE("loader: error_defaults per kind: a group that mixes lengths and angles") {
+  const Description d =
+      load_machine_text(location_machine("\n    translation: {sigma: 4, unit: um}\n"
+                                         "    rotation: {uniform: [-10, 10], unit: µrad}"),
+                        "m.yaml");
+  const ErrorDef& x0c = d.errors.at(static_cast<std::size_t>(d.error_index("E_X0C")));
+  const ErrorDef& c0c = d.errors.at(static_cast<std::size_t>(d.error_index("E_C0C")));
+  CHECK(x0c.group == "location");
+  CHECK(c0c.group == "location");
+  CHECK(x0c.unit == "um");
+  CHECK(x0c.distribution.kind == Distribution::Kind::Normal);
+  CHECK(x0c.distribution.b == 4);
+  CHECK(x0c.to_base == doctest::Approx(1e-3));
+  CHECK(c0c.unit == "urad");  // the one unit table's spelling of µrad
+  CHECK(c0c.distribution.kind == Distribution::Kind::Uniform);
+  CHECK(c0c.distribution.hi == 10);
+  CHECK(c0c.to_base == doctest::Approx(1e-6));
+  // A group distribution and one kind's override: the translation takes the group's.
+  const Description e = load_machine_text(
+      location_machine("{sigma: 0.002, unit: mm, rotation: {sigma: 3, unit: arcsec}}"), "m.yaml");
+  const ErrorDef& ex = e.errors.at(static_cast<std::size_t>(e.error_index("E_X0C")));
+  const ErrorDef& ec = e.errors.at(static_cast<std::size_t>(e.error_index("E_C0C")));
+  CHECK(ex.unit == "mm");
+  CHECK(ex.distribution.b == 0.002);
+  CHECK(ec.unit == "arcsec");
+  CHECK(ec.distribution.b == 3);
+  CHECK(ec.to_base == doctest::Approx(kPi / 180 / 3600));
+}
+
+TEST_CASE("bad: error_defaults per kind") {
+  // One unit for the whole group: the angle E_C0C cannot take µm (names the error and its line).
+  expect_error(location_machine("{sigma: 5, unit: µm}"), "bad.yaml:4:30",
+               {"unit 'µm' is a length but error 'E_C0C' (line 16) is a rotation",
+                "location: {translation: {..., unit: um}, rotation: {..., unit: urad}}"});
+  // A kind's unit of the other dimension, at the unit.
+  expect_error(location_machine("{translation: {sigma: 5, unit: urad}, rotation: {sigma: 5}}"),
+               "bad.yaml:4:44",
+               {"error_defaults.location.translation.unit",
+                "unit 'urad' is an angle but a translation default needs a length"});
+  // A kind without a distribution; an unknown key in a kind; a unit beside kinds only.
+  expect_error(location_machine("{translation: {unit: um}, rotation: {sigma: 5}}"), "bad.yaml:4:27",
+               {"error_defaults.location.translation", "give a distribution"});
+  expect_error(location_machine("{translation: {sigma: 1, mean: 0}, rotation: {sigma: 5}}"),
+               "bad.yaml:4:38", {"unknown key 'mean'"});
+  expect_error(location_machine("{unit: um, translation: {sigma: 1}, rotation: {sigma: 5}}"),
+               "bad.yaml:4:20", {"'unit' goes with a distribution"});
+  // Only translations given: the rotation E_C0C has no default (at the error, naming the kind).
+  expect_error(location_machine("{translation: {sigma: 5, unit: um}}"), "bad.yaml:16:7",
+               {"'E_C0C' has no distribution", "error_defaults.location has none for a rotation",
+                "add rotation: {...}"});
+  // Both kinds given: the group's own distribution would apply to nothing.
+  expect_error(location_machine("{sigma: 1, translation: {sigma: 1}, rotation: {sigma: 5}}"),
+               "bad.yaml:4:13", {"applies to no error"});
+}
+
 TEST_CASE("loader: the one unit table: µm and µrad (micro sign or Greek mu) read as um and urad") {
   // The same machine written with um/urad and with µm (U+00B5), μm (U+03BC) and µrad: the same
   // description, the units stored in their ASCII spelling.

@@ -1,17 +1,19 @@
 // The Sobol' study of the 70-error dual-chuck laser pipe cutter (machines/pipe_cutter.yaml; seed
 // ../shared/seeds/lpcs_lie_group_sobol.txt, section 3): first-order (Saltelli) and total (Jansen)
-// indices of dx, dy, dz with bootstrap intervals, N = 20000 quasi-Monte Carlo samples, the Table 2
-// uniform error ranges, the jaws clamped at Y231 = Y451 = Z453 = 20 mm, the DD motors at
-// A12 = A04 = 0 and the feeding carriage at X = 100, 450, 800 mm; at order 1 (built-in model) and
-// order 2 (compiled at run time by the model loader), with the exact linear indices as a check.
+// indices of dx, dy, dz and the pipe's roll da with bootstrap intervals, N = 20000 quasi-Monte
+// Carlo samples, the Table 2 uniform error ranges, the jaws clamped at Y231 = Y451 = Z453 = 20 mm,
+// the chucks at A04 = 0 (A12 follows A04) and the feeding carriage at X = 100, 450, 800 mm; at
+// order 1 (built-in model) and order 2 (compiled at run time by the model loader), with the exact
+// linear indices as a check; and, from the exact linear indices, what changes when the chucks
+// turn (A04 = 0, 45, 90, 180 deg).
 //
 //   weilgen_exp_pipe_cutter_sobol [--out DIR] [--samples N] [--bootstrap R] [--threads T]
 //                                 [--orders 1,2]
 //
 // Writes DIR/results.md (a Markdown fragment: essential errors per output, index sums, order-2
 // minus order-1 differences, run summary), DIR/results.json (every index, timings, settings) and
-// DIR/sobol_dx.png, sobol_dy.png, sobol_dz.png (first-order indices of the essential errors at the
-// three poses, lowest requested order; skipped when gnuplot is missing).
+// DIR/sobol_dx.png, sobol_dy.png, sobol_dz.png, sobol_da.png (first-order indices of the essential
+// errors at the three poses, lowest requested order; skipped when gnuplot is missing).
 //
 // Links the built-in models (weilgen_builtin_models) and the generator (weilgen_generator, for
 // the loader's run-time compilation of the order-2 model), besides weilgen_runtime.
@@ -48,8 +50,11 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kEssential = 0.03;  // the seed's threshold for an essential error
-constexpr std::size_t kOutputs = 3;  // dx, dy, dz: outputs 0, 1, 2 of Model::deviation
-const char* const kOutputNames[kOutputs] = {"dx", "dy", "dz"};
+constexpr std::size_t kOutputs = 4;  // dx, dy, dz, da: outputs 0 .. 3 of Model::deviation
+const char* const kOutputNames[kOutputs] = {"dx", "dy", "dz", "da"};
+const char* const kOutputUnits[kOutputs] = {"mm", "mm", "mm", "rad"};
+const double kTurnA04[] = {0, 45, 90, 180};  // deg, the chucks' angles of the turning table
+constexpr std::size_t kTurns = 4;
 const double kFeedX[] = {100, 450, 800};  // mm, the seed's feeding positions
 constexpr std::size_t kPoses = 3;
 
@@ -58,6 +63,14 @@ struct Options {
   std::size_t samples = 20000, bootstrap = 200;
   unsigned threads = 0;
   std::vector<int> orders = {1, 2};
+};
+
+// One row of the turning table: exact linear figures at one X and A04.
+struct TurnRow {
+  double x = 0, a04 = 0;
+  double sigma_radial_um = kNaN;                 // sqrt(var(dy) + var(dz)), µm
+  double sigma_roll_urad = kNaN;                 // sqrt(var(da)), µrad
+  double S_dy = kNaN, S_dz = kNaN, S_da = kNaN;  // of E_YY451, E_YY451 and E_AA04
 };
 
 // Per order, pose, output and error.
@@ -146,8 +159,8 @@ Options parse_options(int argc, char** argv) {
 std::vector<std::vector<double>> seed_poses(const Description& desc) {
   std::vector<std::vector<double>> poses;
   for (double x : kFeedX) {
-    const std::map<std::string, double> by_name = {{"X", x},   {"A12", 0},   {"Y231", 20},
-                                                   {"A04", 0}, {"Y451", 20}, {"Z453", 20}};
+    const std::map<std::string, double> by_name = {
+        {"X", x}, {"Y231", 20}, {"A04", 0}, {"Y451", 20}, {"Z453", 20}};
     std::vector<double> pose;
     std::size_t used = 0;
     for (int b : desc.axes()) {
@@ -239,19 +252,62 @@ std::vector<std::size_t> essential_errors(const OrderRun& run, std::size_t o) {
   return rows;
 }
 
+// Exact linear figures of the model's first-order part at every X and every A04 of kTurnA04:
+// the radial and roll spreads and the indices that show the main chuck's jaws turning with it.
+std::vector<TurnRow> turning_table(const Model& model, const Description& desc,
+                                   const std::vector<std::vector<double>>& poses,
+                                   const std::vector<InputDistribution>& inputs) {
+  const std::size_t ne = desc.errors.size();
+  const auto yy451 = static_cast<std::size_t>(desc.error_index("E_YY451"));
+  const auto aa04 = static_cast<std::size_t>(desc.error_index("E_AA04"));
+  std::size_t a04_axis = 0;
+  const std::vector<int> axes = desc.axes();
+  for (std::size_t a = 0; a < axes.size(); ++a)
+    if (desc.bodies[static_cast<std::size_t>(axes[a])].joint.coordinate == "A04") a04_axis = a;
+  ModelData data(model);
+  std::vector<TurnRow> rows;
+  for (std::size_t p = 0; p < kPoses; ++p)
+    for (double a04 : kTurnA04) {
+      std::vector<double> pose = poses[p];
+      pose[a04_axis] = a04;
+      model.coefficients(data, pose.data(), data.coeff.data());
+      const auto column = [&](std::size_t o) {
+        return std::vector<double>(data.coeff.begin() + static_cast<long>(o * ne),
+                                   data.coeff.begin() + static_cast<long>((o + 1) * ne));
+      };
+      double radial = 0, roll = 0;
+      for (std::size_t i = 0; i < ne; ++i) {
+        const double var = inputs[i].stddev() * inputs[i].stddev();
+        radial += var * (data.coeff[ne + i] * data.coeff[ne + i] +
+                         data.coeff[2 * ne + i] * data.coeff[2 * ne + i]);
+        roll += var * data.coeff[3 * ne + i] * data.coeff[3 * ne + i];
+      }
+      TurnRow r;
+      r.x = kFeedX[p];
+      r.a04 = a04;
+      r.sigma_radial_um = 1e3 * std::sqrt(radial);
+      r.sigma_roll_urad = 1e6 * std::sqrt(roll);
+      r.S_dy = linear_sobol_indices(column(1), inputs)[yy451];
+      r.S_dz = linear_sobol_indices(column(2), inputs)[yy451];
+      r.S_da = linear_sobol_indices(column(3), inputs)[aa04];
+      rows.push_back(r);
+    }
+  return rows;
+}
+
 std::string results_markdown(const Description& desc, const std::vector<OrderRun>& runs,
-                             const Options& opt, unsigned threads, double design_seconds,
-                             double confidence) {
+                             const std::vector<TurnRow>& turns, const Options& opt,
+                             unsigned threads, double design_seconds, double confidence) {
   std::ostringstream md;
   const auto& errors = desc.errors;
   const int ci = static_cast<int>(std::lround(100 * confidence));
   md << "<!-- Written by weilgen_exp_pipe_cutter_sobol (bench/experiments/pipe_cutter_sobol.cpp)."
         " -->\n\n";
-  md << "Sobol' indices of the working point's deviation (dx, dy, dz) of `" << desc.name << "` ("
-     << errors.size() << " errors, uniform per Table 2), N = " << opt.samples
+  md << "Sobol' indices of the working point's deviation (dx, dy, dz) and the pipe's roll (da) of `"
+     << desc.name << "` (" << errors.size() << " errors, uniform per Table 2), N = " << opt.samples
      << " quasi-Monte Carlo samples (Sobol' points, digital shift seed 1), " << ci
      << " % bootstrap intervals (" << opt.bootstrap
-     << " resamples); poses A12 = 0, Y231 = 20, A04 = 0, Y451 = 20, Z453 = 20 and X = 100, 450, "
+     << " resamples); poses Y231 = 20, A04 = 0 (A12 = A04), Y451 = 20, Z453 = 20 and X = 100, 450, "
         "800 mm.\n";
 
   // (a) essential errors per order and output.
@@ -335,7 +391,19 @@ std::string results_markdown(const Description& desc, const std::vector<OrderRun
       }
   }
 
-  // (d) run summary.
+  // (d) turning the chucks.
+  md << "\n### Turning the chucks (exact linear indices)\n\n"
+     << "σ_radial = √(var(dy) + var(dz)) of the working point, σ(da) of the roll; S of E_YY451 "
+        "(jaw 45.1's positioning) in dy and dz, of E_AA04 (the main DD motor's angular "
+        "positioning) in da.\n\n"
+     << "| X (mm) | A04 (deg) | σ_radial (µm) | σ(da) (µrad) | S(E_YY451) dy | S(E_YY451) dz | "
+        "S(E_AA04) da |\n| ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+  for (const TurnRow& r : turns)
+    md << "| " << g3(r.x) << " | " << g3(r.a04) << " | " << f3(r.sigma_radial_um) << " | "
+       << f3(r.sigma_roll_urad) << " | " << f3(r.S_dy) << " | " << f3(r.S_dz) << " | " << f3(r.S_da)
+       << " |\n";
+
+  // (e) run summary.
   md << "\n### Run summary\n\n| | value |\n| --- | --- |\n"
      << "| base sample size N | " << opt.samples << " |\n"
      << "| bootstrap resamples | " << opt.bootstrap << " |\n"
@@ -355,8 +423,9 @@ std::string results_markdown(const Description& desc, const std::vector<OrderRun
 
 nlohmann::json results_json(const Description& desc, const std::vector<InputDistribution>& inputs,
                             const std::vector<std::vector<double>>& poses,
-                            const std::vector<OrderRun>& runs, const Options& opt, unsigned threads,
-                            double design_seconds, double confidence) {
+                            const std::vector<OrderRun>& runs, const std::vector<TurnRow>& turns,
+                            const Options& opt, unsigned threads, double design_seconds,
+                            double confidence) {
   const auto& errors = desc.errors;
   nlohmann::json axes = nlohmann::json::array();
   for (int b : desc.axes()) axes.push_back(desc.bodies[b].joint.coordinate);
@@ -394,7 +463,7 @@ nlohmann::json results_json(const Description& desc, const std::vector<InputDist
         summary.push_back({{"order", run.order},
                            {"pose", pose_json(p)},
                            {"output", kOutputNames[o]},
-                           {"unit", "mm"},
+                           {"unit", kOutputUnits[o]},
                            {"mean", json_number(run.stats[p][o].mean)},
                            {"variance", json_number(run.stats[p][o].variance)}});
         for (std::size_t i = 0; i < run.errors; ++i) {
@@ -414,6 +483,15 @@ nlohmann::json results_json(const Description& desc, const std::vector<InputDist
       }
   }
   timings["runs"] = runs_json;
+  nlohmann::json turning = nlohmann::json::array();
+  for (const TurnRow& r : turns)
+    turning.push_back({{"X_mm", r.x},
+                       {"A04_deg", r.a04},
+                       {"sigma_radial_um", r.sigma_radial_um},
+                       {"sigma_da_urad", r.sigma_roll_urad},
+                       {"S_dy_E_YY451", r.S_dy},
+                       {"S_dz_E_YY451", r.S_dz},
+                       {"S_da_E_AA04", r.S_da}});
   return {{"weilgen", kVersion},
           {"experiment", "pipe_cutter_sobol"},
           {"machine", {{"name", desc.name}, {"source", desc.source_file}, {"axes", axes}}},
@@ -425,12 +503,13 @@ nlohmann::json results_json(const Description& desc, const std::vector<InputDist
             {"confidence", confidence},
             {"threads", threads},
             {"orders", opt.orders},
-            {"outputs", {"dx", "dy", "dz"}},
+            {"outputs", {"dx", "dy", "dz", "da"}},
             {"essential_threshold", kEssential},
             {"poses", pose_list}}},
           {"inputs", in},
           {"timings", timings},
           {"summary", summary},
+          {"turning", turning},
           {"results", results}};
 }
 
@@ -495,6 +574,7 @@ int run(const Options& opt) {
   const double design_seconds = seconds_since(t0);
 
   std::vector<OrderRun> runs;
+  std::vector<TurnRow> turns;
   for (int order : opt.orders) {
     LoadOptions lo;
     lo.order = order;
@@ -514,6 +594,7 @@ int run(const Options& opt) {
     std::cout << "order " << order << ": model origin: " << run.origin << " (loaded in "
               << duration(run.load_seconds) << ")\n";
 
+    if (turns.empty()) turns = turning_table(model, desc, poses, inputs);
     // Exact indices of the linear model (the first-order reference; exact at order 1).
     ModelData data(model);
     for (std::size_t p = 0; p < kPoses; ++p) {
@@ -563,13 +644,13 @@ int run(const Options& opt) {
   const auto out = [&](const std::string& name) {
     return (std::filesystem::path(opt.out) / name).string();
   };
-  write_file_atomically(out("results.md"),
-                        results_markdown(desc, runs, opt, threads, design_seconds, so.confidence));
+  write_file_atomically(out("results.md"), results_markdown(desc, runs, turns, opt, threads,
+                                                            design_seconds, so.confidence));
   written.push_back(out("results.md"));
-  write_file_atomically(
-      out("results.json"),
-      results_json(desc, inputs, poses, runs, opt, threads, design_seconds, so.confidence).dump(1) +
-          "\n");
+  write_file_atomically(out("results.json"), results_json(desc, inputs, poses, runs, turns, opt,
+                                                          threads, design_seconds, so.confidence)
+                                                     .dump(1) +
+                                                 "\n");
   written.push_back(out("results.json"));
   write_charts(desc, runs.front(), opt, written);
 

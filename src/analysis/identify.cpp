@@ -83,9 +83,12 @@ ErrorParameterisation::ErrorParameterisation(const Description& desc, const Pdge
       continue;
     }
     // Precedence: per-error flag, run-wide flag, the error's basis, the machine's, fallback.
-    std::string spec = choice.fallback;
+    std::string spec = choice.fallback.empty() ? default_pdge_basis(j) : choice.fallback;
     SourceLoc where;
-    if (!desc.pdge_basis.empty()) spec = desc.pdge_basis, where = desc.pdge_basis_loc;
+    const bool rotary = j.type == JointType::Revolute;
+    const std::string& machine = rotary ? desc.pdge_basis_revolute : desc.pdge_basis;
+    if (!machine.empty())
+      spec = machine, where = rotary ? desc.pdge_basis_revolute_loc : desc.pdge_basis_loc;
     if (!e.basis.empty()) spec = e.basis, where = e.basis_loc;
     if (choice.all) spec = *choice.all, where = {};
     for (const auto& [name, s] : choice.per_error)
@@ -96,7 +99,7 @@ ErrorParameterisation::ErrorParameterisation(const Description& desc, const Pdge
                                   "(range: [min, max]) to place its basis on");
     }
     try {
-      bases_[k] = parse_basis(spec).on(j.min, j.max);
+      bases_[k] = basis_on_joint(parse_basis(spec), j);
     } catch (const std::invalid_argument& ex) {
       if (where.line > 0) throw InputError(where, ex.what());
       throw std::invalid_argument(e.name + ": " + ex.what());

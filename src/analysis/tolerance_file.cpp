@@ -345,6 +345,35 @@ ToleranceOverrides read_tolerance_file(const std::string& path, const Descriptio
   return read_tolerance_text(text, path, desc);
 }
 
+std::vector<double> read_error_values(const std::string& path, const Description& desc) {
+  std::string text;
+  if (!read_file(path, text)) throw InputError({path, 0, 0}, "cannot read the error values");
+  const ToleranceOverrides o = read_tolerance_text(text, path, desc);
+  std::vector<double> values(desc.errors.size(), 0.0);
+  for (std::size_t i = 0; i < o.size(); ++i) {
+    if (!o[i]) continue;
+    if (!o[i]->is_constant()) {
+      // The entry's line: the first line naming the error or one of its aliases.
+      int line = 0, n = 0;
+      std::istringstream in(text);
+      for (std::string l; line == 0 && std::getline(in, l);) {
+        ++n;
+        if (l.find(desc.errors[i].name) != std::string::npos) line = n;
+        for (const auto& a : desc.errors[i].aliases)
+          if (line == 0 && l.find(a.name) != std::string::npos) line = n;
+        if (line == 0 && l.find("group:") == std::string::npos &&
+            l.find(desc.errors[i].group) != std::string::npos)
+          line = n;  // set through its group
+      }
+      throw InputError({path, line, 0}, desc.errors[i].name +
+                                            ": a distribution, but a compensation needs a value: "
+                                            "write {const: v, unit: ...}");
+    }
+    values[i] = o[i]->mean();
+  }
+  return values;
+}
+
 std::string tolerance_file_text(const Description& desc,
                                 const std::vector<InputDistribution>& base_unit_distributions,
                                 const std::string& header_comment) {

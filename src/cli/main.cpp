@@ -17,7 +17,7 @@ const std::map<std::string, Verb>& verbs() {
   static const std::map<std::string, Verb> v = {
       {"generate",
        {weilgen::cli::verb_generate,
-        "generate <machine>... [--order r] [--out DIR] [--check]\n"
+        "generate <machine>... [--order r] [--out DIR] [--check] [--c-api]\n"
         "      multiply the error HTMs over the Weil algebra and write the C++ header\n"
         "      and the closed-form report (generated/<machine>.hpp, .md)"}},
 #ifndef WEILGEN_CODEGEN_ONLY
@@ -43,8 +43,13 @@ const std::map<std::string, Verb>& verbs() {
         "      tighten the most sensitive errors until the reliability targets hold"}},
       {"iso230-2",
        {weilgen::cli::verb_iso230_2,
-        "iso230-2 <data.csv> [--axis X] [--json FILE] [--plot FILE]\n"
+        "iso230-2 <data.csv> [--axis X] [--json FILE] [--csv FILE] [--plot FILE]\n"
+        "         [--report F.html] [--tolerance SPEC] [--expansion PPM_PER_K] ...\n"
         "      ISO 230-2 positioning figures, with the thermal-drift-eliminated evaluation"}},
+      {"import",
+       {weilgen::cli::verb_import,
+        "import <file> [--format auto|carto|wide|tidy] [--axis X] [--out FILE]\n"
+        "      a laser export (Renishaw XL-80/CARTO wide CSV, generic wide) as the tidy CSV"}},
       {"fit-pdge",
        {weilgen::cli::verb_fit_pdge,
         "fit-pdge <data.csv> [--basis poly|fourier|legendre|chebyshev|all] [--order n|auto]\n"
@@ -58,6 +63,10 @@ const std::map<std::string, Verb>& verbs() {
        {weilgen::cli::verb_gap,
         "gap <machine> --data FILE [--holdout ...] [--effects ...] [--json F] [--report F.md]\n"
         "      where model and machine disagree, which unmodelled effect, how far it shrinks"}},
+      {"linuxcnc",
+       {weilgen::cli::verb_linuxcnc,
+        "linuxcnc <machine> --out DIR [--params P] [--name NAME]\n"
+        "      a LinuxCNC HAL component compensating the machine's errors in the servo thread"}},
 #endif
   };
   return v;

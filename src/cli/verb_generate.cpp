@@ -73,7 +73,10 @@ int verb_generate(const Args& args) {
                            "output directory")(
       "check",
       "write nothing; exit 1 and list the stale files when the files in --out differ\n"
-      "from what would be generated");
+      "from what would be generated")(
+      "c-api",
+      "also write the C API: <out>/<name>_c.h (C99, extern \"C\" under C++) and\n"
+      "<out>/<name>_c.cpp, its implementation over <name>.hpp (docs/controllers.md)");
   po::variables_map vm;
   if (auto stop = parse_args<std::vector<std::string>>("generate", args, opts, "machine", -1, vm))
     return *stop;
@@ -89,7 +92,7 @@ int verb_generate(const Args& args) {
   }
   std::vector<gen::GeneratedFile> files;
   for (const Description& d : machines) {
-    auto f = gen::generate_files(d, order, out);
+    auto f = gen::generate_files(d, order, out, vm.count("c-api") > 0);
     files.insert(files.end(), f.begin(), f.end());
   }
   if (vm.count("check")) {

@@ -3,6 +3,7 @@
 // write the parameters as a controller header. docs/identify.md.
 #include <iostream>
 
+#include "comp_table.hpp"
 #include "study.hpp"
 #include "verbs.hpp"
 #include "weilgen/analysis/identify.hpp"
@@ -25,7 +26,8 @@ int verb_identify(const Args& args) {
       "weilgen identify <machine> --data FILE [options]\n\n"
       "Fits the model's error parameters to point measurements (docs/data-format.md): each\n"
       "PIGE a constant, each PDGE a basis in its own axis position (the machine file's\n"
-      "pdge_basis / basis:, else poly:3; --pdge overrides). Linear least squares through the\n"
+      "pdge_basis / basis:, else poly:3 on a linear axis and fourier:2 with a one-turn period\n"
+      "on a rotary one; --pdge overrides). Linear least squares through the\n"
       "generated coefficient matrix (column-equilibrated SVD: minimum-norm solution, rank, the\n"
       "parameter combinations the data cannot identify); Gauss-Newton for order >= 2. Predicts\n"
       "other measurements (points, ballbar circles) and writes the parameters as a standalone\n"
@@ -39,9 +41,9 @@ int verb_identify(const Args& args) {
       "measurement CSV (poses + deviations); repeatable")(
       "pdge", po::value<std::vector<std::string>>(&pdge)->composing(),
       "basis of every PDGE (poly:3, fourier:2, legendre:4, chebyshev:4, fourier:2:20 = period "
-      "20 mm) or of one error (E_YY=fourier:3); repeatable, applied in order")(
-      "fix", po::value<std::vector<std::string>>(&fixed)->composing(),
-      "hold an error at zero: a name, an alias or group:<group> (as --set); repeatable")(
+      "20 mm, or 20 deg on a rotary axis) or of one error (E_YY=fourier:3); repeatable, applied "
+      "in order")("fix", po::value<std::vector<std::string>>(&fixed)->composing(),
+                  "hold an error at zero: a name, an alias or group:<group> (as --set); repeatable")(
       "rank-tol", ranged(&rank_tol, NumberRange::open(0, 1))->default_value(rank_tol, "1e-9"),
       "singular values below rank-tol x the largest (equilibrated columns) count as zero")(
       "predict", po::value<std::vector<std::string>>(&predict)->composing(),
@@ -61,6 +63,8 @@ int verb_identify(const Args& args) {
       "quiet,q", po::bool_switch(&flags.quiet), "no model messages on stderr");
   opts.add(ballbar_circle_options(circle));
   opts.add(model_options(flags));
+  CompTableFlags comp;
+  opts.add(comp_table_options(comp, true));
   po::variables_map vm;
   if (auto stop = parse_args<std::string>("identify", args, opts, "machine", 1, vm)) return *stop;
   if (!vm.count("machine")) return usage_error("identify", "no machine given");
@@ -75,11 +79,14 @@ int verb_identify(const Args& args) {
                               {"--csv", csv_path},
                               {"--plot", plot_path},
                               {"--emit-params", emit},
-                              {"--predict-out", predict_out}});
+                              {"--predict-out", predict_out},
+                              {"--comp-table", comp.path}});
   if (!plot_path.empty()) check_plot_target(plot_path);
+  check_comp_table_flags(comp, vm, true);
 
   // Every input read and every output checked before the work, so that nothing fails after it.
   const Description desc = load_machine_file(resolve_machine(flags.machine));
+  if (!comp.path.empty()) check_axis_comp_table(desc, comp.options);
   const PdgeBasisChoice choice = parse_pdge_flags(desc, pdge);
   const ReadOptions ro = machine_read_options(desc, vm.count("allow-unknown") > 0);
   const auto warn = [](const std::string& w) { std::cerr << w << "\n"; };
@@ -100,6 +107,8 @@ int verb_identify(const Args& args) {
   io.rank_tolerance = rank_tol;
   io.fixed = fixed;
   const IdentifyResult r = Identification(io).run(*model, param, points);
+  const CompTable comp_table =
+      comp.path.empty() ? CompTable{} : axis_comp_table(*model, param, r.theta, comp.options);
   std::cout << identify_text(*model, param, r, points);
 
   nlohmann::json j = identify_json(*model, param, r, data);
@@ -126,6 +135,7 @@ int verb_identify(const Args& args) {
   if (!csv_path.empty()) write_file_atomically(csv_path, identify_csv(*model, param, r));
   if (!plot_path.empty())
     write_plot(plot_path, identify_panels(param, r), "weilgen identify: " + model->name());
+  if (!comp.path.empty()) std::cout << "\n" << write_comp_table(comp, comp_table);
   return 0;
 }
 

@@ -17,9 +17,11 @@ int verb_sensitivity(const Args& args);
 int verb_reliability(const Args& args);
 int verb_allocate(const Args& args);
 int verb_iso230_2(const Args& args);
+int verb_import(const Args& args);
 int verb_fit_pdge(const Args& args);
 int verb_identify(const Args& args);
 int verb_gap(const Args& args);
+int verb_linuxcnc(const Args& args);
 
 // Prints "weilgen <verb>: <message>" to stderr and returns 2 (usage error).
 int usage_error(const std::string& verb, const std::string& message);

@@ -9,6 +9,7 @@
 #include "weilgen/base/text.hpp"
 #include "weilgen/base/version.hpp"
 #include "weilgen/codegen/cse.hpp"
+#include "weilgen/codegen/emit_c_api.hpp"
 #include "weilgen/codegen/emit_compensation.hpp"
 #include "weilgen/codegen/printer.hpp"
 #include "weilgen/machine/model_key.hpp"
@@ -418,6 +419,7 @@ std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_la
   os << "inline constexpr std::array<const char*, kNumOutputs> kOutputs = {{" << names << "}};\n";
   os << "inline constexpr std::array<const char*, kNumOutputs> kOutputUnits = {{" << units
      << "}};\n\n";
+  os << emit_index_constants(m);
   os << "// Monomials of degree >= 2 with a non-zero coefficient: error indices, padded with -1.\n";
   const std::size_t width = higher.empty() ? 1 : higher.back().size();
   os << "inline constexpr std::array<std::array<int, " << width

@@ -278,7 +278,7 @@ std::string emit_report_markdown(const SymbolicModel& m, const std::string& sour
                   : format_literal(j.min) + " … " + format_literal(j.max))
        << " |\n";
   }
-  if (!d.points.empty() || !d.derived.empty() || d.output) {
+  if (!d.points.empty() || !d.directions.empty() || !d.derived.empty() || d.output) {
     os << "\n## Derived quantities\n\n";
     if (!d.points.empty()) {
       os << "Chain points (deviation P(e) − P(0) in the base frame, mm; `name.x` …):\n\n"
@@ -286,6 +286,15 @@ std::string emit_report_markdown(const SymbolicModel& m, const std::string& sour
       for (const ChainPoint& p : d.points)
         os << "| " << p.name << " | " << d.bodies[p.at.body].name << " | [" << p.at.point[0].str()
            << ", " << p.at.point[1].str() << ", " << p.at.point[2].str() << "] |\n";
+      os << "\n";
+    }
+    if (!d.directions.empty()) {
+      os << "Chain directions (nominal unit vector in the base frame at the pose, no unit; "
+            "`name.x` …):\n\n| direction | body | direction in the body |\n| --- | --- | --- |\n";
+      for (const ChainDirection& u : d.directions)
+        os << "| " << u.name << " | " << d.bodies[u.body].name << " | ["
+           << format_literal(u.direction[0]) << ", " << format_literal(u.direction[1]) << ", "
+           << format_literal(u.direction[2]) << "] |\n";
       os << "\n";
     }
     if (!d.derived.empty()) {

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "weilgen/base/atomic_file.hpp"
+#include "weilgen/codegen/emit_c_api.hpp"
 #include "weilgen/codegen/emit_cpp.hpp"
 #include "weilgen/codegen/emit_report.hpp"
 #include "weilgen/machine/yaml_loader.hpp"
@@ -38,12 +39,17 @@ std::string generate_header(const Description& desc, int order_override, std::st
 }
 
 std::vector<GeneratedFile> generate_files(const Description& desc, int order_override,
-                                          const std::string& out_dir) {
+                                          const std::string& out_dir, bool c_api) {
   const SymbolicModel named = named_model(desc, order_override);
   const std::string label = source_label(desc.source_file);
   const std::string base = (std::filesystem::path(out_dir) / named.desc.name).string();
-  return {{base + ".hpp", emit_cpp_header(named, label)},
-          {base + ".md", emit_report_markdown(named, label)}};
+  std::vector<GeneratedFile> files = {{base + ".hpp", emit_cpp_header(named, label)},
+                                      {base + ".md", emit_report_markdown(named, label)}};
+  if (c_api) {
+    files.push_back({base + "_c.h", emit_c_api_header(named, label)});
+    files.push_back({base + "_c.cpp", emit_c_api_source(named, label)});
+  }
+  return files;
 }
 
 namespace {

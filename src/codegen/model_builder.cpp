@@ -251,6 +251,14 @@ struct Builder {
       for (int i = 0; i < 3; ++i)
         names[p.name + "." + static_cast<char>('x' + i)] = m.m[i][3].without_constant();
     }
+    for (const ChainDirection& u : d.directions) {
+      const Mat4 r = nominal_frame(u.body);
+      for (int i = 0; i < 3; ++i) {
+        ex c = 0;
+        for (int k = 0; k < 3; ++k) c += r.m[i][k].constant() * exact_decimal(u.direction[k]);
+        names[u.name + "." + static_cast<char>('x' + i)] = Poly(alg.normalize(c));
+      }
+    }
     for (const Derived& q : d.derived) names[q.name] = value(q.value, names);
     Mat4 m = Mat4::identity();
     for (const TransformStep& s : d.output->steps) {
@@ -293,6 +301,13 @@ struct Builder {
     const Mat4 axis = error_transform(body, ErrorPlacement::Axis);
     m = m.mul(axis, alg).mul(joint(body), alg).mul(neumann_inverse(axis, alg), alg);
     return m.mul(error_transform(body, ErrorPlacement::After), alg);
+  }
+
+  // Base -> body at zero errors (Offset · J per body): the nominal frame of a chain direction.
+  Mat4 nominal_frame(int body) const {
+    Mat4 m = Mat4::identity();
+    for (int b : d.chain_to(body)) m = m.mul(offset(d.bodies[b].offset), alg).mul(joint(b), alg);
+    return m;
   }
 
   // Base -> end.body, then Trans(end.point).

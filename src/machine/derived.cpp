@@ -19,6 +19,20 @@ std::vector<std::string> point_names(const Description& d) {
   return out;
 }
 
+// Index of the entry called `name` in chain points or directions, -1 when none.
+template <typename T>
+int index_of(const std::vector<T>& entries, const std::string& name) {
+  for (std::size_t i = 0; i < entries.size(); ++i)
+    if (entries[i].name == name) return static_cast<int>(i);
+  return -1;
+}
+
+std::vector<std::string> point_and_direction_names(const Description& d) {
+  std::vector<std::string> out = point_names(d);
+  for (const ChainDirection& u : d.directions) out.push_back(u.name);
+  return out;
+}
+
 std::vector<std::string> coordinate_names(const Description& d) {
   std::vector<std::string> out;
   for (const Body& b : d.bodies)
@@ -58,6 +72,7 @@ class Checker {
       check_expression(s.amount, all, s.loc, what);
       for (const Expr& e : s.v) {
         check_expression(e, all, s.loc, what);
+        refuse_direction(e, all, s.loc, what, "the twist's v =");
         if (!is_nominal(e, all, s.loc, what)) {
           throw InputError(s.loc, what + ": the twist's v = '" + e.str() +
                                       "' depends on errors; a twist's axis must be nominal (put "
@@ -99,6 +114,29 @@ class Checker {
     return true;
   }
 
+  // The first direction component `e` uses, directly or through derived quantities, else "".
+  // Directions are nominal but only the chains evaluate them: the loader cannot, so they may
+  // not be divisors (whose travel-range check evaluates them) nor twist axes.
+  std::string direction_used(const Expr& e, std::size_t before) const {
+    for (const std::string& n : e.params()) {
+      const NameRef r = resolve_name(d_, n, before);
+      if (r.kind == NameRef::Kind::DirectionComponent) return n;
+      if (r.kind != NameRef::Kind::Derived) continue;
+      const auto i = static_cast<std::size_t>(r.index);
+      if (std::string via = direction_used(d_.derived[i].value, i); !via.empty()) return via;
+    }
+    return "";
+  }
+
+  void refuse_direction(const Expr& e, std::size_t before, const SourceLoc& loc,
+                        const std::string& what, const std::string& role) const {
+    const std::string via = direction_used(e, before);
+    if (via.empty()) return;
+    throw InputError(loc, what + ": " + role + " '" + e.str() + "' uses the direction component '" +
+                              via + "'; directions may multiply deviations but cannot be " +
+                              "divisors or twist axes");
+  }
+
   // The first name that makes `e` depend on errors (a point, or a derived quantity that does).
   std::string error_source(const Expr& e, std::size_t before) const {
     for (const std::string& n : e.params()) {
@@ -121,6 +159,7 @@ class Checker {
     if (e.a) check_operations(*e.a, before, loc, what);
     if (e.b) check_operations(*e.b, before, loc, what);
     if (e.kind == Expr::Kind::Div) {
+      refuse_direction(*e.b, before, loc, what, "the divisor");
       if (!is_nominal(*e.b, before, loc, what)) {
         throw InputError(loc, what + ": divides by '" + e.b->str() +
                                   "', which depends on errors (" + error_source(*e.b, before) +
@@ -137,7 +176,10 @@ class Checker {
         throw InputError(loc, what + ": '" + e.a->str() + "' depends on errors, so its exponent " +
                                   "must be a whole number >= 0, not " + format_short(k));
       }
-      if (nominal && k < 0) check_nonzero(*e.a, before, loc, what);
+      if (nominal && k < 0) {
+        refuse_direction(*e.a, before, loc, what, "the divisor");
+        check_nonzero(*e.a, before, loc, what);
+      }
     }
   }
 
@@ -189,7 +231,8 @@ class Checker {
       }
       resolve_links(d_, values);
       for (std::size_t i = 0; i < before; ++i)
-        if (d_.derived[i].nominal) values[d_.derived[i].name] = d_.derived[i].value.eval(values);
+        if (d_.derived[i].nominal && direction_used(d_.derived[i].value, i).empty())
+          values[d_.derived[i].name] = d_.derived[i].value.eval(values);
       const double v = den.eval(values);
       if (!std::isfinite(v)) {
         throw InputError(loc,
@@ -291,16 +334,22 @@ NameRef resolve_name(const Description& d, const std::string& name, std::size_t 
   NameRef r;
   if (const auto dot = name.find('.'); dot != std::string::npos) {
     const std::string base = name.substr(0, dot);
-    for (std::size_t i = 0; i < d.points.size(); ++i) {
-      if (d.points[i].name == base) {
-        r.kind = NameRef::Kind::PointComponent;
-        r.index = static_cast<int>(i);
-        r.component = name[dot + 1] - 'x';
-        return r;
-      }
+    r.component = name[dot + 1] - 'x';
+    if ((r.index = index_of(d.points, base)) >= 0) {
+      r.kind = NameRef::Kind::PointComponent;
+      return r;
     }
-    throw std::invalid_argument("unknown chain point '" + base + "' in '" + name +
-                                "' (points: " + listed(point_names(d)) + ")");
+    if ((r.index = index_of(d.directions, base)) >= 0) {
+      r.kind = NameRef::Kind::DirectionComponent;
+      return r;
+    }
+    if (d.directions.empty()) {
+      throw std::invalid_argument("unknown chain point '" + base + "' in '" + name +
+                                  "' (points: " + listed(point_names(d)) + ")");
+    }
+    throw std::invalid_argument(
+        "unknown chain point or direction '" + base + "' in '" + name +
+        "' (points and directions: " + listed(point_and_direction_names(d)) + ")");
   }
   for (std::size_t i = 0; i < d.derived.size(); ++i) {
     if (d.derived[i].name != name) continue;
@@ -328,6 +377,11 @@ NameRef resolve_name(const Description& d, const std::string& name, std::size_t 
   if (std::any_of(d.points.begin(), d.points.end(),
                   [&](const ChainPoint& p) { return p.name == name; })) {
     throw std::invalid_argument("'" + name + "' is a chain point: use its components '" + name +
+                                ".x', '" + name + ".y', '" + name + ".z'");
+  }
+  if (std::any_of(d.directions.begin(), d.directions.end(),
+                  [&](const ChainDirection& u) { return u.name == name; })) {
+    throw std::invalid_argument("'" + name + "' is a chain direction: use its components '" + name +
                                 ".x', '" + name + ".y', '" + name + ".z'");
   }
   std::vector<std::string> derived;

@@ -2,9 +2,10 @@
 //   loader_yaml.cpp      located YAML reading: positions, mappings, scalars, numbers, expressions
 //   loader_schema.cpp    the file's top level: version, parameters, groups, units, distributions
 //   loader_topology.cpp  bodies, offsets, joints (axis form and twists), links, the body tree
-//   loader_errors.cpp    error components: ISO names, custom errors, aliases, groups, defaults
-//   loader_chains.cpp    chain points, derived quantities, the output transform, tool,
-//                        workpiece and algebra
+//   loader_errors.cpp    error components: ISO names, custom errors, aliases, groups
+//   loader_defaults.cpp  error_defaults (per group, per kind) and pdge_basis (per joint type)
+//   loader_chains.cpp    chain points and directions, derived quantities, the output
+//                        transform, tool, workpiece and algebra
 //   yaml_loader.cpp      the public API (weilgen/machine/yaml_loader.hpp) and Loader::load
 #pragma once
 
@@ -45,10 +46,10 @@ inline Unit table_unit(const std::string& name) {
   return {name, f.to_base, f.angle};
 }
 
-const std::vector<std::string> kTopKeys = {"weilgen", "name",       "title",     "notes",
-                                           "algebra", "parameters", "groups",    "error_defaults",
-                                           "bodies",  "tool",       "workpiece", "points",
-                                           "derived", "output",     "pdge_basis"};
+const std::vector<std::string> kTopKeys = {"weilgen", "name",       "title",      "notes",
+                                           "algebra", "parameters", "groups",     "error_defaults",
+                                           "bodies",  "tool",       "workpiece",  "points",
+                                           "derived", "output",     "pdge_basis", "directions"};
 const std::vector<std::string> kBodyKeys = {"parent", "offset", "joint", "errors"};
 const std::vector<std::string> kOffsetKeys = {"translation", "rotation"};
 const std::vector<std::string> kRotationKeys = {"axis", "angle"};
@@ -61,9 +62,13 @@ const std::vector<std::string> kDistributionKeys = {"sigma", "normal", "uniform"
 const std::vector<std::string> kErrorKeys = {
     "aliases",     "group", "unit",   "dependence", "effect",      "direction", "placement",
     "description", "sigma", "normal", "uniform",    "truncnormal", "basis"};
-const std::vector<std::string> kDefaultKeys = {"sigma", "normal", "uniform", "truncnormal", "unit"};
+const std::vector<std::string> kDefaultKeys = {"sigma", "normal",      "uniform", "truncnormal",
+                                               "unit",  "translation", "rotation"};
+const std::vector<std::string> kKindDefaultKeys = {"sigma", "normal", "uniform", "truncnormal",
+                                                   "unit"};
 const std::vector<std::string> kParameterKeys = {"value", "unit", "description"};
 const std::vector<std::string> kPointKeys = {"body", "point"};
+const std::vector<std::string> kDirectionKeys = {"body", "direction"};
 const std::vector<std::string> kAlgebraKeys = {"order", "relations"};
 const std::vector<std::string> kAliasKeys = {"name", "sign"};
 
@@ -104,10 +109,16 @@ inline std::string sub_path(const std::string& path, const std::string& key) {
   return path.empty() ? key : path + "." + key;
 }
 
-// Default distribution of an error group (`error_defaults`).
+// Default distribution of an error group (`error_defaults`), for all its errors or for one kind
+// (translations or rotations: a group such as `location` holds both).
 struct GroupDefault {
   Distribution distribution;
   std::string unit;  // empty: values are in the error's unit
+  Field unit_at;     // where the unit is written (messages)
+};
+
+struct GroupDefaults {
+  std::optional<GroupDefault> any, translation, rotation;
 };
 
 // A body while the file is read: its parent is still a name, indices are in file order.
@@ -212,7 +223,16 @@ class Loader {
 
   std::string known_group(const Field& f) const;
 
+  // error_defaults (loader_defaults.cpp): per group a distribution, or per kind
+  // (translation, rotation) one each.
   void read_error_defaults(const Field& f);
+
+  // One default's distribution and unit; `kind` (translation or rotation) checks the unit's
+  // dimension, empty accepts any.
+  std::optional<GroupDefault> read_group_default(const MapView& m, const std::string& kind) const;
+
+  // pdge_basis: one basis for every PDGE, or {prismatic: ..., revolute: ...} (loader_defaults.cpp).
+  void read_pdge_basis(const Field& f);
 
   // sigma | normal | uniform | truncnormal, at most one; values in the caller's unit.
   std::optional<Distribution> read_distribution(const MapView& m) const;
@@ -238,6 +258,9 @@ class Loader {
   // ---- Points, derived quantities, output transform ---------------------------------------
 
   void read_points(const Field& f);
+
+  // Nominal body directions (`directions:`), after the bodies.
+  void read_directions(const Field& f);
 
   void read_derived(const Field& f);
 
@@ -303,6 +326,9 @@ class Loader {
 
   PointSpec read_point_spec(const Field& f) const;
 
+  // A body named in `body` (points, directions), as its index.
+  int body_ref(const Field& body) const;
+
   void read_algebra(const Field& f);
 
   int read_order(const Field& f) const;
@@ -317,10 +343,9 @@ class Loader {
   std::string file_;
   Description d_;
   std::map<std::string, double> parameter_defaults_;
-  std::map<std::string, GroupDefault> defaults_;
-  std::map<std::string, Field> default_units_;  // where each group default's unit is written
-  std::map<std::string, Claim> error_names_;    // error names and aliases
-  std::map<std::string, Claim> symbols_;        // parameters, coordinates, error names
+  std::map<std::string, GroupDefaults> defaults_;
+  std::map<std::string, Claim> error_names_;  // error names and aliases
+  std::map<std::string, Claim> symbols_;      // parameters, coordinates, error names
   std::vector<BodyDraft> drafts_;
   std::vector<ErrorDef> errors_;              // in file order; moved into d_ in tree order
   std::vector<std::string> parameter_names_;  // in file order, for messages

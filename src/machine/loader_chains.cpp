@@ -29,6 +29,20 @@ void Loader::read_points(const Field& f) {
   }
 }
 
+void Loader::read_directions(const Field& f) {
+  const MapView m = map(f, {}, "direction name");
+  for (const Entry& e : m.entries) {
+    ChainDirection dir;
+    dir.name = key_identifier(e, f.path, "direction name");
+    claim_symbol(dir.name, "chain direction", {e.key_node, e.key_node, f.path});
+    const MapView dm = map(e.value, kDirectionKeys);
+    dir.loc = loc(e.value.where);
+    dir.body = body_ref(required(dm, "body").value);
+    dir.direction = direction(required(dm, "direction").value);
+    d_.directions.push_back(std::move(dir));
+  }
+}
+
 void Loader::read_derived(const Field& f) {
   const MapView m = map(f, {}, "quantity name");
   for (const Entry& e : m.entries) {
@@ -81,15 +95,17 @@ std::array<Expr, 3> Loader::point_formula(const Field& f) const {
   return {parsed(xyz[0]), parsed(xyz[1]), parsed(xyz[2])};
 }
 
+int Loader::body_ref(const Field& body) const {
+  const int b = d_.body_index(text(body));
+  if (b < 0) fail(body, "unknown body '" + text(body) + "' (bodies: " + join(draft_names()) + ")");
+  return b;
+}
+
 PointSpec Loader::read_point_spec(const Field& f) const {
   const MapView m = map(f, kPointKeys);
   PointSpec p;
   p.loc = loc(f.where);
-  const Field& body = required(m, "body").value;
-  p.body = d_.body_index(text(body));
-  if (p.body < 0) {
-    fail(body, "unknown body '" + text(body) + "' (bodies: " + join(draft_names()) + ")");
-  }
+  p.body = body_ref(required(m, "body").value);
   if (const Entry* pt = m.find("point")) p.point = point(pt->value);
   return p;
 }

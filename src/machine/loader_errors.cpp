@@ -203,27 +203,4 @@ void Loader::check_dimension(const Field& at, const ErrorDef& err,
   }
 }
 
-void Loader::apply_group_default(ErrorDef& err, bool unit_given, const Field& at,
-                                 const std::string& context) const {
-  const auto it = defaults_.find(err.group);
-  if (it == defaults_.end()) {
-    fail(at, "error '" + err.name + "'" + context +
-                 " has no distribution (sigma, normal, uniform or truncnormal) and "
-                 "error_defaults has none for its group '" +
-                 err.group + "'");
-  }
-  const GroupDefault& def = it->second;
-  if (!unit_given && !def.unit.empty()) err.unit = def.unit;
-  double scale = 1;
-  if (!def.unit.empty()) {
-    check_dimension(default_units_.at(err.group), err, def.unit);
-    scale = table_unit(def.unit).to_base / table_unit(err.unit).to_base;
-  }
-  err.distribution = def.distribution;
-  err.distribution.a *= scale;
-  err.distribution.b *= scale;
-  err.distribution.lo *= scale;
-  err.distribution.hi *= scale;
-}
-
 }  // namespace weilgen::machine_detail

@@ -75,21 +75,6 @@ std::string Loader::known_group(const Field& f) const {
   return g;
 }
 
-void Loader::read_error_defaults(const Field& f) {
-  const MapView m = map(f, {}, "group");
-  for (const Entry& e : m.entries) {
-    const std::string group = known_group({e.key_node, e.key_node, f.path});
-    const MapView dm = map(e.value, kDefaultKeys);
-    GroupDefault def;
-    const std::optional<Distribution> dist = read_distribution(dm);
-    if (!dist) fail(dm.self, "give a distribution (" + join(kDistributionKeys) + ")");
-    def.distribution = *dist;
-    if (const Entry* u = dm.find("unit")) def.unit = unit(u->value, kErrorUnits)->name;
-    defaults_[group] = def;
-    if (const Entry* u = dm.find("unit")) default_units_.emplace(group, u->value);
-  }
-}
-
 std::optional<Distribution> Loader::read_distribution(const MapView& m) const {
   const Entry* chosen = nullptr;
   for (const std::string& key : kDistributionKeys) {

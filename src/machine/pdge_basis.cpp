@@ -309,4 +309,16 @@ BasisSpec parse_basis(const std::string& text, bool allow_auto) {
   return spec;
 }
 
+std::string default_pdge_basis(const Joint& j) {
+  return j.type == JointType::Revolute ? "fourier:2" : "poly:3";
+}
+
+Basis basis_on_joint(const BasisSpec& spec, const Joint& j) {
+  BasisSpec placed = spec;
+  if (spec.kind == BasisKind::Fourier && !spec.period_search && std::isnan(spec.period_mm) &&
+      j.type == JointType::Revolute)
+    placed.period_mm = j.unit == "deg" ? 360.0 : 2 * kPi / j.to_base;  // one turn, joint unit
+  return placed.on(j.min, j.max);
+}
+
 }  // namespace weilgen

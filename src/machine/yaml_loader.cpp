@@ -48,6 +48,7 @@ Description Loader::load(const YAML::Node& root) {
   if (const Entry* e = top.find("error_defaults")) read_error_defaults(e->value);
   read_bodies(required(top, "bodies"));
   if (const Entry* e = top.find("points")) read_points(e->value);
+  if (const Entry* e = top.find("directions")) read_directions(e->value);
   if (const Entry* e = top.find("derived")) read_derived(e->value);
   if (const Entry* e = top.find("output")) {
     for (const char* key : {"tool", "workpiece"}) {
@@ -63,10 +64,7 @@ Description Loader::load(const YAML::Node& root) {
     d_.workpiece = read_point_spec(required(top, "workpiece").value);
   }
   if (const Entry* e = top.find("algebra")) read_algebra(e->value);
-  if (const Entry* e = top.find("pdge_basis")) {
-    d_.pdge_basis = basis_text(e->value);
-    d_.pdge_basis_loc = loc(e->value.where);
-  }
+  if (const Entry* e = top.find("pdge_basis")) read_pdge_basis(e->value);
   d_.source_file = file_;
   check_derived(d_);
   return std::move(d_);

@@ -60,6 +60,14 @@ double student_coverage_factor(std::size_t dof, double k_normal) {
       boost::math::students_t_distribution<double>(static_cast<double>(dof)), p);
 }
 
+std::string axis_deviation_column(const std::string& axis) {
+  static const std::map<std::string, std::string> kDefault = {
+      {"X", "dx_um"}, {"U", "dx_um"},   {"Y", "dy_um"},   {"V", "dy_um"},  {"Z", "dz_um"},
+      {"W", "dz_um"}, {"A", "da_urad"}, {"B", "db_urad"}, {"C", "dc_urad"}};
+  const auto it = kDefault.find(axis);
+  return it == kDefault.end() ? std::string() : it->second;
+}
+
 // ---- Grouping --------------------------------------------------------------------------------
 
 IsoRuns group_iso_runs(const std::vector<IsoObservation>& observations, const std::string& file,
@@ -82,23 +90,24 @@ IsoRuns group_iso_runs(const std::vector<IsoObservation>& observations, const st
     return obs[a].position_mm < obs[b].position_mm;
   });
   std::vector<std::size_t> target_of(obs.size());
-  std::vector<double> sum;
+  // Offsets from the cluster's first position, so a target read as the same number every time
+  // is that number exactly (a plain mean of 10 x 103.2 is 103.20000000000002).
+  std::vector<double> start, sum;
   std::vector<std::size_t> count;
-  double start = 0;
   for (std::size_t k = 0; k < order.size(); ++k) {
     const double p = obs[order[k]].position_mm;
-    if (k == 0 || p - start > tolerance_mm) {
-      start = p;
+    if (k == 0 || p - start.back() > tolerance_mm) {
+      start.push_back(p);
       sum.push_back(0);
       count.push_back(0);
     }
-    sum.back() += p;
+    sum.back() += p - start.back();
     ++count.back();
     target_of[order[k]] = sum.size() - 1;
   }
   const std::size_t m = sum.size();
   for (std::size_t i = 0; i < m; ++i)
-    runs.positions_mm.push_back(sum[i] / static_cast<double>(count[i]));
+    runs.positions_mm.push_back(start[i] + sum[i] / static_cast<double>(count[i]));
 
   // (direction, target, cycle) -> observation.
   std::array<std::map<std::pair<std::size_t, long>, std::size_t>, 2> cell;
@@ -250,14 +259,10 @@ IsoColumns iso_columns(const MeasurementTable& table, const std::string& axis,
                                   "time, not a deviation");
     c.deviation = deviation_column;
   } else {
-    static const std::map<std::string, std::string> kDefault = {
-        {"X", "dx_um"}, {"U", "dx_um"},   {"Y", "dy_um"},   {"V", "dy_um"},  {"Z", "dz_um"},
-        {"W", "dz_um"}, {"A", "da_urad"}, {"B", "db_urad"}, {"C", "dc_urad"}};
-    const auto it = kDefault.find(c.axis);
-    if (it == kDefault.end())
+    c.deviation = axis_deviation_column(c.axis);
+    if (c.deviation.empty())
       throw std::invalid_argument("axis " + c.axis +
                                   " has no default deviation column: give one with --column");
-    c.deviation = it->second;
     table.column(c.deviation);  // throws "missing column" when absent
   }
   c.unit = table.info_of(c.deviation).unit;
@@ -309,6 +314,7 @@ std::vector<IsoObservation> iso_observations(const MeasurementTable& table, cons
     o.deviation = dev[r];
     o.time_s = time ? (*time)[r] : kNaN;
     o.line = line;
+    o.row = r;
     out.push_back(o);
   }
   return out;

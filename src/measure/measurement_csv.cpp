@@ -84,7 +84,8 @@ bool parse_number(const std::string& text, double& value, std::string& why) {
 
 const char* kKnownRoles =
     "coordinates (single upper-case letters such as X, Y, Z, A, C, or the machine's), t_s, dir, "
-    "dir_<axis>, cycle, T_<name>, covariates (rpm, feed_mm_min, cov_<name>), deviations "
+    "dir_<axis>, cycle, T_<name>, covariates (rpm, feed_mm_min, p_air_Pa, RH_air_pct, "
+    "cov_<name>), deviations "
     "(dx_um, dy_um, dz_um, da_urad, db_urad, dc_urad), ballbar angle_deg and dr_um";
 
 }  // namespace
@@ -142,6 +143,9 @@ ColumnInfo classify_column(const std::string& name, const ReadOptions& o) {
     return set(ColumnRole::Covariate, "");
   if (name == "rpm") return set(ColumnRole::Covariate, "1/min");
   if (name == "feed_mm_min") return set(ColumnRole::Covariate, "mm/min");
+  // The air of a laser measurement (air refraction, docs/iso230-2.md); T_air is a temperature.
+  if (name == "p_air_Pa") return set(ColumnRole::Covariate, "Pa");
+  if (name == "RH_air_pct") return set(ColumnRole::Covariate, "%");
   if (name.size() > 4 && name.rfind("cov_", 0) == 0 && is_identifier(name.substr(4)))
     return set(ColumnRole::Covariate, "");
   return set(ColumnRole::Unknown, "");

@@ -109,6 +109,12 @@ Eigen::Matrix4d NumericChain::output_transform(std::map<std::string, double> val
         (branch(p.at, q_body, errors) - branch(p.at, q_body, none)).block<3, 1>(0, 3);
     for (int i = 0; i < 3; ++i) values[p.name + "." + static_cast<char>('x' + i)] = d[i];
   }
+  for (const ChainDirection& u : desc_.directions) {
+    PointSpec frame;
+    frame.body = u.body;
+    const Eigen::Vector3d r = branch(frame, q_body, none).block<3, 3>(0, 0) * vec(u.direction);
+    for (int i = 0; i < 3; ++i) values[u.name + "." + static_cast<char>('x' + i)] = r[i];
+  }
   for (const Derived& q : desc_.derived) values[q.name] = q.value.eval(values);
   auto vec3 = [&](const std::array<Expr, 3>& e) {
     return Eigen::Vector3d(e[0].eval(values), e[1].eval(values), e[2].eval(values));
@@ -183,6 +189,26 @@ std::array<double, 6> NumericChain::deviation(const std::vector<double>& axes,
   const Eigen::AngleAxisd aa(dr);
   const Eigen::Vector3d w = aa.angle() * aa.axis();
   return {dp[0], dp[1], dp[2], w[0], w[1], w[2]};
+}
+
+Eigen::Matrix<double, 6, Eigen::Dynamic> NumericChain::nominal_jacobian(
+    const std::vector<double>& axes) const {
+  const std::vector<double> zero(desc_.errors.size(), 0.0);
+  const double h = 1e-3;
+  Eigen::Matrix<double, 6, Eigen::Dynamic> j(6, static_cast<Eigen::Index>(axes.size()));
+  for (std::size_t a = 0; a < axes.size(); ++a) {
+    std::vector<double> up = axes, down = axes;
+    up[a] += h;
+    down[a] -= h;
+    const Eigen::Matrix4d tu = tool_in_workpiece(up, zero);
+    const Eigen::Matrix4d td = tool_in_workpiece(down, zero);
+    const Eigen::Matrix3d r = tu.block<3, 3>(0, 0) * td.block<3, 3>(0, 0).transpose();
+    const auto col = static_cast<Eigen::Index>(a);
+    j.block<3, 1>(0, col) = (tu.block<3, 1>(0, 3) - td.block<3, 1>(0, 3)) / (2 * h);
+    j.block<3, 1>(3, col) =
+        0.5 * Eigen::Vector3d(r(2, 1) - r(1, 2), r(0, 2) - r(2, 0), r(1, 0) - r(0, 1)) / (2 * h);
+  }
+  return j;
 }
 
 }  // namespace weilgen

@@ -3,8 +3,10 @@
 #include <cmath>
 #include <iomanip>
 #include <sstream>
+#include <utility>
 
 #include "weilgen/base/format.hpp"
+#include "weilgen/base/text.hpp"
 #include "weilgen/base/version.hpp"
 #include "weilgen/report/json_common.hpp"
 
@@ -86,7 +88,112 @@ void add_band(LinePlot& p, const std::vector<double>& mean, const std::vector<do
   p.lines.emplace_back(label + " -" + format_number(k) + "s", lo);
 }
 
+std::string range_text(const ValueRange& r, int decimals, const std::string& unit) {
+  if (r.empty()) return "-";
+  if (r.max - r.min < 0.5 * std::pow(10.0, -decimals)) return fmt(r.mean, decimals) + " " + unit;
+  return fmt(r.min, decimals) + " .. " + fmt(r.max, decimals) + " " + unit + " (mean " +
+         fmt(r.mean, decimals) + ")";
+}
+
+std::string with_source(const std::string& text, const std::string& source) {
+  return source.empty() ? text : text + " [" + source + "]";
+}
+
+json range_json(const ValueRange& r) {
+  if (r.empty()) return json();
+  return {{"min", json_number(r.min)}, {"mean", json_number(r.mean)}, {"max", json_number(r.max)}};
+}
+
+std::string air_readings(const NormalisationResult& n) {
+  std::vector<std::string> parts;
+  if (!n.air_temperature_C.empty())
+    parts.push_back(
+        with_source(range_text(n.air_temperature_C, 2, "degC"), n.air_temperature_source));
+  if (!n.air_pressure_Pa.empty())
+    parts.push_back(with_source(range_text(n.air_pressure_Pa, 0, "Pa"), n.air_pressure_source));
+  if (!n.air_humidity_pct.empty())
+    parts.push_back(with_source(range_text(n.air_humidity_pct, 1, "%RH"), n.air_humidity_source));
+  std::string out;
+  for (std::size_t i = 0; i < parts.size(); ++i) out += (i ? ", " : "") + parts[i];
+  return out;
+}
+
 }  // namespace
+
+std::vector<std::string> iso230_2_normalisation_statement(const Iso230_2StudyResult& res) {
+  const NormalisationResult& n = res.normalisation;
+  const std::string datum = res.columns.axis + " = " + format_number(n.datum_mm) + " mm";
+  std::vector<std::string> out;
+  const std::string tm =
+      with_source(range_text(n.material_temperature_C, 2, "degC"), n.material_source);
+  if (n.material_applied) {
+    out.push_back("Normalised to " + format_number(n.reference_temperature_C) +
+                  " degC (ISO 1): expansion coefficient " + format_number(n.expansion_ppm_per_K) +
+                  " um/(m K), material temperature " + tm +
+                  "; correction -alpha (T - 20 degC) L, L the travel from the datum " + datum +
+                  ": " + range_text(n.material_correction_um, 3, "um") + ".");
+  } else if (!n.material_temperature_C.empty()) {
+    out.push_back(
+        "Not normalised to 20 degC (no expansion coefficient: --expansion or the header "
+        "key expansion_ppm_per_K); material temperature " +
+        tm + ".");
+  } else {
+    out.push_back(
+        "Not normalised to 20 degC: no expansion coefficient and no material "
+        "temperature recorded.");
+  }
+  const std::string air = air_readings(n);
+  switch (n.air) {
+    case AirCompensation::Edlen:
+      out.push_back(
+          "Air refraction corrected by weilgen with the modified Edlen equation of "
+          "Birch & Downs (1993, corrected 1994), vacuum wavelength " +
+          format_number(n.wavelength_nm) + " nm, air " + air +
+          ": n - 1 = " + format_significant(n.air_refractivity.min, 6) + " .. " +
+          format_significant(n.air_refractivity.max, 6) + "; readings counted with n0 = " +
+          format_number(n.assumed_index) + "; correction L (n0/n - 1) from the datum " + datum +
+          ": " + range_text(n.air_correction_um, 3, "um") + ".");
+      break;
+    case AirCompensation::Instrument:
+      out.push_back("Air refraction compensated by the instrument" +
+                    (air.empty() ? std::string(".") : "; air as recorded: " + air + "."));
+      break;
+    case AirCompensation::None:
+      out.push_back(
+          "Air refraction NOT compensated: the deviations include the refractive index "
+          "of the air (about 271 um per metre of travel at 20 degC, 101325 Pa, "
+          "50 %RH); --air-compensation edlen corrects them from the air's temperature, "
+          "pressure and humidity" +
+          (air.empty() ? std::string(".") : "; air as recorded: " + air + "."));
+      break;
+    case AirCompensation::Unstated:
+      out.push_back(
+          "Air refraction: the file does not say whether the instrument compensated "
+          "it; weilgen corrected nothing (--air-compensation instrument|edlen|none or "
+          "the header key air_compensation states it)" +
+          (air.empty() ? std::string(".") : "; air as recorded: " + air + "."));
+      break;
+  }
+  return out;
+}
+
+std::vector<std::string> iso230_2_tolerance_statement(const Iso230_2StudyResult& res) {
+  std::vector<std::string> out;
+  if (res.tolerance.empty()) return out;
+  const std::string u = res.columns.unit;
+  std::vector<std::string> failed;
+  for (const ToleranceCheck& c : res.tolerance) {
+    std::ostringstream l;
+    l << "  " << std::left << std::setw(8) << (c.name == "band" ? std::string("|x +- 2s|") : c.name)
+      << std::right << std::setw(10) << fmt(c.value) << " " << u << (c.pass ? " <= " : " >  ")
+      << std::setw(8) << format_number(c.limit) << " " << u << "  " << (c.pass ? "pass" : "FAIL");
+    out.push_back(l.str());
+    if (!c.pass) failed.push_back(c.name);
+  }
+  out.push_back(failed.empty() ? "  verdict: PASS (the classical ISO 230-2 figures, k = 2)"
+                               : "  verdict: FAIL (" + join(failed) + " out of tolerance)");
+  return out;
+}
 
 std::string iso230_2_text(const std::string& data, const Iso230_2StudyResult& res) {
   const IsoColumns& cols = res.columns;
@@ -102,6 +209,9 @@ std::string iso230_2_text(const std::string& data, const Iso230_2StudyResult& re
   o << "weilgen iso230-2: " << data << ", axis " << cols.axis << " (deviation " << cols.deviation
     << "), " << m << " target" << (m == 1 ? "" : "s") << ", " << runs.cycles[kUp].size()
     << " cycles up, " << runs.cycles[kDown].size() << " cycles down\n\n";
+  o << "Normalisation and air (ISO 230-2:2014, ISO 1)\n";
+  for (const auto& line : iso230_2_normalisation_statement(res)) o << "  " << line << "\n";
+  o << "\n";
   o << "Per target (" << u << "; ISO 230-2, k = 2)\n";
   o << std::setw(12) << "target mm" << std::setw(10) << "mean up" << std::setw(10) << "mean dn"
     << std::setw(9) << "s up" << std::setw(9) << "s dn" << std::setw(9) << "B_i" << std::setw(9)
@@ -148,6 +258,10 @@ std::string iso230_2_text(const std::string& data, const Iso230_2StudyResult& re
   for (const IsoFigures* s : sets)
     o << std::setw(12) << (s ? fmt(s->k_up, 2) + "/" + fmt(s->k_down, 2) : std::string("-"));
   o << "\n";
+  if (!res.tolerance.empty()) {
+    o << "\nTolerances (" << u << ")\n";
+    for (const auto& line : iso230_2_tolerance_statement(res)) o << line << "\n";
+  }
 
   if (drift) {
     const DriftResult& D = *drift;
@@ -221,7 +335,8 @@ std::string iso230_2_text(const std::string& data, const Iso230_2StudyResult& re
   return o.str();
 }
 
-nlohmann::json iso230_2_json(const std::string& data, const Iso230_2StudyResult& res) {
+nlohmann::json iso230_2_json(const std::string& data, const Iso230_2StudyResult& res,
+                             const std::string& source_format) {
   const IsoColumns& cols = res.columns;
   const IsoRuns& runs = res.runs;
   const Iso230_2Result& cr = res.classical;
@@ -234,12 +349,52 @@ nlohmann::json iso230_2_json(const std::string& data, const Iso230_2StudyResult&
   json j;
   {
     j = {
-        {"weilgen", kVersion}, {"command", "iso230-2"},         {"file", data},
+        {"file", data},
         {"axis", cols.axis},   {"column", cols.deviation},      {"deviation_unit", u},
         {"targets", m},        {"cycles_up", runs.cycles[kUp]}, {"cycles_down", runs.cycles[kDown]},
         {"positions_mm", P},   {"coverage_factor", F.k_up}};
+    j["source_format"] = source_format;
+    j["metadata"] = res.header_keys;
+    const NormalisationResult& n = res.normalisation;
+    j["normalisation"] = {
+        {"reference_temperature_C", n.reference_temperature_C},
+        {"datum_mm", json_number(n.datum_mm)},
+        {"material",
+         {{"applied", n.material_applied},
+          {"expansion_ppm_per_K", json_number(n.expansion_ppm_per_K)},
+          {"temperature_source", n.material_source.empty() ? json() : json(n.material_source)},
+          {"temperature_C", range_json(n.material_temperature_C)},
+          {"correction_um", range_json(n.material_correction_um)}}},
+        {"air",
+         {{"compensation", to_string(n.air)},
+          {"applied", n.air_applied},
+          {"equation", n.air_applied ? json("modified Edlen equation, Birch & Downs, Metrologia 30 "
+                                            "(1993) 155 and 31 (1994) 315")
+                                     : json()},
+          {"wavelength_nm", json_number(n.wavelength_nm)},
+          {"assumed_index", json_number(n.assumed_index)},
+          {"temperature_C", range_json(n.air_temperature_C)},
+          {"pressure_Pa", range_json(n.air_pressure_Pa)},
+          {"humidity_pct", range_json(n.air_humidity_pct)},
+          {"refractivity", range_json(n.air_refractivity)},
+          {"correction_um", range_json(n.air_correction_um)}}},
+        {"statement", iso230_2_normalisation_statement(res)}};
     j.update(figures_json(F));
     j["student"] = cr.student ? figures_json(*cr.student) : json();
+    if (res.tolerance.empty()) {
+      j["tolerance"] = json();
+    } else {
+      json checks = json::array();
+      bool pass = true;
+      for (const ToleranceCheck& c : res.tolerance) {
+        checks.push_back({{"name", c.name},
+                          {"value_um", json_number(c.value)},
+                          {"limit_um", json_number(c.limit)},
+                          {"pass", c.pass}});
+        pass = pass && c.pass;
+      }
+      j["tolerance"] = {{"checks", checks}, {"pass", pass}};
+    }
     if (drift) {
       const DriftResult& D = *drift;
       json de = figures_json(D.figures);
@@ -288,7 +443,37 @@ nlohmann::json iso230_2_json(const std::string& data, const Iso230_2StudyResult&
     }
   }
 
-  return j;
+  return json_document("iso230-2", std::move(j));
+}
+
+std::string iso230_2_csv(const Iso230_2StudyResult& res) {
+  const IsoFigures& F = res.classical.figures;
+  const std::vector<double>& P = res.runs.positions_mm;
+  const std::string u = "_" + res.columns.unit;
+  const std::optional<DriftResult>& D = res.drift;
+  std::ostringstream c;
+  c << "target_mm";
+  for (const char* name : {"mean_up", "mean_down", "s_up", "s_down", "B_i", "R_i_up", "R_i_down",
+                           "R_i", "mean_bi", "lower_up", "upper_up", "lower_down", "upper_down"})
+    c << "," << name << u;
+  if (D)
+    for (const char* name : {"chart_up", "s_star_up", "chart_down", "s_star_down"})
+      c << "," << name << u;
+  c << "\n";
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    c << csv_number(P[i]);
+    for (double v : {F.mean_up[i], F.mean_down[i], F.s_up[i], F.s_down[i], F.B_i[i], F.R_i_up[i],
+                     F.R_i_down[i], F.R_i[i], F.mean_bi[i], F.mean_up[i] - F.k_up * F.s_up[i],
+                     F.mean_up[i] + F.k_up * F.s_up[i], F.mean_down[i] - F.k_down * F.s_down[i],
+                     F.mean_down[i] + F.k_down * F.s_down[i]})
+      c << "," << csv_number(v);
+    if (D)
+      for (double v : {D->chart[kUp].value[i], D->chart[kUp].s[i], D->chart[kDown].value[i],
+                       D->chart[kDown].s[i]})
+        c << "," << csv_number(v);
+    c << "\n";
+  }
+  return c.str();
 }
 
 std::vector<Panel> iso230_2_panels(const Iso230_2StudyResult& res) {

@@ -9,6 +9,7 @@
 #include "effects.hpp"
 #include "weilgen/base/text.hpp"
 #include "weilgen/machine/iso_names.hpp"
+#include "weilgen/machine/pdge_basis.hpp"
 
 namespace weilgen::gap_detail {
 
@@ -64,7 +65,7 @@ void add_missing_error(const EffectContext& ctx, std::vector<Candidate>& out) {
   struct Missing {
     std::string name, coordinate;
     bool pdge;
-    double lo, hi;
+    Basis basis;    // a PDGE's default basis on its joint (poly:3, or fourier:2 over a turn)
     MatrixXd unit;  // per observation: ∂output/∂error (µm or µrad per declared unit)
   };
   auto missing = std::make_shared<std::vector<Missing>>();
@@ -97,8 +98,10 @@ void add_missing_error(const EffectContext& ctx, std::vector<Candidate>& out) {
       NumericChain chain(aug);
       chain.set_parameters(ctx.model->parameters());
       const auto& obs = d.points.observations;
-      Missing mi{n,     j.coordinate, e.dependence == Dependence::PDGE,
-                 j.min, j.max,        MatrixXd(static_cast<Index>(obs.size()), 1)};
+      const bool pdge = e.dependence == Dependence::PDGE && j.max > j.min;
+      Missing mi{n, j.coordinate, pdge,
+                 pdge ? basis_on_joint(parse_basis(default_pdge_basis(j)), j) : Basis{},
+                 MatrixXd(static_cast<Index>(obs.size()), 1)};
       std::vector<double> err(aug.errors.size(), 0.0);
       std::size_t row = SIZE_MAX;
       std::array<double, 6> g{};
@@ -121,7 +124,7 @@ void add_missing_error(const EffectContext& ctx, std::vector<Candidate>& out) {
   c.name = "missing_error";
   for (std::size_t k = 0; k < missing->size(); ++k)
     c.variants.push_back({(*missing)[k].name, {static_cast<double>(k)}});
-  // The coordinate of each observation for a PDGE's basis (poly:3 on the joint's travel).
+  // The coordinate of each observation for a PDGE's basis (default_pdge_basis on the joint).
   c.columns = [&d, missing, axes, &desc](const Variant& v, const std::vector<double>&) {
     const Missing& mi = (*missing)[static_cast<std::size_t>(v.hyper[0])];
     if (!mi.pdge) return MatrixXd(mi.unit);
@@ -129,12 +132,14 @@ void add_missing_error(const EffectContext& ctx, std::vector<Candidate>& out) {
     for (std::size_t i = 0; i < axes.size(); ++i)
       if (desc.bodies[static_cast<std::size_t>(axes[i])].joint.coordinate == mi.coordinate) a = i;
     const auto& obs = d.points.observations;
-    MatrixXd E(static_cast<Index>(obs.size()), 4);
+    const auto terms = static_cast<Index>(mi.basis.size());
+    MatrixXd E(static_cast<Index>(obs.size()), terms);
+    std::vector<double> f(mi.basis.size());
     for (std::size_t i = 0; i < obs.size(); ++i) {
-      const double u = (2 * d.points.poses[obs[i].row][a] - mi.lo - mi.hi) / (mi.hi - mi.lo);
-      double p = 1;
-      for (Index t = 0; t < 4; ++t, p *= u)
-        E(static_cast<Index>(i), t) = mi.unit(static_cast<Index>(i), 0) * p;
+      mi.basis.evaluate(d.points.poses[obs[i].row][a], f.data());
+      for (Index t = 0; t < terms; ++t)
+        E(static_cast<Index>(i), t) =
+            mi.unit(static_cast<Index>(i), 0) * f[static_cast<std::size_t>(t)];
     }
     return E;
   };
@@ -148,11 +153,13 @@ void add_missing_error(const EffectContext& ctx, std::vector<Candidate>& out) {
       fit.summary = mi.name + " = " + num(coef[0], 3) + " " + unit + " (not in the machine file)";
     } else {
       double peak = 0;
-      for (double u = -1; u <= 1.0001; u += 0.05)
-        peak = std::max(peak, std::abs(coef[0] + u * (coef[1] + u * (coef[2] + u * coef[3]))));
+      for (int k = 0; k <= 40; ++k) {
+        const double x = mi.basis.a + (mi.basis.b - mi.basis.a) * k / 40.0;
+        peak = std::max(peak, std::abs(mi.basis.value(coef.data(), x)));
+      }
       fit.params[mi.name + "_peak"] = peak;
       fit.summary = mi.name + "(" + mi.coordinate + ") up to " + num(peak, 3) + " " + unit +
-                    " over the travel (poly:3; not in the machine file)";
+                    " over the travel (" + mi.basis.name() + "; not in the machine file)";
     }
   };
   out.push_back(std::move(c));

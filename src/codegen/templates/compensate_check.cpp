@@ -1,48 +1,16 @@
-// Compiles templates/compensate.hpp on its own against a stand-in model (two prismatic axes,
-// a zero offset and a scale error of the first axis) with a controller's strict flags, and
-// checks that Compensate finds the command the stand-in's closed form gives. CTest
-// compensate_template; the generated headers' own Compensate is tested in test_compensation.cpp.
+// Compiles templates/compensate.hpp on its own against the stand-in model templates/standin.hpp
+// (two prismatic axes, a zero offset and a scale error of the first axis) with a controller's
+// strict flags, and checks that Compensate finds the command the stand-in's closed form gives.
+// CTest compensate_template; the generated headers' own Compensate is tested in
+// test_compensation.cpp.
 #include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdio>
 
-namespace standin {
+#include "standin.hpp"
 
-inline constexpr std::size_t kNumAxes = 2;
-inline constexpr std::size_t kNumErrors = 2;  // e0: offset of axis 0 (mm), e1: its scale error
-inline constexpr std::size_t kNumParams = 1;
-
-template <typename Scalar>
-void NominalPose(const std::array<Scalar, kNumAxes>& q, const std::array<Scalar, kNumParams>&,
-                 std::array<Scalar, 3>* const position, std::array<Scalar, 9>* const rotation) {
-  if (position) *position = {q[0], q[1], Scalar(0)};
-  if (rotation)
-    *rotation = {Scalar(1), Scalar(0), Scalar(0), Scalar(0), Scalar(1),
-                 Scalar(0), Scalar(0), Scalar(0), Scalar(1)};
-}
-
-template <typename Scalar>
-void NominalJacobian(const std::array<Scalar, kNumAxes>&, const std::array<Scalar, kNumParams>&,
-                     std::array<Scalar, 6 * kNumAxes>* const jacobian) {
-  *jacobian = {};
-  (*jacobian)[0 * kNumAxes + 0] = Scalar(1);
-  (*jacobian)[1 * kNumAxes + 1] = Scalar(1);
-}
-
-template <typename Scalar>
-void Deviation(const std::array<Scalar, kNumAxes>& q, const std::array<Scalar, kNumErrors>& e,
-               const std::array<Scalar, kNumParams>&, std::array<Scalar, 3>* const position,
-               std::array<Scalar, 3>* const orientation) {
-  if (position) *position = {e[0] + e[1] * q[0], Scalar(0), Scalar(0)};
-  if (orientation) *orientation = {};
-}
-
-#define WEILGEN_TEMPLATE_ORIENTATION false
-#include "compensate.hpp"
-#undef WEILGEN_TEMPLATE_ORIENTATION
-
-}  // namespace standin
+namespace standin = weilgen_models::standin;
 
 int main() {
   const std::array<double, 2> target = {250.0, -40.0};

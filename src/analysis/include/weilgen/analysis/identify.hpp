@@ -32,10 +32,11 @@
 namespace weilgen {
 
 // Which basis each PDGE uses. Precedence: a per-error override, then the run-wide override,
-// then the error's `basis:` in the machine file, then the machine's `pdge_basis:`, then
-// `fallback`.
+// then the error's `basis:` in the machine file, then the machine's `pdge_basis:` for the joint's
+// type, then `fallback` (empty: default_pdge_basis, poly:3 on a linear axis and fourier:2 over
+// one turn on a rotary one).
 struct PdgeBasisChoice {
-  std::string fallback = "poly:3";
+  std::string fallback;
   std::optional<std::string> all;                              // --pdge poly:3
   std::vector<std::pair<std::string, std::string>> per_error;  // --pdge E_YY=fourier:3
 };

@@ -32,6 +32,12 @@ ToleranceOverrides read_tolerance_file(const std::string& path, const Descriptio
 ToleranceOverrides read_tolerance_text(const std::string& yaml, const std::string& filename,
                                        const Description& desc);
 
+// Fixed error values from a tolerance file (YAML or its JSON spelling) whose entries are all
+// `const`: base units (mm, rad), kErrors order, 0 for errors the file does not mention. A
+// distribution that is not constant is an InputError naming the file, the error's line and the
+// error (a compensation needs values, not spreads). `weilgen linuxcnc --params`.
+std::vector<double> read_error_values(const std::string& path, const Description& desc);
+
 // The text write_tolerance_file writes: every error by name, values in its declared unit
 // (sigma / normal / uniform / truncnormal / const), `header_comment` as leading "# " lines.
 // Reading it back gives the same distributions to within 1e-15 relative (each value is printed

@@ -18,10 +18,11 @@ struct GeneratedFile {
 // Depends on the path only: output is the same from any checkout, working directory or binary.
 std::string source_label(const std::string& machine_path);
 
-// The header and report of a model. File and namespace names are the machine's name, with
-// "_o<r>" appended when `order_override` differs from the file's order.
+// The header and report of a model, and with `c_api` its C API (<name>_c.h, <name>_c.cpp;
+// emit_c_api.hpp). File and namespace names are the machine's name, with "_o<r>" appended when
+// `order_override` differs from the file's order.
 std::vector<GeneratedFile> generate_files(const Description& desc, int order_override,
-                                          const std::string& out_dir);
+                                          const std::string& out_dir, bool c_api = false);
 
 // The header alone (run-time compilation, model_loader.hpp); `name_space` receives the model's
 // namespace under weilgen_models.

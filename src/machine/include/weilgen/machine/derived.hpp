@@ -14,10 +14,10 @@ namespace weilgen {
 
 // What an identifier of a link, derived or output expression names.
 struct NameRef {
-  enum class Kind { Parameter, Coordinate, PointComponent, Derived };
+  enum class Kind { Parameter, Coordinate, PointComponent, DirectionComponent, Derived };
   Kind kind = Kind::Parameter;
-  int index = -1;      // parameter, body (coordinate), point or derived index
-  int component = -1;  // PointComponent: 0, 1, 2 for .x, .y, .z
+  int index = -1;      // parameter, body (coordinate), point, direction or derived index
+  int component = -1;  // PointComponent, DirectionComponent: 0, 1, 2 for .x, .y, .z
 };
 
 // Resolves `name` (`pi` excluded: the parser makes it a number). Derived quantities with an index

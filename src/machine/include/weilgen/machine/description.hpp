@@ -153,6 +153,17 @@ struct ChainPoint {
   PointSpec at;
 };
 
+// A direction fixed in a body (unit vector, body frame) and its nominal value in the base frame at
+// the current pose, R(q, e = 0) · direction: derived quantities use it as `name.x`, `name.y`,
+// `name.z` (dimensionless) to project deviations on a moving direction, such as a chuck's
+// clamping direction after the chuck has turned.
+struct ChainDirection {
+  std::string name;
+  int body = -1;
+  Vec3 direction{1, 0, 0};
+  SourceLoc loc;
+};
+
 // A named scalar of the algebra (mm, rad or dimensionless), in file order; its expression may use
 // parameters, coordinates (independent or linked), point components `P.x` and earlier derived
 // quantities. Divisors must be nominal (no error dependence) and non-zero over the travel range.
@@ -198,11 +209,14 @@ struct Description {
   std::vector<ErrorDef> errors;
   PointSpec tool;       // tool point (cutting point) on the tool branch (unset with `output`)
   PointSpec workpiece;  // workpiece coordinate system origin on the workpiece branch
-  std::vector<ChainPoint> points;         // chain points used by derived quantities
-  std::vector<Derived> derived;           // in evaluation (file) order
-  std::optional<OutputTransform> output;  // replaces W⁻¹·T when present
-  std::string pdge_basis;                 // default identification basis of PDGEs ("poly:3")
-  SourceLoc pdge_basis_loc;
+  std::vector<ChainPoint> points;          // chain points used by derived quantities
+  std::vector<ChainDirection> directions;  // nominal body directions used by derived quantities
+  std::vector<Derived> derived;            // in evaluation (file) order
+  std::optional<OutputTransform> output;   // replaces W⁻¹·T when present
+  std::string pdge_basis;                  // default identification basis of PDGEs ("poly:3")
+  SourceLoc pdge_basis_loc;                //   of linear axes (prismatic joints)
+  std::string pdge_basis_revolute;         // ... of rotary axes (revolute joints)
+  SourceLoc pdge_basis_revolute_loc;
 
   // Index lookups; -1 when absent.
   int body_index(const std::string& name) const;

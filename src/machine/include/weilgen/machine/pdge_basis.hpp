@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "weilgen/machine/description.hpp"
+
 namespace weilgen {
 
 enum class BasisKind { Polynomial, Fourier, Legendre, Chebyshev };
@@ -24,7 +26,8 @@ const char* basis_kind_name(BasisKind kind);
 //   Chebyshev  (degree n):  T_0(u), ..., T_n(u)                         n + 1 terms
 //   Fourier    (order n):   1, cos(2πx/L), sin(2πx/L), ..., cos(2πnx/L), sin(2πnx/L)
 //                           2n + 1 terms; x is the axis position itself (not u) and L the
-//                           period (the travel b - a unless period_mm is set).
+//                           period (the travel b - a unless period_mm is set; period_mm is in
+//                           the axis' unit: mm, or deg for a rotary axis).
 // The three polynomial kinds span the same functions at the same degree (identical fits);
 // they differ in conditioning and in what the coefficients mean.
 struct Basis {
@@ -88,5 +91,15 @@ int max_order_for_points(BasisKind kind, std::size_t points);
 
 // Number of terms of `kind` at `order`.
 std::size_t basis_size(BasisKind kind, int order);
+
+// The basis of a PDGE of joint `j` when neither a flag nor the machine file chooses one:
+// "poly:3" on a linear axis; "fourier:2" on a rotary axis, whose errors repeat every turn
+// (placed by basis_on_joint with one turn as its period).
+std::string default_pdge_basis(const Joint& j);
+
+// `spec` on the joint's travel [min, max] (its unit); a Fourier basis without a period takes one
+// turn on a rotary axis (360 deg, 2π rad) and the travel on a linear one. Throws like
+// BasisSpec::on.
+Basis basis_on_joint(const BasisSpec& spec, const Joint& j);
 
 }  // namespace weilgen

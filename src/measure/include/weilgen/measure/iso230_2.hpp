@@ -32,6 +32,7 @@ struct IsoObservation {
   double time_s = std::numeric_limits<double>::quiet_NaN();  // optional
   int line = 0;    // 1-based source line (messages), 0 when not from a file
   int column = 0;  // 1-based source column of the deviation cell (messages), 0 when unknown
+  std::size_t row = static_cast<std::size_t>(-1);  // the table row it was read from (if any)
 };
 
 // Index of a direction in the per-direction arrays: 0 = up (+1), 1 = down (-1).
@@ -67,6 +68,10 @@ struct IsoColumns {
   std::string time;       // t_s or "" when absent
   std::string unit;       // the deviation column's unit: "um" or "urad"
 };
+
+// The deviation along an axis: dx_um for X (and U), dy_um for Y (V), dz_um for Z (W), da_urad,
+// db_urad, dc_urad for A, B, C; "" for any other name.
+std::string axis_deviation_column(const std::string& axis);
 
 // Chooses the columns: `axis` given, else the header key `# axis:`, else the only coordinate
 // column, else the only coordinate column whose values vary. `deviation_column` overrides the

@@ -38,6 +38,11 @@ class NumericChain {
   std::array<double, 6> deviation(const std::vector<double>& axes,
                                   const std::vector<double>& errors) const;
 
+  // d(nominal pose)/d(axes) at zero errors by central differences (step 1e-3 of the axis unit:
+  // µm, millidegree; far above rounding, far below any curvature), 6 x num_axes: rows dx, dy, dz
+  // in mm and the rotation rate da, db, dc in rad (the axial vector of dR·Rᵀ), per axis unit.
+  Eigen::Matrix<double, 6, Eigen::Dynamic> nominal_jacobian(const std::vector<double>& axes) const;
+
   const Description& description() const { return desc_; }
   std::size_t num_axes() const { return axis_bodies_.size(); }
   std::size_t num_errors() const { return desc_.errors.size(); }

@@ -12,9 +12,22 @@
 
 namespace weilgen {
 
-// `data`: the file name as given, for the heading and the JSON.
+// `data`: the file name as given, for the heading and the JSON; `source_format`: how it was read
+// ("tidy", "carto", "wide"; weilgen/measure/instrument_import.hpp).
 std::string iso230_2_text(const std::string& data, const Iso230_2StudyResult& result);
-nlohmann::json iso230_2_json(const std::string& data, const Iso230_2StudyResult& result);
+nlohmann::json iso230_2_json(const std::string& data, const Iso230_2StudyResult& result,
+                             const std::string& source_format = "tidy");
+
+// What the normalisation to 20 °C and the air compensation did, one sentence per line (ASCII
+// units: um, degC); the text, the JSON and the HTML report state it in these words.
+std::vector<std::string> iso230_2_normalisation_statement(const Iso230_2StudyResult& result);
+// The tolerance verdicts, one line each, and the overall verdict ("" without tolerances).
+std::vector<std::string> iso230_2_tolerance_statement(const Iso230_2StudyResult& result);
+// The per-target table as CSV, one row per target: target_mm, the classical k = 2 columns
+// (mean_up_um ... R_i_um, mean_bi_um, the band lower_up_um = x̄↑ − 2s↑ ... upper_down_um) and,
+// with a drift-eliminated evaluation, chart_up_um, s_star_up_um, chart_down_um, s_star_down_um
+// (µrad columns for a rotary axis). The axis figures are in the JSON.
+std::string iso230_2_csv(const Iso230_2StudyResult& result);
 std::vector<Panel> iso230_2_panels(const Iso230_2StudyResult& result);
 
 }  // namespace weilgen

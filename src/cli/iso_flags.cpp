@@ -1,0 +1,78 @@
+#include "iso_flags.hpp"
+
+#include <filesystem>
+
+#include "flags.hpp"
+#include "weilgen/base/atomic_file.hpp"
+#include "weilgen/base/text.hpp"
+
+namespace po = boost::program_options;
+
+namespace weilgen::cli {
+
+po::options_description iso_options(IsoFlags& f) {
+  po::options_description o(
+      "Instrument files, normalisation to 20 degC, air, tolerances, report (docs/iso230-2.md)");
+  o.add_options()("format", po::value<std::string>(&f.format)->default_value(f.format),
+                  "the data file's layout: auto, tidy, carto (Renishaw XL-80/CARTO wide CSV) or "
+                  "wide (docs/data-format.md, 'Instrument files')")(
+      "expansion", ranged(&f.expansion_ppm_per_K, NumberRange::closed(-100, 100)),
+      "expansion coefficient of the machine's material, um/(m K) = ppm/K: normalise the "
+      "deviations to 20 degC (default: header key expansion_ppm_per_K, else none)")(
+      "material-temperature", po::value<std::string>(),
+      "material temperature: degC, or columns whose mean is used (T_table,T_scale; default: "
+      "columns T_material, T_material_<k>, or header key material_temperature_C)")(
+      "air-compensation", po::value<std::string>(),
+      "who compensated the air's refractive index: instrument, edlen (weilgen, modified Edlen "
+      "equation of Birch & Downs from the air columns) or none (default: header key "
+      "air_compensation, else unstated)")(
+      "air-temperature", po::value<std::string>(),
+      "air temperature: degC or a column (default: column T_air, header key air_temperature_C)")(
+      "air-pressure", po::value<std::string>(),
+      "air pressure: Pa (or '1013.2 hPa', mbar, kPa) or a column (default: column p_air_Pa, "
+      "header key air_pressure_Pa)")(
+      "air-humidity", po::value<std::string>(),
+      "relative humidity: % or a column (default: column RH_air_pct, header key "
+      "air_humidity_pct)")("wavelength", ranged(&f.wavelength_nm, NumberRange::closed(100, 20000)),
+                           "the laser's vacuum wavelength, nm (default 632.991, HeNe)")(
+      "air-index-assumed", ranged(&f.air_index_assumed, NumberRange::closed(0.9, 1.1)),
+      "the refractive index the uncompensated readings assumed (default 1: vacuum wavelength)")(
+      "datum", ranged(&f.datum_mm, NumberRange{}),
+      "the target (mm) where the laser was zeroed (default: the lowest target)")(
+      "tolerance", po::value<std::string>(&f.tolerance),
+      "tolerances in the deviation unit: a band +-T ('10'), figure limits ('A=12,R=6,B=4') or "
+      "both ('10,A=12'); verdicts in the text, JSON and report")(
+      "report", po::value<std::string>(&f.report),
+      "write the test report as one self-contained HTML file (charts inline)");
+  return o;
+}
+
+void apply_iso_flags(const IsoFlags& f, const po::variables_map& vm, Iso230_2StudyOptions& s,
+                     ImportOptions& imp) {
+  if (lower(f.format) != "auto") imp.format = parse_instrument_format(f.format);
+  NormalisationOptions& n = s.normalisation;
+  if (vm.count("expansion")) n.expansion_ppm_per_K = f.expansion_ppm_per_K;
+  if (vm.count("wavelength")) n.wavelength_nm = f.wavelength_nm;
+  if (vm.count("air-index-assumed")) n.assumed_index = f.air_index_assumed;
+  if (vm.count("datum")) n.datum_mm = f.datum_mm;
+  if (vm.count("air-compensation"))
+    n.air = parse_air_compensation(vm["air-compensation"].as<std::string>(), "--air-compensation");
+  const std::tuple<const char*, EnvironmentSource*, EnvironmentQuantity> sources[] = {
+      {"material-temperature", &n.material_temperature, EnvironmentQuantity::MaterialTemperature},
+      {"air-temperature", &n.air_temperature, EnvironmentQuantity::AirTemperature},
+      {"air-pressure", &n.air_pressure, EnvironmentQuantity::AirPressure},
+      {"air-humidity", &n.air_humidity, EnvironmentQuantity::AirHumidity}};
+  for (const auto& [flag, source, quantity] : sources)
+    if (vm.count(flag))
+      *source =
+          parse_environment_source(vm[flag].as<std::string>(), quantity, std::string("--") + flag);
+  n.validate();
+  if (!f.tolerance.empty()) s.tolerance = parse_iso_tolerance(f.tolerance);
+  if (!f.report.empty()) {
+    const std::string ext = lower(std::filesystem::path(f.report).extension().string());
+    if (ext != ".html" && ext != ".htm")
+      throw std::invalid_argument("--report " + f.report + ": the report is an .html file");
+  }
+}
+
+}  // namespace weilgen::cli

@@ -1,0 +1,493 @@
+#include "weilgen/report/iso230_2_html.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <sstream>
+
+#include "weilgen/base/format.hpp"
+#include "weilgen/base/version.hpp"
+#include "weilgen/report/iso230_2_document.hpp"
+#include "weilgen/report/svg_chart.hpp"
+
+namespace weilgen {
+
+namespace {
+
+const char* const kUpColour = "#1f77b4";    // forward (↑)
+const char* const kDownColour = "#d62728";  // reverse (↓)
+
+std::string h(const std::string& s) { return xml_escape(s); }
+std::string num(double v, int decimals = 3) { return format_fixed(v, decimals); }
+
+bool word_char(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }
+
+// The ASCII units of the shared statements in print: um -> µm, urad -> µrad, degC -> °C,
+// +- -> ±, alpha -> α, ".." -> "…" (whole words only).
+std::string pretty(const std::string& s) {
+  static const std::pair<const char*, const char*> words[] = {{"um", "\xC2\xB5m"},
+                                                              {"urad", "\xC2\xB5rad"},
+                                                              {"degC",
+                                                               "\xC2\xB0"
+                                                               "C"},
+                                                              {"alpha", "\xCE\xB1"}};
+  std::string out;
+  for (std::size_t i = 0; i < s.size();) {
+    bool done = false;
+    for (const auto& [from, to] : words) {
+      const std::size_t n = std::char_traits<char>::length(from);
+      if (s.compare(i, n, from) == 0 &&
+          (i == 0 || !std::isalpha(static_cast<unsigned char>(s[i - 1]))) &&
+          (i + n >= s.size() || !word_char(s[i + n]))) {
+        out += to;
+        i += n;
+        done = true;
+        break;
+      }
+    }
+    if (done) continue;
+    if (s.compare(i, 2, "+-") == 0) {
+      out += "\xC2\xB1";
+      i += 2;
+    } else if (s.compare(i, 4, " .. ") == 0) {
+      out += " \xE2\x80\xA6 ";
+      i += 4;
+    } else {
+      out += s[i++];
+    }
+  }
+  return out;
+}
+
+std::string unit_html(const std::string& u) { return pretty(u); }
+
+// One figures table (bidirectional, forward, reverse) with data attributes naming the JSON keys.
+std::string figures_table(const IsoFigures& F, const std::string& set, const std::string& u,
+                          const std::vector<ToleranceCheck>* checks) {
+  struct Row {
+    const char* name;
+    const char* symbol;
+    const char* bi;
+    const char* up;
+    const char* down;
+    double IsoFigures::*f_bi;
+    double IsoFigures::*f_up;
+    double IsoFigures::*f_down;
+  };
+  const Row rows[] = {
+      {"Accuracy", "A", "A", "A_up", "A_down", &IsoFigures::A, &IsoFigures::A_up,
+       &IsoFigures::A_down},
+      {"Repeatability", "R", "R", "R_up", "R_down", &IsoFigures::R, &IsoFigures::R_up,
+       &IsoFigures::R_down},
+      {"Systematic positional deviation", "E", "E", "E_up", "E_down", &IsoFigures::E,
+       &IsoFigures::E_up, &IsoFigures::E_down},
+      {"Range of mean bidirectional deviation", "M", "M", nullptr, nullptr, &IsoFigures::M, nullptr,
+       nullptr},
+      {"Reversal value", "B", "B", nullptr, nullptr, &IsoFigures::B, nullptr, nullptr},
+      {"Mean reversal value", "B\xCC\x84", "B_mean", nullptr, nullptr, &IsoFigures::B_mean, nullptr,
+       nullptr}};
+  auto limit_of = [&](const char* key) -> std::string {
+    if (!checks || !key) return "";
+    for (const auto& c : *checks)
+      if (c.name == key)
+        return " <span class=\"" + std::string(c.pass ? "pass" : "fail") + "\">" +
+               (c.pass ? "\xE2\x89\xA4 " : "&gt; ") + format_number(c.limit) + "</span>";
+    return "";
+  };
+  auto cell = [&](const char* key, double IsoFigures::*f) {
+    if (!key) return std::string("<td class=\"num na\">\xE2\x80\x93</td>");
+    return "<td class=\"num\"><span data-set=\"" + set + "\" data-key=\"" + key + "_um\">" +
+           num(F.*f) + "</span>" + limit_of(key) + "</td>";
+  };
+  std::ostringstream o;
+  o << "<table class=\"figures\"><thead><tr><th>Figure (" << unit_html(u)
+    << ")</th><th></th><th>Bidirectional</th><th>Forward \xE2\x86\x91</th><th>Reverse "
+       "\xE2\x86\x93</th></tr></thead><tbody>\n";
+  for (const Row& r : rows) {
+    o << "<tr><td>" << r.name << "</td><td class=\"sym\">" << r.symbol << "</td>"
+      << cell(r.bi, r.f_bi) << cell(r.up, r.f_up) << cell(r.down, r.f_down) << "</tr>\n";
+  }
+  o << "<tr class=\"k\"><td>Coverage factor</td><td class=\"sym\">k</td><td></td><td class=\"num\">"
+    << num(F.k_up, 2) << "</td><td class=\"num\">" << num(F.k_down, 2) << "</td></tr>\n";
+  o << "</tbody></table>\n";
+  return o.str();
+}
+
+void add_cycles(SvgChart& c, const std::vector<std::vector<double>>& x, const char* colour,
+                const std::string& label) {
+  const std::size_t n = x.empty() ? 0 : x[0].size();
+  for (std::size_t j = 0; j < n; ++j) {
+    SvgSeries s;
+    s.label = j == 0 ? label : "";
+    for (const auto& row : x) s.y.push_back(row[j]);
+    s.colour = colour;
+    s.width = 0.8;
+    s.opacity = 0.3;
+    c.series.push_back(s);
+  }
+}
+
+void add_mean_band(SvgChart& c, const std::vector<double>& mean, const std::vector<double>& s,
+                   double k, const char* colour, const std::string& name,
+                   const std::string& band_name) {
+  SvgBand b;
+  b.label = band_name;
+  b.colour = colour;
+  for (std::size_t i = 0; i < mean.size(); ++i) {
+    b.lo.push_back(mean[i] - k * s[i]);
+    b.hi.push_back(mean[i] + k * s[i]);
+  }
+  c.bands.push_back(b);
+  SvgSeries m;
+  m.label = name;
+  m.y = mean;
+  m.colour = colour;
+  m.width = 2;
+  m.markers = true;
+  c.series.push_back(m);
+}
+
+void add_tolerance(SvgChart& c, const std::vector<ToleranceCheck>& checks, const std::string& u) {
+  for (const auto& t : checks)
+    if (t.name == "band") {
+      c.rules.push_back({"tolerance \xC2\xB1" + format_number(t.limit) + " " + pretty(u), t.limit,
+                         "#000000", true});
+      c.rules.push_back({"", -t.limit, "#000000", true});
+    }
+}
+
+// The common y range of charts drawn side by side.
+std::pair<double, double> y_range_of(const std::vector<const SvgChart*>& charts) {
+  double lo = INFINITY, hi = -INFINITY;
+  auto take = [&](double v) {
+    if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
+  };
+  for (const SvgChart* c : charts) {
+    for (const auto& s : c->series)
+      for (double v : s.y) take(v);
+    for (const auto& b : c->bands) {
+      for (double v : b.lo) take(v);
+      for (double v : b.hi) take(v);
+    }
+    for (const auto& r : c->rules) take(r.y);
+  }
+  if (!std::isfinite(lo)) return {-1, 1};
+  const double pad = 0.04 * std::max(hi - lo, 1e-9);
+  return {lo - pad, hi + pad};
+}
+
+// The environment as recorded (min, mean, max of the rows) and the corrections made, one row per
+// known quantity; nothing when the file records no environment.
+void environment_table(std::ostream& o, const NormalisationResult& n) {
+  struct Row {
+    const char* name;
+    const ValueRange& v;
+    double scale;
+    int decimals;
+    const char* unit;
+    std::string source;
+  };
+  const std::string air_source =
+      n.air_applied ? "Edl\xC3\xA9n (Birch & Downs), " + num(n.wavelength_nm, 3) + " nm" : "";
+  const Row rows[] = {
+      {"Material temperature", n.material_temperature_C, 1, 2,
+       "\xC2\xB0"
+       "C",
+       n.material_source},
+      {"Air temperature", n.air_temperature_C, 1, 2,
+       "\xC2\xB0"
+       "C",
+       n.air_temperature_source},
+      {"Air pressure", n.air_pressure_Pa, 0.01, 1, "hPa", n.air_pressure_source},
+      {"Relative humidity", n.air_humidity_pct, 1, 1, "%", n.air_humidity_source},
+      {"Air refractivity (n \xE2\x88\x92 1) \xC3\x97 10\xE2\x81\xB6", n.air_refractivity, 1e6, 3,
+       "", air_source},
+      {"Air correction \xCE\xB4<sub>air</sub>", n.air_correction_um, 1, 3, "\xC2\xB5m", ""},
+      {"Expansion correction \xCE\xB4<sub>T</sub>", n.material_correction_um, 1, 3, "\xC2\xB5m",
+       n.material_applied
+           ? "\xCE\xB1 = " + num(n.expansion_ppm_per_K, 2) + " \xC2\xB5m/(m\xC2\xB7K)"
+           : ""}};
+  bool any = false;
+  for (const Row& r : rows) any |= !r.v.empty();
+  if (!any) return;
+  o << "<table class=\"env\"><tr><th>Quantity</th><th>Min</th><th>Mean</th><th>Max</th>"
+       "<th>Unit</th><th>Source</th></tr>\n";
+  for (const Row& r : rows) {
+    if (r.v.empty()) continue;
+    o << "<tr><td>" << r.name << "</td>";
+    for (double v : {r.v.min, r.v.mean, r.v.max})
+      o << "<td class=\"num\">" << num(v * r.scale, r.decimals) << "</td>";
+    o << "<td>" << r.unit << "</td><td>" << h(r.source) << "</td></tr>\n";
+  }
+  o << "</table>\n";
+}
+
+const char* kStyle = R"(
+body { font-family: Helvetica, Arial, sans-serif; font-size: 13px; color: #222; margin: 0;
+       background: #fff; }
+main { max-width: 1160px; margin: 0 auto; padding: 18px 20px 30px; }
+header { border-bottom: 3px solid #1f3b63; margin-bottom: 10px; }
+h1 { font-size: 21px; margin: 0 0 4px; color: #1f3b63; }
+h2 { font-size: 16px; margin: 18px 0 6px; color: #1f3b63; border-bottom: 1px solid #c8d0dc; }
+h3 { font-size: 14px; margin: 6px 0; }
+.sub { color: #555; margin: 0 0 8px; }
+table { border-collapse: collapse; }
+td, th { border: 1px solid #c8d0dc; padding: 3px 7px; }
+th { background: #eef2f7; text-align: left; }
+td.num { text-align: right; font-variant-numeric: tabular-nums; white-space: nowrap; }
+td.sym { text-align: center; font-style: italic; }
+td.na { color: #aaa; text-align: center; }
+table.meta td:first-child { background: #f6f8fb; width: 150px; }
+.pair { display: flex; gap: 16px; align-items: flex-start; }
+.pair > div { flex: 1 1 0; min-width: 0; }
+figure { margin: 8px 0; }
+figcaption { color: #555; font-size: 12px; margin-top: 2px; }
+.pass { color: #1a7f37; font-weight: bold; }
+.fail { color: #c62828; font-weight: bold; }
+.verdict { font-size: 15px; margin: 8px 0; }
+ul.statements li { margin: 3px 0; }
+table.env { margin-bottom: 4px; }
+table.targets { font-size: 12px; }
+.signature { display: flex; gap: 40px; margin-top: 28px; }
+.signature div { flex: 1; border-top: 1px solid #444; padding-top: 4px; color: #444; }
+footer { margin-top: 22px; color: #666; font-size: 11px; border-top: 1px solid #c8d0dc;
+         padding-top: 6px; }
+@media print { main { max-width: none; } .pair { break-inside: avoid; } }
+)";
+
+}  // namespace
+
+std::string iso230_2_html(const std::string& data, const Iso230_2StudyResult& res,
+                          const std::string& source_format) {
+  const IsoColumns& cols = res.columns;
+  const IsoRuns& runs = res.runs;
+  const IsoFigures& F = res.classical.figures;
+  const std::string& u = cols.unit;
+  const auto& P = runs.positions_mm;
+  const std::size_t m = P.size();
+  const bool rotary = cols.unit == "urad";
+  const std::string pos_unit = rotary ? "deg" : "mm";
+  auto key = [&](const std::string& k) {
+    const auto it = res.header_keys.find(k);
+    return it == res.header_keys.end() ? std::string() : it->second;
+  };
+  const std::string machine = key("machine");
+  std::ostringstream o;
+  o << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+    << "<meta name=\"generator\" content=\"weilgen " << kVersion << "\">\n<title>ISO 230-2 "
+    << h(cols.axis) << (machine.empty() ? "" : " \xE2\x80\x93 " + h(machine)) << "</title>\n<style>"
+    << kStyle << "</style>\n</head>\n<body>\n<main>\n";
+  // ---- Heading and identification.
+  o << "<header><h1>Positioning accuracy and repeatability \xE2\x80\x93 ISO 230-2:2014</h1>"
+    << "<p class=\"sub\">Axis " << h(cols.axis)
+    << (machine.empty() ? "" : " \xC2\xB7 " + h(machine))
+    << (key("date").empty() ? "" : " \xC2\xB7 " + h(key("date"))) << "</p></header>\n";
+  o << "<section id=\"identification\"><h2>Test identification</h2>\n<table class=\"meta\">\n";
+  auto meta_row = [&](const std::string& label, const std::string& value, const std::string& k) {
+    if (value.empty()) return;
+    o << "<tr><td>" << label << "</td><td" << (k.empty() ? "" : " data-key=\"" + k + "\"") << ">"
+      << h(value) << "</td></tr>\n";
+  };
+  const std::pair<const char*, const char*> known[] = {
+      {"machine", "Machine"},   {"serial", "Serial number"}, {"title", "Test"},
+      {"customer", "Customer"}, {"location", "Location"},    {"date", "Test date"},
+      {"operator", "Operator"}, {"instrument", "Instrument"}};
+  std::set<std::string> shown;
+  for (const auto& [k, label] : known) {
+    meta_row(label, key(k), k);
+    shown.insert(k);
+  }
+  meta_row("Axis", cols.axis + " (deviation " + cols.deviation + ", " + pretty(u) + ")", "axis");
+  meta_row("Targets",
+           std::to_string(m) + " from " + format_number(P.front()) + " to " +
+               format_number(P.back()) + " " + pos_unit,
+           "targets");
+  meta_row("Cycles",
+           std::to_string(runs.cycles[kUp].size()) + " forward, " +
+               std::to_string(runs.cycles[kDown].size()) + " reverse",
+           "cycles");
+  meta_row("Data file", data + " (read as " + source_format + ")", "file");
+  for (const auto& [k, v] : res.header_keys) {
+    static const std::set<std::string> handled = {"axis",
+                                                  "expansion_ppm_per_K",
+                                                  "material_temperature_C",
+                                                  "air_compensation",
+                                                  "air_temperature_C",
+                                                  "air_pressure_Pa",
+                                                  "air_humidity_pct",
+                                                  "laser_wavelength_nm",
+                                                  "air_index_assumed",
+                                                  "datum_mm",
+                                                  "format"};
+    if (!shown.count(k) && !handled.count(k)) meta_row(k, v, k);
+  }
+  o << "</table></section>\n";
+  // ---- Environment.
+  o << "<section id=\"environment\"><h2>Environment, normalisation and compensation</h2>\n";
+  environment_table(o, res.normalisation);
+  o << "<ul class=\"statements\">\n";
+  for (const auto& line : iso230_2_normalisation_statement(res))
+    o << "<li>" << h(pretty(line)) << "</li>\n";
+  o << "</ul></section>\n";
+  // ---- Results: figures and charts, classical beside drift-eliminated.
+  SvgChart classical;
+  classical.id = "chart-classical";
+  classical.title = "Deviation, mean \xC2\xB1 2s (ISO 230-2)";
+  classical.xlabel = "target " + cols.axis + " (" + pos_unit + ")";
+  classical.ylabel = "deviation (" + pretty(u) + ")";
+  classical.x = P;
+  add_cycles(classical, runs.x[kUp], kUpColour, "runs \xE2\x86\x91");
+  add_cycles(classical, runs.x[kDown], kDownColour, "runs \xE2\x86\x93");
+  add_mean_band(classical, F.mean_up, F.s_up, 2, kUpColour, "mean \xE2\x86\x91",
+                "\xC2\xB1 2s \xE2\x86\x91");
+  add_mean_band(classical, F.mean_down, F.s_down, 2, kDownColour, "mean \xE2\x86\x93",
+                "\xC2\xB1 2s \xE2\x86\x93");
+  add_tolerance(classical, res.tolerance, u);
+  SvgChart drift_chart;
+  const DriftResult* D = res.drift ? &*res.drift : nullptr;
+  if (D) {
+    drift_chart.id = "chart-drift";
+    drift_chart.title = "Drift eliminated: chart \xC2\xB1 2s* (Stejskal et al.)";
+    drift_chart.xlabel = classical.xlabel;
+    drift_chart.ylabel = classical.ylabel;
+    drift_chart.x = P;
+    add_cycles(drift_chart, D->chart[kUp].shifted, kUpColour, "runs shifted \xE2\x86\x91");
+    add_cycles(drift_chart, D->chart[kDown].shifted, kDownColour, "runs shifted \xE2\x86\x93");
+    add_mean_band(drift_chart, D->chart[kUp].value, D->chart[kUp].s, 2, kUpColour,
+                  "chart \xE2\x86\x91", "\xC2\xB1 2s* \xE2\x86\x91");
+    add_mean_band(drift_chart, D->chart[kDown].value, D->chart[kDown].s, 2, kDownColour,
+                  "chart \xE2\x86\x93", "\xC2\xB1 2s* \xE2\x86\x93");
+    add_tolerance(drift_chart, res.tolerance, u);
+    const auto range = y_range_of({&classical, &drift_chart});
+    classical.y_range = drift_chart.y_range = range;
+  }
+  o << "<section id=\"results\"><h2>Results</h2>\n";
+  if (!res.tolerance.empty()) {
+    bool pass = true;
+    for (const auto& c : res.tolerance) pass = pass && c.pass;
+    o << "<p class=\"verdict\" data-key=\"tolerance_pass\" data-value=\""
+      << (pass ? "true" : "false") << "\">Verdict against the tolerances: <span class=\""
+      << (pass ? "pass\">PASS" : "fail\">FAIL") << "</span> (classical figures, k = 2)</p>\n";
+  }
+  o << "<div class=\"pair\">\n<div><h3>ISO 230-2 evaluation (k = 2)</h3>\n"
+    << figures_table(F, "classical", u, &res.tolerance) << "<figure>" << svg_chart(classical)
+    << "<figcaption>Every run (thin), the mean unidirectional deviations x\xCC\x84\xE2\x86\x91, "
+       "x\xCC\x84\xE2\x86\x93 and the bands x\xCC\x84 \xC2\xB1 2s.</figcaption></figure>\n</div>\n";
+  if (D) {
+    o << "<div><h3>Drift-eliminated evaluation (k = 2)</h3>\n"
+      << figures_table(D->figures, "drift_eliminated", u, nullptr) << "<figure>"
+      << svg_chart(drift_chart) << "<figcaption>Adjacent-position differences accumulated from "
+      << h(cols.axis) << " = " << format_number(P[D->reference_target]) << " " << pos_unit
+      << ", cycle " << D->reference_cycle
+      << "; every run shifted to that reference; s* = s of the differences / \xE2\x88\x9A"
+         "2. "
+         "Thermal drift between cycles is removed; drift within a pass is not.</figcaption>"
+         "</figure>\n</div>\n";
+  } else {
+    o << "<div><h3>Drift-eliminated evaluation</h3><p>Needs at least 2 targets.</p></div>\n";
+  }
+  o << "</div>\n";
+  if (res.classical.student) {
+    const IsoFigures& S = *res.classical.student;
+    o << "<p>With the Student-t coverage factor for " << runs.cycles[kUp].size()
+      << " cycles (k = " << num(S.k_up, 2) << " / " << num(S.k_down, 2)
+      << "): A = <span data-set=\"student\" data-key=\"A_um\">" << num(S.A) << "</span> "
+      << pretty(u) << ", R = <span data-set=\"student\" data-key=\"R_um\">" << num(S.R)
+      << "</span> " << pretty(u) << ".</p>\n";
+  }
+  if (!res.tolerance.empty()) {
+    o << "<table class=\"tolerance\"><thead><tr><th>Tolerance</th><th>Value (" << pretty(u)
+      << ")</th><th>Limit (" << pretty(u) << ")</th><th>Result</th></tr></thead><tbody>\n";
+    for (const auto& c : res.tolerance)
+      o << "<tr><td>"
+        << (c.name == "band" ? std::string("every x\xCC\x84 \xC2\xB1 2s within \xC2\xB1 limit")
+                             : h(c.name))
+        << "</td><td class=\"num\" data-set=\"tolerance\" data-key=\"" << h(c.name) << "\">"
+        << num(c.value) << "</td><td class=\"num\">" << format_number(c.limit)
+        << "</td><td class=\"" << (c.pass ? "pass\">pass" : "fail\">FAIL") << "</td></tr>\n";
+    o << "</tbody></table>\n";
+  }
+  o << "</section>\n";
+  // ---- Per target.
+  o << "<section id=\"targets\"><h2>Per target (" << pretty(u) << ", k = 2)</h2>\n"
+    << "<table class=\"targets\"><thead><tr><th>Target (" << pos_unit
+    << ")</th><th>x\xCC\x84 \xE2\x86\x91</th><th>x\xCC\x84 \xE2\x86\x93</th><th>s "
+       "\xE2\x86\x91</th><th>s \xE2\x86\x93</th><th>B<sub>i</sub></th><th>R<sub>i</sub> "
+       "\xE2\x86\x91</th><th>R<sub>i</sub> "
+       "\xE2\x86\x93</th><th>R<sub>i</sub></th><th>x\xCC\x84<sub>i</sub></th>";
+  if (D)
+    o << "<th>chart \xE2\x86\x91</th><th>s* \xE2\x86\x91</th><th>chart \xE2\x86\x93</th><th>s* "
+         "\xE2\x86\x93</th>";
+  o << "</tr></thead><tbody>\n";
+  for (std::size_t i = 0; i < m; ++i) {
+    auto td = [&](const char* k, double v) {
+      return "<td class=\"num\" data-set=\"classical\" data-key=\"" + std::string(k) +
+             "\" data-index=\"" + std::to_string(i) + "\">" + num(v) + "</td>";
+    };
+    o << "<tr><td class=\"num\">" << format_number(P[i]) << "</td>"
+      << td("mean_up_um", F.mean_up[i]) << td("mean_down_um", F.mean_down[i])
+      << td("s_up_um", F.s_up[i]) << td("s_down_um", F.s_down[i]) << td("B_i_um", F.B_i[i])
+      << td("R_i_up_um", F.R_i_up[i]) << td("R_i_down_um", F.R_i_down[i]) << td("R_i_um", F.R_i[i])
+      << td("mean_bi_um", F.mean_bi[i]);
+    if (D)
+      o << "<td class=\"num\">" << num(D->chart[kUp].value[i]) << "</td><td class=\"num\">"
+        << num(D->chart[kUp].s[i]) << "</td><td class=\"num\">" << num(D->chart[kDown].value[i])
+        << "</td><td class=\"num\">" << num(D->chart[kDown].s[i]) << "</td>";
+    o << "</tr>\n";
+  }
+  o << "</tbody></table></section>\n";
+  // ---- Drift.
+  if (D) {
+    const DriftPerCycle& C = D->per_cycle;
+    SvgChart cyc;
+    cyc.id = "chart-cycles";
+    cyc.title =
+        "Offset of every cycle (relative to cycle " + std::to_string(D->reference_cycle) + ")";
+    cyc.xlabel = "cycle";
+    cyc.ylabel = "offset (" + pretty(u) + ")";
+    for (long c : C.cycles) cyc.x.push_back(static_cast<double>(c));
+    cyc.series.push_back({"forward \xE2\x86\x91", C.offset_up, kUpColour, 1.6, false, true, 1});
+    cyc.series.push_back({"reverse \xE2\x86\x93", C.offset_down, kDownColour, 1.6, false, true, 1});
+    cyc.series.push_back({"mean", C.offset, "#333333", 1.2, true, false, 1});
+    cyc.width = 760;
+    cyc.height = 300;
+    o << "<section id=\"drift\"><h2>Thermal drift</h2>\n<figure>" << svg_chart(cyc)
+      << "</figure>\n<p>Drift rate " << num(C.rate_per_cycle, 4) << " \xC2\xB1 "
+      << num(C.rate_per_cycle_se, 4) << " " << pretty(u) << " per cycle";
+    if (std::isfinite(C.rate_per_h))
+      o << ", " << num(C.rate_per_h, 4) << " \xC2\xB1 " << num(C.rate_per_h_se, 4) << " "
+        << pretty(u) << "/h";
+    o << " (within-group least squares, standard error). Anomaly test (F test of each adjacent "
+         "difference, Bonferroni over "
+      << D->tests << " tests, \xCE\xB1 = " << format_number(D->alpha) << "): ";
+    if (D->anomalous_positions.empty() && D->anomalous_differences.empty()) {
+      o << "no anomalous spread.";
+    } else {
+      std::vector<std::string> items;
+      for (const auto& a : D->anomalous_positions)
+        items.push_back(cols.axis + " = " + format_number(P[a.target]) + " " + pos_unit +
+                        (a.direction > 0 ? " \xE2\x86\x91" : " \xE2\x86\x93"));
+      for (const auto& a : D->anomalous_differences)
+        items.push_back(format_number(P[a.from]) + "\xE2\x80\xA6" + format_number(P[a.to]) + " " +
+                        pos_unit + (a.direction > 0 ? " \xE2\x86\x91" : " \xE2\x86\x93") +
+                        " (p = " + format_significant(a.p_value, 2) + ")");
+      o << "anomalous: ";
+      for (std::size_t i = 0; i < items.size(); ++i) o << (i ? "; " : "") << h(items[i]);
+      o << ".";
+    }
+    o << "</p></section>\n";
+  }
+  // ---- Signature and method.
+  o << "<section id=\"signature\"><h2>Approval</h2><div class=\"signature\"><div>Tested by</div>"
+       "<div>Checked by</div><div>Date</div></div></section>\n";
+  o << "<footer>Figures as defined in ISO 230-2:2014, clause 3 (coverage factor k = 2). "
+       "Drift-eliminated evaluation after T. Stejskal et al., Advances in Science and Technology "
+       "Research Journal 11(4), 2017. Normalisation to 20 \xC2\xB0"
+       "C per ISO 1; air refraction by "
+       "the modified Edl\xC3\xA9n equation of Birch &amp; Downs (Metrologia 30, 1993; 31, 1994). "
+       "Report written by weilgen "
+    << kVersion << " (docs/iso230-2.md).</footer>\n</main>\n</body>\n</html>\n";
+  return o.str();
+}
+
+}  // namespace weilgen
