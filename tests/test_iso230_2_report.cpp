@@ -143,7 +143,7 @@ TEST_CASE("html report: sections, charts, numbers equal to the JSON, nothing ext
   CHECK(html.find("<td data-key=\"axis\">") != std::string::npos);
 }
 
-TEST_CASE("iso230-2 --report: writes the HTML with the JSON; bad targets are refused first") {
+TEST_CASE("iso230-2 --report: writes the HTML with the JSON, bad targets are refused first") {
   const auto dir = test::fresh_dir("iso_report_cli");
   const std::string html = (dir / "r.html").string(), js = (dir / "r.json").string();
   test::Run r = run(cli("iso230-2 " + small_csv() + " --report " + html + " --json " + js +
@@ -181,7 +181,7 @@ TEST_CASE("iso230-2 --report: writes the HTML with the JSON; bad targets are ref
                    "temperature 20.00 degC [--material-temperature]") != std::string::npos);
 }
 
-TEST_CASE("iso230-2 --csv and --plot: the per-target table equals the JSON; refusals come first") {
+TEST_CASE("iso230-2 --csv and --plot: the per-target table equals the JSON, refusals come first") {
   const auto dir = test::fresh_dir("iso_csv_cli");
   const std::string csv = (dir / "t.csv").string(), js = (dir / "t.json").string(),
                     svg = (dir / "t.svg").string();

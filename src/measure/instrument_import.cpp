@@ -876,7 +876,9 @@ ImportResult parse_instrument_text(const std::string& text, const std::string& f
 
 ImportResult read_instrument_file(const std::string& path, const ImportOptions& o) {
   std::string text;
-  if (!read_file(path, text)) throw InputError(SourceLoc{path, 0, 0}, "cannot read file");
+  if (const std::string why = unreadable_reason(path); !why.empty() || !read_file(path, text))
+    throw InputError(SourceLoc{path, 0, 0},
+                     "cannot read the data file: " + (why.empty() ? "read error" : why));
   return parse_instrument_text(text, path, o);
 }
 
