@@ -227,9 +227,9 @@ TEST_CASE("study poses: --at, units, defaults, grid then at") {
   CHECK(a.grid_axes.empty());
   CHECK(a.grid_size() == 0);
   // --at names every axis: a missing one is an error naming it (--grid still takes 0 for one).
-  expect_words(error_of([&] { parse_poses(d, {"Z=700"}, {}); }),
-               {"--at: \"Z=700\": axes X, Y are not given", "--at names every axis",
-                "add e.g. X=0,Y=0"});
+  expect_words(
+      error_of([&] { parse_poses(d, {"Z=700"}, {}); }),
+      {"--at: \"Z=700\": axes X, Y are not given", "--at names every axis", "add e.g. X=0,Y=0"});
   expect_words(error_of([&] { parse_poses(d, {"X=1"}, {}); }),
                {"--at: \"X=1\": axes Z, Y are not given"});
   expect_words(error_of([&] { parse_poses(d, {}, {"X=0:1000:3"}); }),
@@ -286,7 +286,8 @@ TEST_CASE("study poses: bad flags") {
 
 TEST_CASE("study poses: degree axes of the five-axis machine") {
   const Description& d = five_axis();
-  const PoseSet p = parse_poses(d, {"X=0,Y=0,Z=0,A=90,C=0.5rad", "X=0,Y=0,Z=0,A=-1.5708rad,C=-360"}, {"A=-90:90:3"});
+  const PoseSet p = parse_poses(d, {"X=0,Y=0,Z=0,A=90,C=0.5rad", "X=0,Y=0,Z=0,A=-1.5708rad,C=-360"},
+                                {"A=-90:90:3"});
   const std::size_t ia = index_of(p.axes, "A"), ic = index_of(p.axes, "C");
   CHECK(p.units[ia] == "deg");
   CHECK(p.units[ic] == "deg");

@@ -192,7 +192,7 @@ TEST_CASE("outputs: reliability over three grid axes, small multiples and unit C
   CHECK(std::stod(c[col]) == doctest::Approx(json_value).epsilon(1e-15));
 }
 
-TEST_CASE("outputs: --at names every axis; help shows 0.95; sensitivity names its verb") {
+TEST_CASE("outputs: --at names every axis, help shows 0.95, sensitivity names its verb") {
   const Run r = run(cli("sensitivity gantry_grinder --at Z=700 --quiet"));
   CHECK(r.status == 2);
   CHECK(r.out.find("--at") != std::string::npos);

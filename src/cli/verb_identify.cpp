@@ -42,8 +42,9 @@ int verb_identify(const Args& args) {
       "pdge", po::value<std::vector<std::string>>(&pdge)->composing(),
       "basis of every PDGE (poly:3, fourier:2, legendre:4, chebyshev:4, fourier:2:20 = period "
       "20 mm, or 20 deg on a rotary axis) or of one error (E_YY=fourier:3); repeatable, applied "
-      "in order")("fix", po::value<std::vector<std::string>>(&fixed)->composing(),
-                  "hold an error at zero: a name, an alias or group:<group> (as --set); repeatable")(
+      "in order")(
+      "fix", po::value<std::vector<std::string>>(&fixed)->composing(),
+      "hold an error at zero: a name, an alias or group:<group> (as --set); repeatable")(
       "rank-tol", ranged(&rank_tol, NumberRange::open(0, 1))->default_value(rank_tol, "1e-9"),
       "singular values below rank-tol x the largest (equilibrated columns) count as zero")(
       "predict", po::value<std::vector<std::string>>(&predict)->composing(),

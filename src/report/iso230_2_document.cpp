@@ -348,11 +348,15 @@ nlohmann::json iso230_2_json(const std::string& data, const Iso230_2StudyResult&
   // ---- JSON ----
   json j;
   {
-    j = {
-        {"file", data},
-        {"axis", cols.axis},   {"column", cols.deviation},      {"deviation_unit", u},
-        {"targets", m},        {"cycles_up", runs.cycles[kUp]}, {"cycles_down", runs.cycles[kDown]},
-        {"positions_mm", P},   {"coverage_factor", F.k_up}};
+    j = {{"file", data},
+         {"axis", cols.axis},
+         {"column", cols.deviation},
+         {"deviation_unit", u},
+         {"targets", m},
+         {"cycles_up", runs.cycles[kUp]},
+         {"cycles_down", runs.cycles[kDown]},
+         {"positions_mm", P},
+         {"coverage_factor", F.k_up}};
     j["source_format"] = source_format;
     j["metadata"] = res.header_keys;
     const NormalisationResult& n = res.normalisation;
