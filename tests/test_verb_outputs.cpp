@@ -88,6 +88,27 @@ TEST_CASE("outputs: allocate --plot draws the steps chart, and the verdict has a
   }
 }
 
+TEST_CASE("outputs: allocate --cost-aware gives one verdict whatever --choose") {
+  // The issue's case: the optimum's verdict depended on --choose (a 2e-12 miss counted).
+  const auto dir = test::fresh_dir("outputs_cost_aware");
+  double cost = NAN;
+  for (const char* choose : {"1", "4"}) {
+    CAPTURE(choose);
+    const auto out = dir / (std::string("c") + choose + ".json");
+    // With --choose 1 the step procedure cannot meet the targets (exit 1); the optimum can.
+    const Run r =
+        run(cli("allocate gantry_grinder --grid X=0:1000:3,Y=-1500:1500:3,Z=600:1400:3 "
+                "--tolerance dx=30um,dy=30um --cost-aware --quiet --choose " +
+                std::string(choose) + " --json " + out.string()));
+    CHECK(r.status == (std::string(choose) == "1" ? 1 : 0));
+    REQUIRE(std::filesystem::exists(out));
+    const json ca = read_json(out)["cost_aware"];
+    CHECK(ca["met"] == true);
+    if (std::isnan(cost)) cost = ca["cost"].get<double>();
+    CHECK(ca["cost"].get<double>() == doctest::Approx(cost).epsilon(1e-6));
+  }
+}
+
 TEST_CASE("outputs: identify --plot, --csv equals the JSON, --fix group:, --predict-out first") {
   const auto dir = test::fresh_dir("outputs_identify");
   const std::string base = "identify vmc_3axis --data " + kData + "vmc_3axis_points.csv --quiet";
