@@ -164,7 +164,7 @@ TEST_CASE("sensitivity CLI: the same seed gives the same numbers with 1 or 2 thr
   REQUIRE(read_file(a, ta));
   REQUIRE(read_file(b, tb));
   CHECK(ta == tb);
-  CHECK(ta.rfind("Y,X,Z,output", 0) == 0);
+  CHECK(ta.rfind("Y_mm,X_mm,Z_mm,output,output_unit", 0) == 0);
   REQUIRE(run(cli(common + "--seed 8 --csv " + b)).status == 0);
   REQUIRE(read_file(b, tb));
   CHECK(ta != tb);

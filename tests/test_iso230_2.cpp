@@ -14,6 +14,7 @@
 #include "bench/experiments/normal_deviates.hpp"
 #include "test_support.hpp"
 #include "weilgen/base/atomic_file.hpp"
+#include "weilgen/base/version.hpp"
 #include "weilgen/measure/iso230_2.hpp"
 #include "weilgen/measure/measurement_csv.hpp"
 #include "weilgen/report/plot.hpp"
@@ -556,7 +557,8 @@ TEST_CASE("iso230-2 CLI: the small example, its tables and JSON") {
   CHECK(r.out.find("bidirectional accuracy") != std::string::npos);
   CHECK(r.out.find("wrote " + out) != std::string::npos);
   const json j = read_json(out);
-  CHECK(j["command"] == "iso230-2");
+  CHECK(j["verb"] == "iso230-2");
+  CHECK(j["weilgen"] == kVersion);
   CHECK(j["axis"] == "X");
   CHECK(j["column"] == "dx_um");
   CHECK(j["deviation_unit"] == "um");

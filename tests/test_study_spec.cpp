@@ -226,12 +226,12 @@ TEST_CASE("study poses: --at, units, defaults, grid then at") {
   CHECK(a.poses[1] == std::vector<double>{500, 1200, -1500});
   CHECK(a.grid_axes.empty());
   CHECK(a.grid_size() == 0);
-  // X and Y are not named: 0 lies in their ranges. Z's range [600, 1400] excludes 0.
-  const PoseSet b = parse_poses(d, {"Z=700"}, {});
-  CHECK(b.poses[0] == std::vector<double>{0, 700, 0});
+  // --at names every axis: a missing one is an error naming it (--grid still takes 0 for one).
+  expect_words(
+      error_of([&] { parse_poses(d, {"Z=700"}, {}); }),
+      {"--at: \"Z=700\": axes X, Y are not given", "--at names every axis", "add e.g. X=0,Y=0"});
   expect_words(error_of([&] { parse_poses(d, {"X=1"}, {}); }),
-               {"--at: \"X=1\": axis Z is not given and 0 is outside its range [600, 1400] mm",
-                "give a value (e.g. Z=1000)"});
+               {"--at: \"X=1\": axes Z, Y are not given"});
   expect_words(error_of([&] { parse_poses(d, {}, {"X=0:1000:3"}); }),
                {"--grid: \"X=0:1000:3\": axis Z is not given"});
   // Grid poses first, then --at; a count of 1 is the start; a one-value axis is no grid axis.
@@ -286,7 +286,8 @@ TEST_CASE("study poses: bad flags") {
 
 TEST_CASE("study poses: degree axes of the five-axis machine") {
   const Description& d = five_axis();
-  const PoseSet p = parse_poses(d, {"A=90,C=0.5rad", "A=-1.5708rad,C=-360"}, {"A=-90:90:3"});
+  const PoseSet p = parse_poses(d, {"X=0,Y=0,Z=0,A=90,C=0.5rad", "X=0,Y=0,Z=0,A=-1.5708rad,C=-360"},
+                                {"A=-90:90:3"});
   const std::size_t ia = index_of(p.axes, "A"), ic = index_of(p.axes, "C");
   CHECK(p.units[ia] == "deg");
   CHECK(p.units[ic] == "deg");

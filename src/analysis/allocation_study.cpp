@@ -25,7 +25,7 @@ std::vector<double> parse_steps(const Description& d, const std::vector<std::str
       const int i = d.error_index(name);
       if (i < 0) throw std::invalid_argument("--step: unknown error \"" + name + "\"");
       const auto& e = d.errors[i];
-      const std::string def = e.effect == ErrorEffect::Rotation ? "rad" : "mm";
+      const std::string def = e.base_unit();
       per_error[i] = parse_quantity(flag.substr(eq + 1), def, "--step " + name);
       set_error[i] = true;
       continue;
@@ -138,8 +138,7 @@ AllocationStudyResult AllocationStudy::run(const Study& st) const {
       throw std::invalid_argument("--weight: expected NAME=w with a known error, not \"" + w +
                                   "\"");
     const auto& e = d.errors[i];
-    ao.cost_weights[i] = parse_quantity(
-        w.substr(eq + 1), e.effect == ErrorEffect::Rotation ? "rad" : "mm", "--weight");
+    ao.cost_weights[i] = parse_quantity(w.substr(eq + 1), e.base_unit(), "--weight");
     if (!(ao.cost_weights[i] >= 0)) throw std::invalid_argument("--weight: must be >= 0");
   }
   for (std::size_t i = 0; i < ne; ++i) {

@@ -7,6 +7,7 @@
 #include <map>
 #include <stdexcept>
 
+#include "weilgen/analysis/study_spec.hpp"
 #include "weilgen/base/format.hpp"
 #include "weilgen/base/text.hpp"
 #include "weilgen/base/units.hpp"
@@ -297,11 +298,10 @@ IdentifyResult Identification::run(const Model& model_, const ErrorParameterisat
   R.standard_error.assign(np, kNaN);
   R.identifiable.assign(np, false);
   R.fixed.assign(np, false);
-  for (const std::string& f : options_.fixed) {
-    const int k = error_of_name(desc, f, "--fix");
-    for (std::size_t p = 0; p < np; ++p)
-      if (param_.parameters()[p].error == k) R.fixed[p] = true;
-  }
+  for (const std::string& f : options_.fixed)
+    for (const ErrorTarget& t : select_errors(desc, f, "--fix " + quoted(f)))
+      for (std::size_t p = 0; p < np; ++p)
+        if (param_.parameters()[p].error == static_cast<int>(t.error)) R.fixed[p] = true;
   std::vector<std::size_t> cols;  // free parameters
   for (std::size_t p = 0; p < np; ++p)
     if (!R.fixed[p]) cols.push_back(p);

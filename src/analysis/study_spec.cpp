@@ -231,8 +231,23 @@ PoseSet parse_poses(const Description& desc, const std::vector<std::string>& at,
       pose[index] = axis_value(axes[index], text, context);
       named[index] = true;
     }
+    // A pose names every axis: an axis left out is a mistake more often than a wish for 0.
+    std::vector<std::string> missing, example;
     for (std::size_t i = 0; i < axes.size(); ++i) {
-      if (!named[i]) pose[i] = default_axis_value(axes[i], context);
+      if (named[i]) continue;
+      const Axis& a = axes[i];
+      missing.push_back(a.name);
+      const bool zero_ok = !a.has_range() || (a.min <= 0 && 0 <= a.max);
+      example.push_back(a.name + "=" + format_number(zero_ok ? 0 : 0.5 * (a.min + a.max)));
+    }
+    if (!missing.empty()) {
+      std::string example_text;
+      for (const std::string& e : example) example_text += (example_text.empty() ? "" : ",") + e;
+      fail(context, std::string(missing.size() > 1 ? "axes " : "axis ") + join(missing) +
+                        (missing.size() > 1 ? " are" : " is") +
+                        " not given: --at names every "
+                        "axis (" +
+                        axes_list(desc, axes) + "); add e.g. " + example_text);
     }
     set.poses.push_back(std::move(pose));
   }
@@ -317,6 +332,33 @@ const char* const kSetForm =
 
 }  // namespace
 
+std::vector<ErrorTarget> select_errors(const Description& desc, const std::string& name,
+                                       const std::string& context) {
+  std::vector<ErrorTarget> targets;
+  if (name.compare(0, 6, "group:") == 0) {
+    const std::string group = trim(name.substr(6));
+    for (std::size_t i = 0; i < desc.errors.size(); ++i) {
+      if (desc.errors[i].group == group) targets.push_back({i, 1});
+    }
+    if (targets.empty()) {
+      fail(context, "no errors in group " + quoted(group) + " (groups with errors in machine " +
+                        desc.name + ": " + join(used_groups(desc)) + ")");
+    }
+    return targets;
+  }
+  const int index = desc.error_index(name);
+  if (index < 0) {
+    fail(context, "unknown error " + quoted(abbreviated(name)) + " (machine " + desc.name +
+                      " has " + join(error_names(desc)) + "; or group:<group>)");
+  }
+  int sign = 1;
+  for (const Alias& a : desc.errors[static_cast<std::size_t>(index)].aliases) {
+    if (a.name == name) sign = a.sign;
+  }
+  targets.push_back({static_cast<std::size_t>(index), sign});
+  return targets;
+}
+
 void apply_set_flag(const Description& desc, const std::string& flag,
                     std::vector<std::optional<InputDistribution>>& dists) {
   const std::string context = flag_context("--set", flag);
@@ -325,29 +367,7 @@ void apply_set_flag(const Description& desc, const std::string& flag,
   const std::string name = trim(flag.substr(0, eq));
   const std::string spec = trim(flag.substr(eq + 1));
 
-  // Targets: (error index, sign of the name used).
-  std::vector<std::pair<std::size_t, int>> targets;
-  if (name.compare(0, 6, "group:") == 0) {
-    const std::string group = trim(name.substr(6));
-    for (std::size_t i = 0; i < desc.errors.size(); ++i) {
-      if (desc.errors[i].group == group) targets.emplace_back(i, 1);
-    }
-    if (targets.empty()) {
-      fail(context, "no errors in group " + quoted(group) + " (groups with errors in machine " +
-                        desc.name + ": " + join(used_groups(desc)) + ")");
-    }
-  } else {
-    const int index = desc.error_index(name);
-    if (index < 0) {
-      fail(context, "unknown error " + quoted(abbreviated(name)) + " (machine " + desc.name +
-                        " has " + join(error_names(desc)) + "; or group:<group>)");
-    }
-    int sign = 1;
-    for (const Alias& a : desc.errors[static_cast<std::size_t>(index)].aliases) {
-      if (a.name == name) sign = a.sign;
-    }
-    targets.emplace_back(static_cast<std::size_t>(index), sign);
-  }
+  const std::vector<ErrorTarget> targets = select_errors(desc, name, context);
 
   const std::size_t colon = spec.find(':');
   if (colon == std::string::npos) {

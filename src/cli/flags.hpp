@@ -12,6 +12,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "weilgen/base/format.hpp"
 #include "weilgen/base/output_paths.hpp"
 #include "weilgen/base/range.hpp"
 #include "weilgen/machine/description.hpp"
@@ -27,6 +28,14 @@ class RangedValue : public boost::program_options::typed_value<T> {
   RangedValue(T* store, NumberRange range)
       : boost::program_options::typed_value<T>(store), range_(range) {
     if (std::is_integral_v<T>) range_.whole = true;
+  }
+
+  // The default shown by --help as the number is written ("0.95", not lexical_cast's
+  // "0.94999999999999996"); default_value(v, "text") still sets the text explicitly.
+  using boost::program_options::typed_value<T>::default_value;
+  RangedValue* default_value(const T& v) {
+    boost::program_options::typed_value<T>::default_value(v, format_number(static_cast<double>(v)));
+    return this;
   }
 
   void xparse(boost::any& value_store, const std::vector<std::string>& tokens) const override {

@@ -83,10 +83,10 @@ int verb_allocate(const Args& args) {
   ao.weights = weight_flags;
   if (!errors_text.empty()) ao.errors = split(errors_text, ',');
 
-  if (!f.plot.empty()) return usage_error("allocate", "--plot: allocate draws no figure");
   std::vector<PathArg> outputs = study_outputs(f);
   outputs.push_back({"--save-tolerances", save});
   check_output_paths(study_inputs(f), outputs);
+  if (!f.plot.empty()) check_plot_target(f.plot);  // before a long run, not after
   const Study st = open_study(f, true);
   const AllocationStudyResult out = AllocationStudy(ao).run(st);
   std::cout << allocation_text(st, ao, out);
@@ -97,6 +97,8 @@ int verb_allocate(const Args& args) {
   if (!f.json.empty())
     write_file_atomically(f.json, allocation_json(st, ao, text, out).dump(1) + "\n");
   if (!f.csv.empty()) write_file_atomically(f.csv, allocation_csv(st, out));
+  if (!f.plot.empty())
+    write_plot(f.plot, allocation_panels(st, ao, out), "weilgen allocate: " + st.model->name());
   return out.result.met ? 0 : 1;
 }
 

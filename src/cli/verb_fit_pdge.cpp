@@ -27,7 +27,7 @@ int verb_fit_pdge(const Args& args) {
       "docs/fit-pdge.md, docs/data-format.md.\n\nOptions");
   std::vector<std::string> basis_flags, column_flags;
   std::string order = "auto", period = "travel", cv = "blocks", rule = "1se", axis, travel;
-  std::string json_path, plot_path, angular = "mean";
+  std::string json_path, csv_path, plot_path, angular = "mean";
   int max_order = 10, min_order = 0, folds = 10;
   bool keep_line = false, curves = false;
   opts.add_options()("help,h", "show this help")(
@@ -65,13 +65,16 @@ int verb_fit_pdge(const Args& args) {
       "6D files: mean (remove each angular profile's mean) | none")(
       "curves", po::bool_switch(&curves), "print the CV curve (error per order) of every fit")(
       "json", po::value<std::string>(&json_path), "write every number to FILE (JSON)")(
+      "csv", po::value<std::string>(&csv_path),
+      "write one row per profile and basis (order, metrics, CV error) to FILE (CSV)")(
       "plot", po::value<std::string>(&plot_path),
       "draw data, fitted curves and residuals to FILE (.png or .svg, gnuplot)");
   po::variables_map vm;
   if (auto stop = parse_args<std::string>("fit-pdge", args, opts, "data", 1, vm)) return *stop;
   if (!vm.count("data")) return usage_error("fit-pdge", "no data file given");
   const std::string data_path = vm["data"].as<std::string>();
-  check_output_paths({{"data file", data_path}}, {{"--json", json_path}, {"--plot", plot_path}});
+  check_output_paths({{"data file", data_path}},
+                     {{"--json", json_path}, {"--csv", csv_path}, {"--plot", plot_path}});
   PdgeFitStudyOptions so;
   so.bases = basis_flags;
   so.order = order;
@@ -97,6 +100,7 @@ int verb_fit_pdge(const Args& args) {
   for (const std::string& w : r.warnings) std::cerr << w << "\n";
   std::cout << pdge_fit_text(so, r, curves);
   if (!json_path.empty()) write_file_atomically(json_path, pdge_fit_json(so, r).dump(1) + "\n");
+  if (!csv_path.empty()) write_file_atomically(csv_path, pdge_fit_csv(r));
   if (!plot_path.empty())
     write_plot(plot_path, pdge_fit_panels(r), "weilgen fit-pdge: " + data_path);
   // A basis the data cannot support is reported and the others still fitted; exit status 1.

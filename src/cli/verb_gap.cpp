@@ -23,7 +23,7 @@ int verb_gap(const Args& args) {
       "(by output, coordinate, time, direction, cycle, temperatures, covariates), ranks the\n"
       "candidate unmodelled effects by held-out improvement with a test corrected for the extra\n"
       "parameters, and says how far the gap shrinks. docs/gap.md.\n\nOptions");
-  std::string json_path, report_path, plot_dir;
+  std::string json_path, csv_path, report_path, plot_dir;
   opts.add_options()("help,h", "show this help")("data", po::value<std::string>(&rq.data),
                                                  "measurement CSV (docs/data-format.md)")(
       "holdout", po::value<std::string>(&rq.holdout)->default_value(rq.holdout),
@@ -39,6 +39,8 @@ int verb_gap(const Args& args) {
       "alpha", ranged(&rq.alpha, NumberRange::open(0, 0.5))->default_value(rq.alpha),
       "family-wise false-positive rate of each decision")(
       "json", po::value<std::string>(&json_path), "write the results as JSON to FILE")(
+      "csv", po::value<std::string>(&csv_path),
+      "write the candidate effects, one row each in ranking order, to FILE (CSV)")(
       "report", po::value<std::string>(&report_path), "write a Markdown report to FILE")(
       "plot", po::value<std::string>(&plot_dir),
       "draw residual-versus-coordinate and effect-ranking plots into DIR (PNG)")(
@@ -58,7 +60,8 @@ int verb_gap(const Args& args) {
   }
   std::vector<PathArg> inputs = study_inputs(flags);
   inputs.push_back({"--data", rq.data});
-  check_output_paths(inputs, {{"--json", json_path}, {"--report", report_path}});
+  check_output_paths(inputs,
+                     {{"--json", json_path}, {"--csv", csv_path}, {"--report", report_path}});
   check_output_dir(inputs, {"--plot", plot_dir});
   if (!plot_dir.empty()) check_plot_target(plot_dir + "/x.png");
 
@@ -72,6 +75,7 @@ int verb_gap(const Args& args) {
                           gap_markdown(run.result, *run.model, rq.data, pngs, report_path));
   if (!json_path.empty())
     write_file_atomically(json_path, gap_json(run.result, *run.model, rq.data).dump(2) + "\n");
+  if (!csv_path.empty()) write_file_atomically(csv_path, gap_csv(run.result, rq.data));
   return 0;
 }
 

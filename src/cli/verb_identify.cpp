@@ -11,6 +11,7 @@
 #include "weilgen/base/atomic_file.hpp"
 #include "weilgen/report/identify_document.hpp"
 #include "weilgen/report/params_header.hpp"
+#include "weilgen/report/plot.hpp"
 #include "weilgen/report/prediction_document.hpp"
 
 namespace po = boost::program_options;
@@ -30,15 +31,16 @@ int verb_identify(const Args& args) {
       "parameter combinations the data cannot identify); Gauss-Newton for order >= 2. Predicts\n"
       "other measurements (points, ballbar circles) and writes the parameters as a standalone\n"
       "controller header. docs/identify.md.\n\nOptions");
-  std::string json_path, emit;
+  std::string json_path, csv_path, plot_path, emit;
   opts.add_options()("help,h", "show this help")(
       "data", po::value<std::vector<std::string>>(&rq.data)->composing(),
       "measurement CSV (poses + deviations); repeatable")(
       "pdge", po::value<std::vector<std::string>>(&rq.pdge)->composing(),
       "basis of every PDGE (poly:3, fourier:2, legendre:4, chebyshev:4, fourier:2:20 = period "
       "20 mm, or 20 deg on a rotary axis) or of one error (E_YY=fourier:3); repeatable, applied "
-      "in order")("fix", po::value<std::vector<std::string>>(&rq.fixed)->composing(),
-                  "hold an error at zero (name or alias); repeatable")(
+      "in order")(
+      "fix", po::value<std::vector<std::string>>(&rq.fixed)->composing(),
+      "hold an error at zero: a name, an alias or group:<group> (as --set); repeatable")(
       "rank-tol",
       ranged(&rq.rank_tolerance, NumberRange::open(0, 1))->default_value(rq.rank_tolerance, "1e-9"),
       "singular values below rank-tol x the largest (equilibrated columns) count as zero")(
@@ -48,6 +50,11 @@ int verb_identify(const Args& args) {
       "predict-out", po::value<std::string>(&rq.predict_out),
       "write the predictions of the last --predict file to FILE (CSV)")(
       "json", po::value<std::string>(&json_path), "write the results as JSON to FILE")(
+      "csv", po::value<std::string>(&csv_path),
+      "write the parameters (value, standard error, unit, identifiable) to FILE (CSV)")(
+      "plot", po::value<std::string>(&plot_path),
+      "draw the residuals per output before and after, and the parameters with their 95 %\n"
+      "intervals, to FILE (.png or .svg, gnuplot)")(
       "emit-params", po::value<std::string>(&emit),
       "write the identified parameters as a standalone C++ header to FILE")(
       "allow-unknown", "warn about unknown columns instead of failing")(
@@ -68,9 +75,12 @@ int verb_identify(const Args& args) {
   for (const std::string& d : rq.data) inputs.push_back({"--data", d});
   for (const std::string& p : rq.predict) inputs.push_back({"--predict", p});
   check_output_paths(inputs, {{"--json", json_path},
+                              {"--csv", csv_path},
+                              {"--plot", plot_path},
                               {"--emit-params", emit},
                               {"--predict-out", rq.predict_out},
                               {"--comp-table", comp.path}});
+  if (!plot_path.empty()) check_plot_target(plot_path);
   check_comp_table_flags(comp, vm, true);
   if (!comp.path.empty()) check_axis_comp_table(rq.description(), comp.options);
 
@@ -88,6 +98,11 @@ int verb_identify(const Args& args) {
     std::cout << "\nwrote " << emit << "\n";
   }
   if (!json_path.empty()) write_file_atomically(json_path, identify_json(run).dump(2) + "\n");
+  if (!csv_path.empty())
+    write_file_atomically(csv_path, identify_csv(*run.model, *run.param, run.result));
+  if (!plot_path.empty())
+    write_plot(plot_path, identify_panels(*run.param, run.result),
+               "weilgen identify: " + run.model->name());
   if (!comp.path.empty()) std::cout << "\n" << write_comp_table(comp, comp_table);
   return 0;
 }

@@ -37,6 +37,7 @@ int verb_reliability(const Args& args) {
   check_output_paths(study_inputs(f), study_outputs(f));
   if (!f.plot.empty()) check_plot_target(f.plot);  // before a long run, not after
   const Study st = open_study(f, true);
+  if (!f.plot.empty()) check_reliability_plot(st);
   Progress progress("reliability", st.tolerances.size() * st.poses.poses.size(), f.quiet);
   const auto cases = ReliabilitySweep(settings).run(
       st, st.inputs, [&](std::size_t done, std::size_t) { progress.update(done); });

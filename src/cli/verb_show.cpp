@@ -6,6 +6,7 @@
 #include "weilgen/codegen/emit_report.hpp"
 #include "weilgen/machine/algebra_size.hpp"
 #include "weilgen/machine/yaml_loader.hpp"
+#include "weilgen/report/json_common.hpp"
 
 namespace po = boost::program_options;
 
@@ -43,7 +44,7 @@ int verb_show(const Args& args) {
   const gen::SymbolicModel m = gen::build_model(d, order);
   const gen::Notation n = notation == "iso" ? gen::Notation::Iso : gen::Notation::Alias;
   if (format == "json") {
-    auto j = gen::closed_forms_json(m, n);
+    auto j = json_document("show", gen::closed_forms_json(m, n));
     if (only >= 0) {
       auto one = j["outputs"][output_name(static_cast<std::size_t>(only))];
       j["outputs"] = {{output_name(static_cast<std::size_t>(only)), one}};

@@ -5,12 +5,21 @@
 #include <iomanip>
 #include <sstream>
 
-#include "weilgen/base/version.hpp"
+#include "weilgen/base/format.hpp"
+#include "weilgen/report/csv_table.hpp"
 #include "weilgen/report/json_common.hpp"
 
 namespace weilgen {
 
 namespace {
+
+// One verdict, with the comparison it rests on (AllocationOptions::target_tolerance).
+std::string verdict(bool met, const AllocationOptions& o) {
+  return std::string(met ? "targets met" : "targets NOT met") +
+         " (min R >= " + format_short(100 * o.min_target) +
+         " %, mean R >= " + format_short(100 * o.mean_target) + " %, within " +
+         format_short(o.target_tolerance) + ")";
+}
 
 // A spread in the error's declared unit, 4 significant digits.
 std::string sigma_text(const ErrorDef& e, double sigma_base) {
@@ -50,12 +59,11 @@ std::string allocation_text(const Study& st, const AllocationStudyOptions& o,
       line << std::setw(11) << 100 * s.group_mean[g] << std::setw(10) << 100 * s.group_min[g];
     os << line.str() << "\n";
   }
-  os << (res.met ? "targets met" : "targets NOT met") << " after "
+  os << verdict(res.met, out.options) << " after "
      << (res.steps.empty() ? 0 : res.steps.back().step) << " steps\n";
   if (!res.note.empty()) os << "note: " << res.note << "\n";
   if (!o.cost_aware) return os.str();
-  os << "\ncost-aware (min sum w/sigma): "
-     << (res.cost_aware_met ? "targets met" : "targets NOT met") << ", cost "
+  os << "\ncost-aware (min sum w/sigma): " << verdict(res.cost_aware_met, out.options) << ", cost "
      << std::setprecision(6) << res.cost_aware << " vs step procedure " << res.cost_step << " ("
      << std::setprecision(3) << std::fixed << 100 * (1 - res.cost_aware / res.cost_step)
      << " % cheaper)\n";
@@ -123,21 +131,21 @@ nlohmann::json allocation_json(const Study& st, const AllocationStudyOptions& o,
   }
   nlohmann::json chosen = nlohmann::json::array();
   for (std::size_t i : res.chosen) chosen.push_back(d.errors[i].name);
-  nlohmann::json j = {{"weilgen", kVersion},
-                      {"verb", "allocate"},
-                      {"model", model_json(*st.model)},
-                      {"settings",
-                       {{"min", o.min_target},
-                        {"mean", o.mean_target},
-                        {"limit", text.limit},
-                        {"method", text.method},
-                        {"seed", text.seed}}},
-                      {"inputs", inputs_json(*st.model, st.inputs)},
-                      {"stddev_unit", "base units: mm for translations, rad for rotations"},
-                      {"chosen", chosen},
-                      {"steps", steps},
-                      {"met", res.met},
-                      {"note", res.note}};
+  nlohmann::json j = json_document(
+      "allocate", {{"model", model_json(*st.model)},
+                   {"settings",
+                    {{"min", o.min_target},
+                     {"mean", o.mean_target},
+                     {"target_tolerance", out.options.target_tolerance},
+                     {"limit", text.limit},
+                     {"method", text.method},
+                     {"seed", text.seed}}},
+                   {"inputs", inputs_json(*st.model, st.inputs)},
+                   {"stddev_unit", "base units: mm for translations, rad for rotations"},
+                   {"chosen", chosen},
+                   {"steps", steps},
+                   {"met", res.met},
+                   {"note", res.note}});
   if (o.cost_aware) {
     nlohmann::json sig = nlohmann::json::object();
     for (std::size_t i = 0; i < ne; ++i) sig[d.errors[i].name] = res.cost_aware_stddev[i];
@@ -151,19 +159,77 @@ nlohmann::json allocation_json(const Study& st, const AllocationStudyOptions& o,
 
 std::string allocation_csv(const Study& st, const AllocationStudyResult& out) {
   const Description& d = st.model->description();
-  std::ostringstream c;
-  c << "step";
-  for (const auto& e : d.errors) c << ",sigma_" << e.name;
-  for (const auto& g : out.groups) c << ",mean_" << g << ",min_" << g;
-  c << "\n";
-  for (const auto& s : out.result.steps) {
-    c << s.step;
-    for (std::size_t i = 0; i < d.errors.size(); ++i) c << "," << csv_number(s.stddev[i]);
-    for (std::size_t g = 0; g < out.groups.size(); ++g)
-      c << "," << csv_number(s.group_mean[g]) << "," << csv_number(s.group_min[g]);
-    c << "\n";
+  CsvTable t;
+  t.column("step");
+  // Spreads in each error's declared unit, as in the machine and tolerance files.
+  for (const auto& e : d.errors) t.column("sigma_" + e.name, e.unit);
+  for (const auto& g : out.groups) {
+    t.column("mean_R_" + g);
+    t.column("min_R_" + g);
   }
-  return c.str();
+  for (const auto& s : out.result.steps) {
+    t.count(static_cast<std::size_t>(s.step));
+    for (std::size_t i = 0; i < d.errors.size(); ++i) t.number(s.stddev[i] / d.errors[i].to_base);
+    for (std::size_t g = 0; g < out.groups.size(); ++g)
+      t.number(s.group_mean[g]).number(s.group_min[g]);
+    t.end_row();
+  }
+  return t.str();
+}
+
+std::vector<Panel> allocation_panels(const Study& st, const AllocationStudyOptions& o,
+                                     const AllocationStudyResult& out) {
+  const Description& d = st.model->description();
+  const AllocationResult& res = out.result;
+  std::vector<double> steps;
+  for (const auto& s : res.steps) steps.push_back(static_cast<double>(s.step));
+  std::vector<Panel> panels;
+  for (std::size_t g = 0; g < out.groups.size(); ++g) {
+    LinePlot l;
+    l.title = "R(" + out.groups[g] + ") over the steps";
+    l.xlabel = "step";
+    l.ylabel = "R (%)";
+    l.x = steps;
+    std::vector<double> mean, min;
+    for (const auto& s : res.steps) {
+      mean.push_back(100 * s.group_mean[g]);
+      min.push_back(100 * s.group_min[g]);
+    }
+    l.lines.push_back({"mean R", mean});
+    l.lines.push_back({"min R", min});
+    l.lines.push_back({"mean target", std::vector<double>(steps.size(), 100 * o.mean_target)});
+    l.lines.push_back({"min target", std::vector<double>(steps.size(), 100 * o.min_target)});
+    panels.push_back(l);
+  }
+  if (!res.chosen.empty() && !res.steps.empty()) {
+    LinePlot l;
+    l.title = "spreads of the chosen errors";
+    l.xlabel = "step";
+    l.ylabel = "sigma (% of its start)";
+    l.x = steps;
+    for (std::size_t i : res.chosen) {
+      std::vector<double> y;
+      for (const auto& s : res.steps) y.push_back(100 * s.stddev[i] / res.steps.front().stddev[i]);
+      l.lines.push_back({d.errors[i].name, y});
+    }
+    panels.push_back(l);
+  }
+  if (o.cost_aware && !res.steps.empty() && res.cost_aware_stddev.size() == d.errors.size()) {
+    BarChart b;
+    b.title = "cost-aware optimum against the step procedure";
+    b.ylabel = "sigma (% of its start)";
+    BarSeries after{"after the steps", {}, {}, {}}, optimum{"cost-aware", {}, {}, {}};
+    for (std::size_t i = 0; i < d.errors.size(); ++i) {
+      const double s0 = res.steps.front().stddev[i];
+      if (!(s0 > 0)) continue;  // a constant error has no spread to allocate
+      b.categories.push_back(d.errors[i].name);
+      after.value.push_back(100 * res.steps.back().stddev[i] / s0);
+      optimum.value.push_back(100 * res.cost_aware_stddev[i] / s0);
+    }
+    b.series = {after, optimum};
+    if (!b.categories.empty()) panels.push_back(b);
+  }
+  return panels;
 }
 
 std::string allocation_tolerance_comment(const Study& st, const AllocationStudyResult& out) {

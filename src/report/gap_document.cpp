@@ -8,7 +8,7 @@
 #include <sstream>
 
 #include "weilgen/base/format.hpp"
-#include "weilgen/base/version.hpp"
+#include "weilgen/report/csv_table.hpp"
 #include "weilgen/report/json_common.hpp"
 
 namespace weilgen {
@@ -70,6 +70,33 @@ json effect_json(const EffectFit& e, const std::array<std::size_t, kObservationK
 
 }  // namespace
 
+std::string gap_csv(const GapResult& r, const std::string& data) {
+  CsvTable t;
+  t.comment("weilgen gap " + data + ": candidate effects in ranking order (held-out " + r.holdout +
+            ")");
+  t.column("rank");
+  t.column("effect");
+  t.column("variant");
+  t.column("extra_parameters");
+  t.column("heldout_rms_before", "um");
+  t.column("heldout_rms_after", "um");
+  t.column("shrink", "%");
+  for (const char* c :
+       {"explained_fraction", "f_statistic", "p_value", "significant", "in_explanation", "summary"})
+    t.column(c);
+  for (std::size_t k = 0; k < r.effects.size(); ++k) {
+    const EffectFit& e = r.effects[k];
+    bool explains = false;
+    for (const EffectFit& x : r.explanation) explains = explains || x.name == e.name;
+    t.count(k + 1).text(e.name).text(e.variant).count(e.extra_parameters);
+    t.number(e.heldout_rms_before_um).number(e.heldout_rms_after_um).number(e.shrink_pct);
+    t.number(e.explained_fraction).number(e.f_statistic).number(e.p_value);
+    t.text(e.significant ? "yes" : "no").text(explains ? "yes" : "no").text(e.summary);
+    t.end_row();
+  }
+  return t.str();
+}
+
 nlohmann::json gap_json(const GapResult& r, const Model& model, const std::string& data) {
   json where = json::array(), effects = json::array(), expl = json::array(), names = json::array();
   for (const GapRegion& g : r.where) where.push_back(region_json(g));
@@ -84,37 +111,36 @@ nlohmann::json gap_json(const GapResult& r, const Model& model, const std::strin
                         {"value_um", g.value_um},
                         {"residual_um", g.residual_um},
                         {"robust_sigmas", g.sigmas}});
-  return {{"weilgen", kVersion},
-          {"verb", "gap"},
-          {"model", model_json(model)},
-          {"outliers", outliers},
-          {"data", data},
-          {"baseline",
-           {{"holdout", r.holdout},
-            {"holdout_reason", r.holdout_reason},
-            {"observations", r.observations},
-            {"parameters", r.parameters},
-            {"rank", r.rank},
-            {"heldout_rms_um", per_output_json(r.baseline_rms, r.count)},
-            {"heldout_max_um", per_output_json(r.baseline_max, r.count)},
-            {"heldout_rms_all_um", json_number(r.baseline_rms_um)},
-            {"excess_um", json_number(r.baseline_excess_um)},
-            {"p_value", json_number(r.baseline_p_value)}}},
-          {"noise_floor_um", json_number(r.noise.sigma_um)},
-          {"noise_floor_source", r.noise.source},
-          {"noise_floor_detail", r.noise.detail},
-          {"noise_floor_per_output_um", per_output_json(r.noise.per_output, r.count)},
-          {"where", where},
-          {"effects", effects},
-          {"verdict",
-           {{"effect", r.verdict},
-            {"reason", r.verdict_reason},
-            {"explanation", names},
-            {"steps", expl},
-            {"heldout_rms_after_um", per_output_json(r.final_rms, r.count)},
-            {"heldout_rms_after_all_um", json_number(r.final_rms_um)},
-            {"remaining_excess_um", json_number(r.final_excess_um)},
-            {"remaining_p_value", json_number(r.final_p_value)}}}};
+  return json_document("gap",
+                       {{"model", model_json(model)},
+                        {"outliers", outliers},
+                        {"data", data},
+                        {"baseline",
+                         {{"holdout", r.holdout},
+                          {"holdout_reason", r.holdout_reason},
+                          {"observations", r.observations},
+                          {"parameters", r.parameters},
+                          {"rank", r.rank},
+                          {"heldout_rms_um", per_output_json(r.baseline_rms, r.count)},
+                          {"heldout_max_um", per_output_json(r.baseline_max, r.count)},
+                          {"heldout_rms_all_um", json_number(r.baseline_rms_um)},
+                          {"excess_um", json_number(r.baseline_excess_um)},
+                          {"p_value", json_number(r.baseline_p_value)}}},
+                        {"noise_floor_um", json_number(r.noise.sigma_um)},
+                        {"noise_floor_source", r.noise.source},
+                        {"noise_floor_detail", r.noise.detail},
+                        {"noise_floor_per_output_um", per_output_json(r.noise.per_output, r.count)},
+                        {"where", where},
+                        {"effects", effects},
+                        {"verdict",
+                         {{"effect", r.verdict},
+                          {"reason", r.verdict_reason},
+                          {"explanation", names},
+                          {"steps", expl},
+                          {"heldout_rms_after_um", per_output_json(r.final_rms, r.count)},
+                          {"heldout_rms_after_all_um", json_number(r.final_rms_um)},
+                          {"remaining_excess_um", json_number(r.final_excess_um)},
+                          {"remaining_p_value", json_number(r.final_p_value)}}}});
 }
 
 namespace {

@@ -1,11 +1,12 @@
 #include "weilgen/report/identify_document.hpp"
 
+#include <cmath>
 #include <iomanip>
 #include <map>
 #include <sstream>
 
 #include "weilgen/base/format.hpp"
-#include "weilgen/base/version.hpp"
+#include "weilgen/report/csv_table.hpp"
 #include "weilgen/report/json_common.hpp"
 #include "weilgen/report/prediction_document.hpp"
 
@@ -61,20 +62,19 @@ json identify_json(const Model& model, const ErrorParameterisation& param, const
         {"rms_after" + u, json_number(r.rms_after[static_cast<std::size_t>(o)])},
         {"max_after" + u, json_number(r.max_after[static_cast<std::size_t>(o)])}};
   }
-  return {{"weilgen", kVersion},
-          {"model", model_json(model)},
-          {"data", files},
-          {"observations", r.observations},
-          {"parameters", params},
-          {"bases", bases},
-          {"free_parameters", r.free_parameters},
-          {"rank", r.rank},
-          {"condition", json_number(r.condition)},
-          {"singular_values", r.singular_values},
-          {"unidentifiable", null},
-          {"residual_sigma", json_number(r.residual_sigma)},
-          {"gauss_newton_iterations", r.gauss_newton_iterations},
-          {"outputs", outputs}};
+  return json_document("identify", {{"model", model_json(model)},
+                                    {"data", files},
+                                    {"observations", r.observations},
+                                    {"parameters", params},
+                                    {"bases", bases},
+                                    {"free_parameters", r.free_parameters},
+                                    {"rank", r.rank},
+                                    {"condition", json_number(r.condition)},
+                                    {"singular_values", r.singular_values},
+                                    {"unidentifiable", null},
+                                    {"residual_sigma", json_number(r.residual_sigma)},
+                                    {"gauss_newton_iterations", r.gauss_newton_iterations},
+                                    {"outputs", outputs}});
 }
 
 std::string identify_text(const Model& model, const ErrorParameterisation& param,
@@ -145,6 +145,64 @@ std::string identify_text(const IdentifyRun& run) {
   for (const FilePrediction& p : run.predictions)
     text += "\n" + (p.ballbar ? ballbar_prediction_text(*p.ballbar) : prediction_text(*p.points));
   return text;
+}
+
+std::string identify_csv(const Model& model, const ErrorParameterisation& param,
+                         const IdentifyResult& r) {
+  const Description& d = model.description();
+  CsvTable t;
+  t.comment("weilgen identify " + d.name + ": rank " + std::to_string(r.rank) + " of " +
+            std::to_string(r.free_parameters) + " free parameters, " +
+            std::to_string(r.observations) + " observations");
+  for (const char* c : {"parameter", "error", "basis", "term", "value", "standard_error", "unit",
+                        "identifiable", "fixed"})
+    t.column(c);
+  for (std::size_t p = 0; p < param.size(); ++p) {
+    const IdentParameter& ip = param.parameters()[p];
+    const auto& basis = param.basis_of(static_cast<std::size_t>(ip.error));
+    t.text(ip.label).text(d.errors[static_cast<std::size_t>(ip.error)].name);
+    t.text(basis ? basis->name() : "constant").count(ip.term);
+    t.number(r.theta[p]).number(r.standard_error[p]).text(ip.unit);
+    t.text(r.identifiable[p] ? "yes" : "no").text(r.fixed[p] ? "yes" : "no").end_row();
+  }
+  return t.str();
+}
+
+std::vector<Panel> identify_panels(const ErrorParameterisation& param, const IdentifyResult& r) {
+  std::vector<Panel> panels;
+  BarChart res;
+  res.title = "RMS residual per output";
+  res.ylabel = "RMS (um for dx dy dz, urad for da db dc)";
+  BarSeries before{"before (model without errors)", {}, {}, {}}, after{"after", {}, {}, {}};
+  for (std::size_t o = 0; o < 6; ++o) {
+    if (!r.count[o]) continue;
+    res.categories.push_back(std::string(output_name(o)) + (o < 3 ? " (um)" : " (urad)"));
+    before.value.push_back(r.rms_before[o]);
+    after.value.push_back(r.rms_after[o]);
+  }
+  res.series = {before, after};
+  if (!res.categories.empty()) panels.push_back(res);
+  // Parameters, one chart per unit (values in different units share no axis); fixed ones left
+  // out; an interval only where the data identify the parameter.
+  std::map<std::string, BarChart> by_unit;
+  for (std::size_t p = 0; p < param.size(); ++p) {
+    if (r.fixed[p]) continue;
+    const IdentParameter& ip = param.parameters()[p];
+    BarChart& b = by_unit[ip.unit];
+    if (b.series.empty()) {
+      b.title = "identified parameters (" + ip.unit + "), 95 % intervals";
+      b.ylabel = "value (" + ip.unit + ")";
+      b.series.push_back({"value", {}, {}, {}});
+    }
+    const double v = r.theta[p], se = r.standard_error[p];
+    const double h = std::isfinite(se) ? 1.96 * se : 0.0;
+    b.categories.push_back(ip.label + (r.identifiable[p] ? "" : " (not identifiable)"));
+    b.series[0].value.push_back(v);
+    b.series[0].lo.push_back(v - h);
+    b.series[0].hi.push_back(v + h);
+  }
+  for (auto& [unit, b] : by_unit) panels.push_back(b);
+  return panels;
 }
 
 }  // namespace weilgen

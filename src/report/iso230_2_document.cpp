@@ -3,6 +3,7 @@
 #include <cmath>
 #include <iomanip>
 #include <sstream>
+#include <utility>
 
 #include "weilgen/base/format.hpp"
 #include "weilgen/base/text.hpp"
@@ -347,11 +348,15 @@ nlohmann::json iso230_2_json(const std::string& data, const Iso230_2StudyResult&
   // ---- JSON ----
   json j;
   {
-    j = {
-        {"weilgen", kVersion}, {"command", "iso230-2"},         {"file", data},
-        {"axis", cols.axis},   {"column", cols.deviation},      {"deviation_unit", u},
-        {"targets", m},        {"cycles_up", runs.cycles[kUp]}, {"cycles_down", runs.cycles[kDown]},
-        {"positions_mm", P},   {"coverage_factor", F.k_up}};
+    j = {{"file", data},
+         {"axis", cols.axis},
+         {"column", cols.deviation},
+         {"deviation_unit", u},
+         {"targets", m},
+         {"cycles_up", runs.cycles[kUp]},
+         {"cycles_down", runs.cycles[kDown]},
+         {"positions_mm", P},
+         {"coverage_factor", F.k_up}};
     j["source_format"] = source_format;
     j["metadata"] = res.header_keys;
     const NormalisationResult& n = res.normalisation;
@@ -442,7 +447,7 @@ nlohmann::json iso230_2_json(const std::string& data, const Iso230_2StudyResult&
     }
   }
 
-  return j;
+  return json_document("iso230-2", std::move(j));
 }
 
 std::string iso230_2_csv(const Iso230_2StudyResult& res) {

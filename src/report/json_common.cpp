@@ -3,9 +3,16 @@
 #include <cmath>
 
 #include "weilgen/base/format.hpp"
+#include "weilgen/base/version.hpp"
 #include "weilgen/machine/model_key.hpp"
 
 namespace weilgen {
+
+nlohmann::json json_document(const std::string& verb, nlohmann::json body) {
+  body["weilgen"] = kVersion;
+  body["verb"] = verb;
+  return body;
+}
 
 nlohmann::json json_number(double v) {
   return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json();

@@ -117,7 +117,7 @@ std::string params_header(const Model& model, const ErrorParameterisation& param
   for (std::size_t k = 0; k < d.errors.size(); ++k) {
     const ErrorDef& e = d.errors[k];
     const auto& basis = param.basis_of(k);
-    const std::string unit = e.effect == ErrorEffect::Rotation ? "rad" : "mm";
+    const std::string unit = e.base_unit();
     if (!basis) {
       h << "inline constexpr double k" << e.name << " = " << num(theta[first[k]] * e.to_base)
         << ";  // " << unit << "\n";

@@ -7,7 +7,7 @@
 #include <sstream>
 
 #include "weilgen/base/format.hpp"
-#include "weilgen/base/version.hpp"
+#include "weilgen/report/csv_table.hpp"
 #include "weilgen/report/json_common.hpp"
 
 namespace weilgen {
@@ -245,26 +245,80 @@ nlohmann::json pdge_fit_json(const PdgeFitStudyOptions& o, const PdgeFitStudyRes
     }
     std::vector<std::string> spec_names;
     for (const BasisSpec& s : r.specs) spec_names.push_back(s.str());
-    json j = {{"weilgen", kVersion},
-              {"verb", "fit-pdge"},
-              {"file", r.file},
-              {"format", r.format},
-              {"axis", pos_name},
-              {"travel_mm", {a, b}},
-              {"settings",
-               {{"bases", spec_names},
-                {"cv", cv_scheme_name(r.fit_options.cv.scheme)},
-                {"folds", r.fit_options.cv.scheme == CvScheme::Blocks ? json(o.folds) : json()},
-                {"keep_ends", r.fit_options.cv.keep_ends},
-                {"rule", o.rule},
-                {"min_order", o.min_order},
-                {"max_order", o.max_order},
-                {"period", o.period}}},
-              {"line6d", line6d},
-              {"profiles", cols}};
+    json j = json_document(
+        "fit-pdge",
+        {{"file", r.file},
+         {"format", r.format},
+         {"axis", pos_name},
+         {"travel_mm", {a, b}},
+         {"settings",
+          {{"bases", spec_names},
+           {"cv", cv_scheme_name(r.fit_options.cv.scheme)},
+           {"folds", r.fit_options.cv.scheme == CvScheme::Blocks ? json(o.folds) : json()},
+           {"keep_ends", r.fit_options.cv.keep_ends},
+           {"rule", o.rule},
+           {"min_order", o.min_order},
+           {"max_order", o.max_order},
+           {"period", o.period}}},
+         {"line6d", line6d},
+         {"profiles", cols}});
     return j;
   }
 }
+
+std::string pdge_fit_csv(const PdgeFitStudyResult& r) {
+  CsvTable t;
+  t.comment("weilgen fit-pdge " + r.file + " (axis " + r.axis + ")");
+  for (const char* c : {"profile", "column", "unit", "basis", "kind", "order", "order_choice"})
+    t.column(c);
+  t.column("period", "mm");
+  for (const char* c : {"params", "n", "e_max", "R2", "SSE", "RMSE", "CV_RMSE", "error"})
+    t.column(c);
+  for (std::size_t i = 0; i < r.profiles.size(); ++i) {
+    const PdgeProfile& p = r.profiles[i];
+    for (std::size_t k = 0; k < r.results[i].size(); ++k) {
+      const PdgeFitResult& fr = r.results[i][k];
+      t.text(p.name).text(p.column).text(p.unit);
+      if (!r.failures[i][k].empty()) {
+        t.text(fr.spec.str());
+        for (int c = 0; c < 11; ++c) t.text("");
+        t.text(r.failures[i][k]).end_row();
+        continue;
+      }
+      const FitResult& f = fr.fit;
+      t.text(f.basis.name()).text(basis_kind_name(f.basis.kind));
+      t.count(static_cast<std::size_t>(f.basis.order));
+      t.text(fr.order_choice).number(f.basis.kind == BasisKind::Fourier ? f.basis.period() : NAN);
+      t.count(f.params()).count(f.metrics.n).number(f.metrics.e_max);
+      t.number(f.metrics.r2).number(f.metrics.sse).number(f.metrics.rmse).number(fr.cv.rmse);
+      t.text("").end_row();
+    }
+  }
+  return t.str();
+}
+
+namespace {
+
+// Adds the curve `y` to `plot`, or, when a curve already drawn equals it to 1e-9 of its range,
+// appends `label` to that curve's label and returns true.
+bool add_or_merge(LinePlot& plot, const std::string& label, const std::vector<double>& y) {
+  for (std::size_t k = 1; k < plot.lines.size(); ++k) {  // line 0 is the data
+    const std::vector<double>& other = plot.lines[k].second;
+    double range = 0, diff = 0;
+    for (std::size_t i = 0; i < y.size(); ++i) {
+      range = std::max(range, std::abs(other[i]));
+      diff = std::max(diff, std::abs(other[i] - y[i]));
+    }
+    if (diff <= 1e-9 * range) {
+      plot.lines[k].first += " = " + label;
+      return true;
+    }
+  }
+  plot.lines.emplace_back(label, y);
+  return false;
+}
+
+}  // namespace
 
 std::vector<Panel> pdge_fit_panels(const PdgeFitStudyResult& r) {
   const auto& profiles = r.profiles;
@@ -296,6 +350,7 @@ std::vector<Panel> pdge_fit_panels(const PdgeFitStudyResult& r) {
           data[k] = means[static_cast<std::size_t>(it - xs.begin())];
       }
       fitp.lines.emplace_back(p.cycle.empty() ? "data" : "data (mean per position)", data);
+      std::vector<LineStyle> styles{LineStyle::Points};
       LinePlot resp;
       resp.title = p.name + ": residuals";
       resp.xlabel = fitp.xlabel;
@@ -306,12 +361,17 @@ std::vector<Panel> pdge_fit_panels(const PdgeFitStudyResult& r) {
         const PdgeFitResult& fr = results[i][k];
         std::vector<double> yfit;
         for (double x : dense) yfit.push_back(fr.fit.predict(x));
-        fitp.lines.emplace_back(fr.fit.basis.name(), yfit);
+        // Polynomial, Legendre and Chebyshev bases of one order span one space and give one
+        // curve: draw it once, named by every basis that gives it.
+        if (add_or_merge(fitp, fr.fit.basis.name(), yfit)) continue;
+        styles.push_back(LineStyle::Lines);
         std::vector<double> fx, res;
         position_means(p.x, fr.fit.residuals, fx, res);
         resp.lines.emplace_back(fr.fit.basis.name(), res);
       }
-      panels.push_back(fitp);
+      for (std::size_t k = 0; k < resp.lines.size(); ++k)
+        resp.lines[k].first = fitp.lines[k + 1].first;
+      panels.push_back(StyledLinePlot{fitp, styles});
       panels.push_back(resp);
     }
   }

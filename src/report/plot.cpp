@@ -133,6 +133,13 @@ void check(const LinePlot& l) {
   }
 }
 
+void check(const StyledLinePlot& l) {
+  check(l.plot);
+  if (l.styles.size() != l.plot.lines.size())
+    bad(l.plot.title, std::to_string(l.styles.size()) + " line styles for " +
+                          std::to_string(l.plot.lines.size()) + " lines");
+}
+
 // Categories whose labels need vertical tics.
 bool rotated(const BarChart& c) {
   std::size_t longest = 0;
@@ -316,7 +323,19 @@ void heat_script(std::ostringstream& s, const fs::path& dir, int index, const He
   s << "\n";
 }
 
-void line_script(std::ostringstream& s, const fs::path& dir, int index, const LinePlot& l) {
+const char* style_text(LineStyle style) {
+  switch (style) {
+    case LineStyle::Lines:
+      return "lines lw 1.5";
+    case LineStyle::Points:
+      return "points pt 7 ps 0.9";
+    default:
+      return "linespoints pt 7 ps 0.6";
+  }
+}
+
+void line_script(std::ostringstream& s, const fs::path& dir, int index, const LinePlot& l,
+                 const std::vector<LineStyle>& styles = {}) {
   const fs::path data = dir / ("panel" + std::to_string(index) + ".tsv");
   std::ostringstream d;
   bool all_nan = true;
@@ -338,9 +357,9 @@ void line_script(std::ostringstream& s, const fs::path& dir, int index, const Li
   if (all_nan) s << "set yrange [0:1]\n";
   s << "plot ";
   for (std::size_t k = 0; k < l.lines.size(); ++k) {
-    s << (k == 0 ? gq(data.string()) : std::string("''")) << " using 1:" << k + 2
-      << " with linespoints pt 7 ps 0.6 title " << gq(l.lines[k].first)
-      << (k + 1 < l.lines.size() ? ", \\\n     " : "\n");
+    s << (k == 0 ? gq(data.string()) : std::string("''")) << " using 1:" << k + 2 << " with "
+      << style_text(styles.empty() ? LineStyle::LinesPoints : styles[k]) << " title "
+      << gq(l.lines[k].first) << (k + 1 < l.lines.size() ? ", \\\n     " : "\n");
   }
 }
 
@@ -419,6 +438,37 @@ std::string first_lines(const std::string& text, std::size_t max_lines) {
 
 }  // namespace
 
+void pareto(BarChart& b, std::size_t key) {
+  check(b);
+  if (key >= b.series.size()) bad(b.title, "pareto: no series " + std::to_string(key));
+  std::vector<std::size_t> order;
+  for (std::size_t c = 0; c < b.categories.size(); ++c) {
+    bool zero = true;
+    for (const BarSeries& s : b.series) zero = zero && !(std::abs(s.value[c]) > 0);
+    if (!zero) order.push_back(c);
+  }
+  if (order.empty()) return;  // nothing has an effect: an all-zero chart says so
+  const std::vector<double>& v = b.series[key].value;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) {
+    const bool fx = std::isfinite(v[x]), fy = std::isfinite(v[y]);
+    return fx != fy ? fx : (fx && v[x] > v[y]);
+  });
+  const auto pick = [&](std::vector<double>& values) {
+    if (values.empty()) return;
+    std::vector<double> out;
+    for (std::size_t c : order) out.push_back(values[c]);
+    values = out;
+  };
+  std::vector<std::string> categories;
+  for (std::size_t c : order) categories.push_back(b.categories[c]);
+  b.categories = categories;
+  for (BarSeries& s : b.series) {
+    pick(s.value);
+    pick(s.lo);
+    pick(s.hi);
+  }
+}
+
 std::string plot_format(const std::string& path) { return format_of_path(path); }
 
 bool gnuplot_available() { return find_on_path("gnuplot"); }
@@ -470,6 +520,7 @@ std::string plot_script(const std::string& data_dir, const std::string& output,
     if (const auto* c = std::get_if<BarChart>(&p)) bar_script(s, dir, i, *c);
     if (const auto* h = std::get_if<HeatMap>(&p)) heat_script(s, dir, i, *h);
     if (const auto* l = std::get_if<LinePlot>(&p)) line_script(s, dir, i, *l);
+    if (const auto* l = std::get_if<StyledLinePlot>(&p)) line_script(s, dir, i, l->plot, l->styles);
   }
   s << "unset multiplot\n";
   s << "unset output\n";

@@ -6,7 +6,7 @@
 #include <sstream>
 
 #include "weilgen/base/format.hpp"
-#include "weilgen/base/version.hpp"
+#include "weilgen/report/csv_table.hpp"
 #include "weilgen/report/json_common.hpp"
 
 namespace weilgen {
@@ -117,70 +117,128 @@ nlohmann::json reliability_json(const Study& st, const ReliabilitySettings& sett
                        {"argmin", pose_json(st.poses, sums[k].argmin)},
                        {"sensitivity", ranking}});
   }
-  return {{"weilgen", kVersion},
-          {"verb", "reliability"},
-          {"model", model_json(model)},
-          {"settings",
-           {{"method", text.method},
-            {"limit", text.limit},
-            {"samples", text.samples},
-            {"seed", text.seed},
-            {"confidence", text.confidence}}},
-          {"inputs", inputs_json(model, st.inputs)},
-          {"results", results},
-          {"summary", summary}};
+  // R is a probability: dR/dmu_i and dR/dsigma_i are per base unit of error i (mm or rad).
+  nlohmann::json units = nlohmann::json::object();
+  for (const auto& e : errors) units[e.name] = std::string("1/") + e.base_unit();
+  return json_document("reliability", {{"model", model_json(model)},
+                                       {"derivative_units", units},
+                                       {"settings",
+                                        {{"method", text.method},
+                                         {"limit", text.limit},
+                                         {"samples", text.samples},
+                                         {"seed", text.seed},
+                                         {"confidence", text.confidence}}},
+                                       {"inputs", inputs_json(model, st.inputs)},
+                                       {"results", results},
+                                       {"summary", summary}});
 }
 
 std::string reliability_csv(const Study& st, const ReliabilitySettings& settings,
                             const std::vector<SweepCase>& cases) {
   const auto& errors = st.model->description().errors;
-  std::ostringstream c;
-  for (const auto& a : st.poses.axes) c << csv_field(a) << ",";
-  c << "output,limit,tolerance,tolerance_unit,method,reliability,ci_lo,ci_hi,cov,evaluations";
-  for (const auto& e : errors) c << ",dR_dmu_" << e.name;
-  for (const auto& e : errors) c << ",dR_dsigma_" << e.name;
-  c << "\n";
+  CsvTable t;
+  t.pose_columns(st.poses);
+  for (const char* c : {"output", "limit", "tolerance", "tolerance_unit", "method", "reliability",
+                        "ci_lo", "ci_hi", "cov", "evaluations"})
+    t.column(c);
+  // R is a probability (unit 1): dR/dmu_i and dR/dsigma_i are per base unit of error i.
+  for (const auto& e : errors) t.column("dR_dmu_" + e.name, std::string("1/") + e.base_unit());
+  for (const auto& e : errors) t.column("dR_dsigma_" + e.name, std::string("1/") + e.base_unit());
   for (const auto& x : cases) {
     const auto& r = x.result;
     const OutputId out = st.tolerances[x.tolerance].output;
-    for (double v : st.poses.poses[x.pose]) c << csv_number(v) << ",";
-    c << output_name(out) << "," << limit_name(settings.limit, out) << ","
-      << csv_number(st.tolerances[x.tolerance].value) << "," << output_unit(out) << ","
-      << to_string(r.method) << "," << csv_number(r.reliability) << "," << csv_number(r.ci_lo)
-      << "," << csv_number(r.ci_hi) << "," << csv_number(r.cov) << "," << r.evaluations;
+    t.pose(st.poses.poses[x.pose]).text(output_name(out)).text(limit_name(settings.limit, out));
+    t.number(st.tolerances[x.tolerance].value).text(output_unit(out)).text(to_string(r.method));
+    t.number(r.reliability).number(r.ci_lo).number(r.ci_hi).number(r.cov).count(r.evaluations);
     for (std::size_t i = 0; i < errors.size(); ++i)
-      c << "," << csv_number(i < r.dR_dmu.size() ? r.dR_dmu[i] : NAN);
+      t.number(i < r.dR_dmu.size() ? r.dR_dmu[i] : NAN);
     for (std::size_t i = 0; i < errors.size(); ++i)
-      c << "," << csv_number(i < r.dR_dsigma.size() ? r.dR_dsigma[i] : NAN);
-    c << "\n";
+      t.number(i < r.dR_dsigma.size() ? r.dR_dsigma[i] : NAN);
+    t.end_row();
   }
-  return c.str();
+  return t.str();
+}
+
+namespace {
+
+// Slices of a grid with more than two varying axes: one per value combination of the axes
+// before the last two.
+std::size_t grid_slices(const PoseSet& g) {
+  std::size_t n = 1;
+  for (std::size_t a = 0; a + 2 < g.grid_values.size(); ++a) n *= g.grid_values[a].size();
+  return n;
+}
+
+std::string axis_label(const PoseSet& g, std::size_t k) {
+  return g.axes[g.grid_axes[k]] + " (" + g.units[g.grid_axes[k]] + ")";
+}
+
+}  // namespace
+
+void check_reliability_plot(const Study& st) {
+  const PoseSet& g = st.poses;
+  if (g.grid_axes.size() <= 2 || g.grid_size() != g.poses.size()) return;
+  const std::size_t panels = grid_slices(g) * st.tolerances.size();
+  if (panels > kMaxReliabilityPanels)
+    throw std::invalid_argument(
+        "--plot: a grid of " + std::to_string(g.grid_axes.size()) + " varying axes gives " +
+        std::to_string(panels) +
+        " heat maps (one per value of the axes before the last two, per "
+        "toleranced output), more than " +
+        std::to_string(kMaxReliabilityPanels) +
+        " in one figure: plot fewer values of the first axes, or read the table (--csv)");
 }
 
 std::vector<Panel> reliability_panels(const Study& st, const std::vector<SweepCase>& cases) {
   std::vector<Panel> panels;
   const auto& g = st.poses;
   const std::size_t np = g.poses.size();
+  const std::size_t na = g.grid_axes.size();
+  const bool whole_grid = g.grid_size() == np;
   for (std::size_t k = 0; k < st.tolerances.size(); ++k) {
     std::vector<double> r;
     for (const auto& c : cases)
       if (c.tolerance == k) r.push_back(100 * c.result.reliability);
     const std::string title = std::string("R(") + output_name(st.tolerances[k].output) +
                               ") %, t = " + st.tolerances[k].text;
-    if (g.grid_axes.size() == 2 && g.grid_size() == np) {
-      HeatMap h;
-      h.title = title;
-      h.ylabel = g.axes[g.grid_axes[0]] + " (" + g.units[g.grid_axes[0]] + ")";
-      h.xlabel = g.axes[g.grid_axes[1]] + " (" + g.units[g.grid_axes[1]] + ")";
-      h.zlabel = "R (%)";
-      h.y = g.grid_values[0];
-      h.x = g.grid_values[1];
-      h.z = r;  // row-major over (first axis, second axis) = z[iy * nx + ix]
-      panels.push_back(h);
-    } else if (g.grid_axes.size() == 1 && g.grid_size() == np) {
+    if (na >= 2 && whole_grid) {
+      // Small multiples over the last two axes (one panel for a two-axis grid); one colour
+      // scale for all of them.
+      const auto& ys = g.grid_values[na - 2];
+      const auto& xs = g.grid_values[na - 1];
+      const std::size_t block = ys.size() * xs.size();
+      for (std::size_t s = 0; s < grid_slices(g); ++s) {
+        HeatMap h;
+        h.title = title;
+        std::size_t rest = s;
+        std::string where;
+        for (std::size_t a = na - 2; a-- > 0;) {
+          const std::size_t n = g.grid_values[a].size();
+          where = g.axes[g.grid_axes[a]] + "=" + format_number(g.grid_values[a][rest % n]) +
+                  (where.empty() ? "" : " ") + where;
+          rest /= n;
+        }
+        if (!where.empty()) h.title += ", " + where;
+        h.ylabel = axis_label(g, na - 2);
+        h.xlabel = axis_label(g, na - 1);
+        h.zlabel = "R (%)";
+        h.y = ys;
+        h.x = xs;
+        // Row-major over the grid axes: the last two vary fastest, z[iy * nx + ix].
+        h.z.assign(r.begin() + static_cast<std::ptrdiff_t>(s * block),
+                   r.begin() + static_cast<std::ptrdiff_t>((s + 1) * block));
+        if (grid_slices(g) > 1) {
+          double lo = INFINITY, hi = -INFINITY;
+          for (double v : r)
+            if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
+          if (hi > lo) h.zmin = lo, h.zmax = hi;
+        }
+        panels.push_back(h);
+      }
+    } else if (na == 1 && whole_grid) {
       LinePlot l;
       l.title = title;
-      l.xlabel = g.axes[g.grid_axes[0]] + " (" + g.units[g.grid_axes[0]] + ")";
+      l.xlabel = axis_label(g, 0);
       l.ylabel = "R (%)";
       l.x = g.grid_values[0];
       l.lines.push_back({"R", r});

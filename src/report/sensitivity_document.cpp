@@ -5,7 +5,7 @@
 #include <iomanip>
 #include <sstream>
 
-#include "weilgen/base/version.hpp"
+#include "weilgen/report/csv_table.hpp"
 #include "weilgen/report/json_common.hpp"
 
 namespace weilgen {
@@ -102,7 +102,7 @@ std::string sensitivity_text(const Study& st, const SensitivityOptions& opt,
       std::ostringstream h;
       h << std::left << std::setw(10) << "error" << std::right;
       if (opt.local && out != OutputId::Dp)
-        h << std::setw(14) << "coefficient" << std::setw(12)
+        h << std::setw(14) << "coefficient" << std::setw(8) << "unit" << std::setw(12)
           << std::string("|c|s ") + display_unit(out);
       if (opt.exact && out != OutputId::Dp) h << std::setw(9) << "S_exact";
       if (opt.sobol) {
@@ -113,13 +113,24 @@ std::string sensitivity_text(const Study& st, const SensitivityOptions& opt,
           h << std::setw(9) << "ST max";
       }
       os << h.str() << "\n";
-      const std::size_t rows = top == 0 ? ne : std::min(top, ne);
-      for (std::size_t k = 0; k < rows; ++k) {
+      // Errors without any effect on this output (all zero) are counted, not listed.
+      const auto no_effect = [&](std::size_t i) {
+        for (double v : {c[i], cs[i], S[i], ST[i], Se[i]})
+          if (std::abs(v) > 0) return false;
+        return true;
+      };
+      std::size_t effective = 0;
+      for (std::size_t i = 0; i < ne; ++i) effective += no_effect(i) ? 0 : 1;
+      const std::size_t rows = top == 0 ? effective : std::min(top, effective);
+      for (std::size_t k = 0, shown = 0; k < ne && shown < rows; ++k) {
         const std::size_t i = order[k];
+        if (no_effect(i)) continue;
+        ++shown;
         std::ostringstream line;
         line << std::left << std::setw(10) << errors[i].name << std::right << std::fixed;
         if (opt.local && out != OutputId::Dp)
           line << std::setw(14) << std::setprecision(6) << std::defaultfloat << c[i] << std::fixed
+               << std::setw(8) << (std::string(output_unit(out)) + "/" + errors[i].base_unit())
                << std::setw(12) << std::setprecision(3) << cs[i] * sc;
         if (opt.exact && out != OutputId::Dp) line << std::setw(9) << std::setprecision(4) << Se[i];
         if (opt.sobol) {
@@ -134,6 +145,9 @@ std::string sensitivity_text(const Study& st, const SensitivityOptions& opt,
         }
         os << line.str() << "\n";
       }
+      if (effective < ne)
+        os << "  (" << ne - effective << " error" << (ne - effective > 1 ? "s" : "")
+           << " without effect on " << output_name(out) << " not listed)\n";
     }
   }
   if (!per_pose) os << "\nPer-pose values: --json FILE or --csv FILE.\n";
@@ -162,8 +176,7 @@ nlohmann::json sensitivity_json(const Study& st, const SensitivityOptions& opt,
              {"output", output_name(out)},
              {"error", errors[i].name},
              {"coefficient", json_number(x.coefficient)},
-             {"coefficient_unit", std::string(output_unit(out)) + "/" +
-                                      (errors[i].effect == ErrorEffect::Rotation ? "rad" : "mm")},
+             {"coefficient_unit", std::string(output_unit(out)) + "/" + errors[i].base_unit()},
              {"contribution", json_number(x.contribution)},
              {"S", json_number(x.S)},
              {"S_ci", {json_number(x.S_lo), json_number(x.S_hi)}},
@@ -173,42 +186,44 @@ nlohmann::json sensitivity_json(const Study& st, const SensitivityOptions& opt,
       }
     }
   const SobolOptions& so = opt.sobol_options;
-  return {{"weilgen", kVersion},
-          {"verb", "sensitivity"},
-          {"model", model_json(model)},
-          {"settings",
-           {{"method", sensitivity_method_name(opt)},
-            {"samples", opt.sobol ? nlohmann::json(so.samples) : nlohmann::json()},
-            {"sampling", sampling_name(so.sampling)},
-            {"seed", so.seed},
-            {"intervals",
-             opt.sobol ? nlohmann::json(interval_method_name(r.intervals)) : nlohmann::json()},
-            {"replicates", opt.sobol ? nlohmann::json(r.replicates) : nlohmann::json()},
-            {"bootstrap", r.bootstrap},
-            {"confidence", so.confidence},
-            {"evaluations", r.evaluations}}},
-          {"inputs", inputs_json(model, st.inputs)},
-          {"summary", sums},
-          {"results", results}};
+  return json_document(
+      "sensitivity", {{"model", model_json(model)},
+                      {"settings",
+                       {{"method", sensitivity_method_name(opt)},
+                        {"samples", opt.sobol ? nlohmann::json(so.samples) : nlohmann::json()},
+                        {"sampling", sampling_name(so.sampling)},
+                        {"seed", so.seed},
+                        {"intervals", opt.sobol ? nlohmann::json(interval_method_name(r.intervals))
+                                                : nlohmann::json()},
+                        {"replicates", opt.sobol ? nlohmann::json(r.replicates) : nlohmann::json()},
+                        {"bootstrap", r.bootstrap},
+                        {"confidence", so.confidence},
+                        {"evaluations", r.evaluations}}},
+                      {"inputs", inputs_json(model, st.inputs)},
+                      {"summary", sums},
+                      {"results", results}});
 }
 
 std::string sensitivity_csv(const Study& st, const SensitivityResult& r) {
   const auto& errors = st.model->description().errors;
-  std::ostringstream c;
-  for (const auto& a : st.poses.axes) c << csv_field(a) << ",";
-  c << "output,output_unit,error,coefficient,contribution,S,S_lo,S_hi,ST,ST_lo,ST_hi,S_exact\n";
+  CsvTable t;
+  t.pose_columns(st.poses);
+  for (const char* c : {"output", "output_unit", "error", "error_unit", "coefficient",
+                        "coefficient_unit", "contribution", "contribution_unit", "S", "S_lo",
+                        "S_hi", "ST", "ST_lo", "ST_hi", "S_exact"})
+    t.column(c);
   for (std::size_t p = 0; p < r.poses; ++p)
     for (std::size_t o = 0; o < r.outputs.size(); ++o)
       for (std::size_t i = 0; i < r.errors; ++i) {
         const SensitivityRecord& x = r.at(p, o, i);
-        for (double v : st.poses.poses[p]) c << csv_number(v) << ",";
-        c << output_name(r.outputs[o]) << "," << output_unit(r.outputs[o]) << "," << errors[i].name;
-        for (double v : {x.coefficient, x.contribution, x.S, x.S_lo, x.S_hi, x.ST, x.ST_lo, x.ST_hi,
-                         x.S_exact})
-          c << "," << csv_number(v);
-        c << "\n";
+        const std::string ou = output_unit(r.outputs[o]), eu = errors[i].base_unit();
+        t.pose(st.poses.poses[p]).text(output_name(r.outputs[o])).text(ou);
+        t.text(errors[i].name).text(eu).number(x.coefficient).text(ou + "/" + eu);
+        t.number(x.contribution).text(ou);
+        for (double v : {x.S, x.S_lo, x.S_hi, x.ST, x.ST_lo, x.ST_hi, x.S_exact}) t.number(v);
+        t.end_row();
       }
-  return c.str();
+  return t.str();
 }
 
 std::vector<Panel> sensitivity_panels(const Study& st, const SensitivityOptions& opt,
@@ -254,6 +269,7 @@ std::vector<Panel> sensitivity_panels(const Study& st, const SensitivityOptions&
       b.ylabel = std::string("|c| sigma (") + display_unit(out) + ")";
       b.series.push_back(l);
     }
+    pareto(b, opt.sobol ? 1 : 0);  // by ST, else S exact, else |c| sigma
     panels.push_back(b);
   }
   return panels;

@@ -85,7 +85,9 @@ GroupStats group_stats(const AllocationProblem& problem, const std::vector<Alloc
   st.group_met.assign(G, false);
   for (std::size_t g = 0; g < G; ++g) {
     st.mean[g] /= static_cast<double>(count[g]);
-    st.group_met[g] = st.min[g] >= options.min_target && st.mean[g] >= options.mean_target;
+    const double tol = options.target_tolerance;
+    st.group_met[g] =
+        st.min[g] >= options.min_target - tol && st.mean[g] >= options.mean_target - tol;
     st.met = st.met && st.group_met[g];
   }
   return st;
@@ -114,6 +116,8 @@ void AllocationOptions::validate() const {
   for (double target : {min_target, mean_target})
     if (!(target > 0 && target <= 1))
       throw std::invalid_argument("allocation: the targets must be in (0, 1]");
+  if (!(target_tolerance >= 0 && target_tolerance <= 1e-3))
+    throw std::invalid_argument("allocation: target_tolerance must be in [0, 1e-3]");
   for (double w : cost_weights)
     if (!(w >= 0) || !std::isfinite(w))
       throw std::invalid_argument("allocation: cost weights must be finite and >= 0");

@@ -96,7 +96,7 @@ CASES = [
     (REL.replace("keep.json", "m.yaml"), 2, ["--json", "is the input"]),
     (ALLOC + " --save-tolerances m.yaml", 2, ["--save-tolerances", "is the input"]),
     (ALLOC + " --tolerances t.yaml --save-tolerances ./t.yaml", 2, ["--save-tolerances"]),
-    (ALLOC + " --plot x.png", 2, ["--plot", "allocate draws no figure"]),
+    (ALLOC + " --plot m.yaml", 2, ["--plot", "is the input"]),
     ("iso230-2 d.csv --json d.csv", 2, ["--json", "is the input"]),
     ("iso230-2 d.csv --plot d.csv", 2, ["--plot", "is the input"]),
     ("iso230-2 d.csv --json sub", 2, ["--json", "is a directory"]),

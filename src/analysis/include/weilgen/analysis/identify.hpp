@@ -152,7 +152,7 @@ Eigen::MatrixXd design_matrix(const Model& model, const ErrorParameterisation& p
 struct IdentifyOptions {
   double rank_tolerance = 1e-9;    // singular values below tol · σ_max (equilibrated) are null
   int max_gauss_newton = 8;        // iterations at order >= 2
-  std::vector<std::string> fixed;  // errors held at zero (names or aliases)
+  std::vector<std::string> fixed;  // errors held at zero (names, aliases, group:<group>)
   // rank_tolerance in (0, 1), max_gauss_newton >= 0 (std::invalid_argument naming the field).
   void validate() const;
 };

@@ -26,7 +26,8 @@ namespace weilgen {
 // count 1 = start; at most one --grid). Axis names are the machine's coordinates; values are in
 // the axis unit (the joint's `unit`: mm or deg for the shipped machines) unless a unit is written
 // ("Y=1.5m", "A=0.5rad"); each value must lie within the axis range when the machine file gives
-// one. An axis not named takes 0 when 0 is within its range, else it must be given.
+// one. --at names every axis (an axis left out is an error naming it); in --grid an axis not
+// named takes 0 when 0 is within its range, else it must be given.
 // The grid is the Cartesian product in the order the axes are written, the LAST written axis
 // varying fastest; grid poses come first, then the --at poses. No poses at all is an error.
 struct PoseSet {
@@ -71,6 +72,17 @@ std::vector<OutputTolerance> parse_tolerances(const std::vector<std::string>& fl
 std::vector<InputDistribution> error_distributions(const Description& desc,
                                                    const std::vector<std::string>& tolerance_files,
                                                    const std::vector<std::string>& set_flags);
+
+// The errors a name selects in --set, identify --fix, ...: an error name, an alias (with the
+// alias's sign) or "group:<group>" (every error of the group, sign +1). Throws
+// std::invalid_argument "<context>: unknown error ..." / "no errors in group ..." naming the
+// machine's errors or groups.
+struct ErrorTarget {
+  std::size_t error = 0;  // index into Description::errors
+  int sign = 1;
+};
+std::vector<ErrorTarget> select_errors(const Description& desc, const std::string& name,
+                                       const std::string& context);
 
 // One --set flag applied to `dists` (Description::errors order, base units; empty = none yet).
 void apply_set_flag(const Description& desc, const std::string& flag,

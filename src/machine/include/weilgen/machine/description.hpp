@@ -104,6 +104,8 @@ struct ErrorDef {
   std::string basis;
   SourceLoc basis_loc;
   SourceLoc loc;
+  // The base unit of its values inside the libraries: "rad" for a rotation, else "mm".
+  const char* base_unit() const { return effect == ErrorEffect::Rotation ? "rad" : "mm"; }
 };
 
 struct Body {

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "weilgen/analysis/allocation_study.hpp"
+#include "weilgen/report/plot.hpp"
 
 namespace weilgen {
 
@@ -21,6 +22,11 @@ nlohmann::json allocation_json(const Study& study, const AllocationStudyOptions&
                                const AllocationSettingsText& text,
                                const AllocationStudyResult& result);
 std::string allocation_csv(const Study& study, const AllocationStudyResult& result);
+// The allocation steps chart (allocate --plot): per toleranced output, min and mean R (%) over
+// the steps with the targets; the chosen errors' spreads (% of their start) over the steps; with
+// --cost-aware, every moving error's spread (% of its start) after the steps and at the optimum.
+std::vector<Panel> allocation_panels(const Study& study, const AllocationStudyOptions& options,
+                                     const AllocationStudyResult& result);
 // The comment heading the saved tolerance file.
 std::string allocation_tolerance_comment(const Study& study, const AllocationStudyResult& result);
 

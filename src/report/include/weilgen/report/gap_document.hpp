@@ -17,6 +17,8 @@ std::string gap_text(const GapResult& result, const Model& model, const std::str
 std::string gap_markdown(const GapResult& result, const Model& model, const std::string& data,
                          const std::vector<std::string>& pngs, const std::string& report_path);
 nlohmann::json gap_json(const GapResult& result, const Model& model, const std::string& data);
+// The candidate effects in ranking order, one row each (held-out RMS in µm, shrink in %).
+std::string gap_csv(const GapResult& result, const std::string& data);
 
 // One plot file: `<stem>.png` with its title and panels.
 struct GapPlot {

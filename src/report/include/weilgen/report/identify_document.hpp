@@ -1,6 +1,6 @@
 // The documents of an identification: the text of `weilgen identify` (observations, rank,
 // residuals per output, parameters with standard errors, the unidentifiable combinations) and
-// its JSON (docs/identify.md).
+// its JSON, CSV and chart (docs/identify.md).
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -9,6 +9,7 @@
 
 #include "weilgen/analysis/identify.hpp"
 #include "weilgen/analysis/identify_request.hpp"
+#include "weilgen/report/plot.hpp"
 
 namespace weilgen {
 
@@ -23,5 +24,13 @@ nlohmann::json identify_json(const Model& model, const ErrorParameterisation& pa
 nlohmann::json identify_json(const IdentifyRun& run);
 // The text of a whole run: identify_text, then each prediction's text.
 std::string identify_text(const IdentifyRun& run);
+// One row per parameter: label, error, basis, term, value and standard error in `unit`,
+// identifiable, fixed.
+std::string identify_csv(const Model& model, const ErrorParameterisation& param,
+                         const IdentifyResult& result);
+// The RMS residual per output before and after (µm, µrad), and per unit the identified
+// parameters with their 95 % intervals (value ± 1.96 standard errors).
+std::vector<Panel> identify_panels(const ErrorParameterisation& param,
+                                   const IdentifyResult& result);
 
 }  // namespace weilgen

@@ -13,6 +13,10 @@
 
 namespace weilgen {
 
+// Every verb's JSON document: `body` with "weilgen" (the version) and "verb" (the verb's name as
+// typed on the command line: "sensitivity", "fit-pdge", ...) added. The one place of these keys.
+nlohmann::json json_document(const std::string& verb, nlohmann::json body);
+
 // A JSON number, or null for NaN and infinities (values not computed, or unbounded).
 nlohmann::json json_number(double v);
 nlohmann::json json_numbers(const std::vector<double>& v);

@@ -33,14 +33,26 @@ struct HeatMap {
   double zmin = NAN, zmax = NAN;
   bool annotate = true;
 };
+enum class LineStyle { LinesPoints, Lines, Points };
 struct LinePlot {
   std::string title, xlabel, ylabel;
   std::vector<double> x;
   std::vector<std::pair<std::string, std::vector<double>>> lines;  // label, y (same size as x)
 };
-using Panel = std::variant<BarChart, HeatMap, LinePlot>;
+// A line plot whose lines have their own styles: measured points (Points skip NaN values, so
+// they can share a dense x grid) among fitted curves (Lines).
+struct StyledLinePlot {
+  LinePlot plot;
+  std::vector<LineStyle> styles;  // one per line of `plot`
+};
+using Panel = std::variant<BarChart, HeatMap, LinePlot, StyledLinePlot>;
 
 constexpr std::size_t kMaxAnnotatedCells = 144;
+
+// A Pareto chart: the categories in descending order of series `key` (NaN last, ties in their
+// order), without the categories where every series is 0 or NaN (an error without effect),
+// unless that is every category.
+void pareto(BarChart& chart, std::size_t key = 0);
 
 // Writes the panels into one figure at `path` (stacked one per row when a bar chart has many
 // categories, else in a grid of up to three columns). The format follows the extension: .png

@@ -36,6 +36,9 @@ struct AllocationProblem {
 
 struct AllocationOptions {
   double min_target = 0.95, mean_target = 0.97;  // per group: min and mean over its cases
+  // A target counts as met when R >= target - target_tolerance (absolute, R in 0..1): an
+  // optimum on the constraint misses it by rounding (2e-12), which is no verdict of its own.
+  double target_tolerance = 1e-9;
   // Per input: the absolute stddev decrement per step. An input with step <= 0 is never chosen
   // by the ranking (it cannot be tightened); an explicitly chosen input must have step > 0.
   std::vector<double> step;
@@ -55,8 +58,9 @@ struct AllocationOptions {
   std::vector<double> sigma_lower, sigma_upper;
   std::size_t cost_max_evaluations = 1000;  // NLopt evaluations of the problem
 
-  // The checks that need no problem: targets in (0, 1], finite non-negative cost weights,
-  // max_steps and cost_max_evaluations >= 1. Throws std::invalid_argument naming the field.
+  // The checks that need no problem: targets in (0, 1], target_tolerance in [0, 1e-3], finite
+  // non-negative cost weights, max_steps and cost_max_evaluations >= 1. Throws
+  // std::invalid_argument naming the field.
   void validate() const;
 };
 
