@@ -3,7 +3,6 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
-
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -164,9 +163,8 @@ TEST_CASE("model loader: a cached model of an older ABI version is compiled agai
   // Without the cache's integrity trailer the entry is first discarded as damaged (a note);
   // either way it is compiled again.
   REQUIRE_FALSE(log.empty());
-  CHECK(std::any_of(log.begin(), log.end(), [](const std::string& l) {
-    return l.find("compiling model two_axis") == 0;
-  }));
+  CHECK(std::any_of(log.begin(), log.end(),
+                    [](const std::string& l) { return l.find("compiling model two_axis") == 0; }));
   CHECK(batch_matches(*model));
   // The new object replaced the stale one: the next load is a cache hit.
   std::vector<std::string> log2;

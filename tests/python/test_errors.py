@@ -33,24 +33,24 @@ def test_bad_flags_carry_the_cli_message(cli):
     A = weilgen.ArgumentError
     raises_like_cli(cli, A, lambda: weilgen.sensitivity("gantry_grinder", grid="X=0:1000:0"),
                     "sensitivity", "gantry_grinder", "--grid", "X=0:1000:0")
-    raises_like_cli(cli, A, lambda: weilgen.sensitivity("gantry_grinder", at="X=0", outputs="dq"),
-                    "sensitivity", "gantry_grinder", "--at", "X=0", "--outputs", "dq")
+    raises_like_cli(cli, A, lambda: weilgen.sensitivity("gantry_grinder", at="X=0,Y=0,Z=600", outputs="dq"),
+                    "sensitivity", "gantry_grinder", "--at", "X=0,Y=0,Z=600", "--outputs", "dq")
     raises_like_cli(cli, A,
-                    lambda: weilgen.sensitivity("gantry_grinder", at="X=0", confidence=1.5),
-                    "sensitivity", "gantry_grinder", "--at", "X=0", "--confidence", "1.5")
-    raises_like_cli(cli, A, lambda: weilgen.sensitivity("gantry_grinder", at="X=0,Z=600",
+                    lambda: weilgen.sensitivity("gantry_grinder", at="X=0,Y=0,Z=600", confidence=1.5),
+                    "sensitivity", "gantry_grinder", "--at", "X=0,Y=0,Z=600", "--confidence", "1.5")
+    raises_like_cli(cli, A, lambda: weilgen.sensitivity("gantry_grinder", at="X=0,Y=0,Z=600",
                                                         set={"E_QQ": "sigma:1um"}),
-                    "sensitivity", "gantry_grinder", "--at", "X=0,Z=600", "--set",
+                    "sensitivity", "gantry_grinder", "--at", "X=0,Y=0,Z=600", "--set",
                     "E_QQ=sigma:1um")
-    raises_like_cli(cli, A, lambda: weilgen.reliability("gantry_grinder", at="X=0,Z=600"),
-                    "reliability", "gantry_grinder", "--at", "X=0,Z=600")
-    raises_like_cli(cli, A, lambda: weilgen.reliability("gantry_grinder", at="X=0,Z=600",
+    raises_like_cli(cli, A, lambda: weilgen.reliability("gantry_grinder", at="X=0,Y=0,Z=600"),
+                    "reliability", "gantry_grinder", "--at", "X=0,Y=0,Z=600")
+    raises_like_cli(cli, A, lambda: weilgen.reliability("gantry_grinder", at="X=0,Y=0,Z=600",
                                                         tolerance="dx=0.03mm", limit="sideways"),
-                    "reliability", "gantry_grinder", "--at", "X=0,Z=600", "--tolerance",
+                    "reliability", "gantry_grinder", "--at", "X=0,Y=0,Z=600", "--tolerance",
                     "dx=0.03mm", "--limit", "sideways")
-    raises_like_cli(cli, A, lambda: weilgen.allocate("gantry_grinder", at="X=0,Z=600",
+    raises_like_cli(cli, A, lambda: weilgen.allocate("gantry_grinder", at="X=0,Y=0,Z=600",
                                                      tolerance="dx=0.03mm", min=1.5),
-                    "allocate", "gantry_grinder", "--at", "X=0,Z=600", "--tolerance", "dx=0.03mm",
+                    "allocate", "gantry_grinder", "--at", "X=0,Y=0,Z=600", "--tolerance", "dx=0.03mm",
                     "--min", "1.5")
     raises_like_cli(cli, A, lambda: weilgen.identify("vmc_3axis", data=POINTS, rank_tol=2),
                     "identify", "vmc_3axis", "--data", POINTS, "--rank-tol", "2")
@@ -74,7 +74,7 @@ def test_bad_flags_carry_the_cli_message(cli):
                                                      axis="X"),
                     "identify", "vmc_3axis", "--data", POINTS, "--comp-table", POINTS, "--axis", "X")
     raises_like_cli(cli, A, lambda: weilgen.Model("gantry_grinder", engine="fast"),
-                    "sensitivity", "gantry_grinder", "--at", "X=0,Z=600", "--engine", "fast")
+                    "sensitivity", "gantry_grinder", "--at", "X=0,Y=0,Z=600", "--engine", "fast")
 
 
 def test_bad_files_carry_file_line_column(cli, tmp_path):
@@ -103,7 +103,7 @@ def test_a_failed_compile_is_a_run_error(cli, tmp_path, monkeypatch):
     with pytest.raises(weilgen.RunError) as e:
         weilgen.Model(str(copy), engine="compiled", compiler="false", quiet=True)
     assert isinstance(e.value, RuntimeError) and e.value.exit_code == 1
-    r = cli.run("sensitivity", str(copy), "--at", "X=0", "--engine", "compiled", "--compiler",
+    r = cli.run("sensitivity", str(copy), "--at", "X=0,Y=0,Z=0", "--engine", "compiled", "--compiler",
                 "false", "--quiet")
     # The same message, up to the process id in the name of the build directory.
     same = lambda text: re.sub(r"build-([0-9a-f]+)-[0-9]+", r"build-\1", text).strip()
@@ -114,19 +114,19 @@ def test_a_failed_compile_is_a_run_error(cli, tmp_path, monkeypatch):
 
 def test_python_mistakes_name_the_keyword_or_flag(tmp_path):
     with pytest.raises(weilgen.ArgumentError, match=r"sensitivity\(\): unknown keyword 'sample' "):
-        weilgen.sensitivity("gantry_grinder", at="X=0,Z=600", sample=10)
+        weilgen.sensitivity("gantry_grinder", at="X=0,Y=0,Z=600", sample=10)
     with pytest.raises(weilgen.ArgumentError, match="--samples: expected a whole number >= 0"):
-        weilgen.sensitivity("gantry_grinder", at="X=0,Z=600", samples=-4)
+        weilgen.sensitivity("gantry_grinder", at="X=0,Y=0,Z=600", samples=-4)
     with pytest.raises(weilgen.ArgumentError, match="--samples: expected a whole number"):
-        weilgen.sensitivity("gantry_grinder", at="X=0,Z=600", samples="many")
+        weilgen.sensitivity("gantry_grinder", at="X=0,Y=0,Z=600", samples="many")
     with pytest.raises(weilgen.ArgumentError, match="--per-output: expected True or False"):
-        weilgen.allocate("gantry_grinder", at="X=0,Z=600", tolerance="dx=30um", per_output=1)
+        weilgen.allocate("gantry_grinder", at="X=0,Y=0,Z=600", tolerance="dx=30um", per_output=1)
     with pytest.raises(weilgen.ArgumentError, match="--grid: nan is not a finite number"):
         weilgen.sensitivity("gantry_grinder", grid={"X": float("nan")})
     with pytest.raises(weilgen.ArgumentError, match="order= is for a machine name or file"):
-        weilgen.sensitivity(weilgen.Model("gantry_grinder"), at="X=0,Z=600", order=2)
+        weilgen.sensitivity(weilgen.Model("gantry_grinder"), at="X=0,Y=0,Z=600", order=2)
     with pytest.raises(weilgen.ArgumentError, match="--plot: unsupported|plot"):
-        weilgen.sensitivity("gantry_grinder", at="X=0,Z=600", plot=str(tmp_path / "x.pdf"))
+        weilgen.sensitivity("gantry_grinder", at="X=0,Y=0,Z=600", plot=str(tmp_path / "x.pdf"))
     assert not (tmp_path / "x.pdf").exists()
     assert issubclass(weilgen.ArgumentError, ValueError)
     assert issubclass(weilgen.InputError, ValueError)

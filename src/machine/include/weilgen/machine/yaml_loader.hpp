@@ -28,11 +28,11 @@ std::string resolve_machine(const std::string& name_or_path);
 std::string shipped_machines_dir();
 
 // The distribution keys of a machine file's error or error_defaults entry, for other files that
-// use the same syntax (tolerance files, weilgen/analysis/tolerance_file.hpp). `mapping` is a YAML mapping
-// (null reads as empty); of its keys, `sigma`, `normal`, `uniform` and `truncnormal` are read (at
-// most one may be present, values numbers or expressions such as 0.05/6, in the caller's unit) and
-// the others are left to the caller. Returns Kind::None when none is present. Throws InputError
-// "file:line:column: <path>.<key>: message", exactly as load_machine_file reports them.
+// use the same syntax (tolerance files, weilgen/analysis/tolerance_file.hpp). `mapping` is a YAML
+// mapping (null reads as empty); of its keys, `sigma`, `normal`, `uniform` and `truncnormal` are
+// read (at most one may be present, values numbers or expressions such as 0.05/6, in the caller's
+// unit) and the others are left to the caller. Returns Kind::None when none is present. Throws
+// InputError "file:line:column: <path>.<key>: message", exactly as load_machine_file reports them.
 Distribution read_distribution_keys(const YAML::Node& mapping, const std::string& file,
                                     const std::string& path);
 
