@@ -211,6 +211,17 @@ TEST_CASE("outputs: reliability over three grid axes, small multiples and unit C
   const double json_value = j["results"][0]["dR_dsigma"]["E_BX"].get<double>();
   CHECK(json_value != 0);
   CHECK(std::stod(c[col]) == doctest::Approx(json_value).epsilon(1e-15));
+
+  // 40 heat maps (40 values of X) are more than one figure holds: refused before the sweep,
+  // naming the count and the way out, and nothing written.
+  const Run refused =
+      run(cli("reliability gantry_grinder --grid X=0:1000:40,Y=-1500:1500:2,"
+              "Z=600:1400:2 --tolerance dx=30um --quiet --plot " +
+              (dir / "r40.svg").string()));
+  CHECK(refused.status == 2);
+  CHECK(refused.out.find("gives 40 heat maps") != std::string::npos);
+  CHECK(refused.out.find("--csv") != std::string::npos);
+  CHECK_FALSE(std::filesystem::exists(dir / "r40.svg"));
 }
 
 TEST_CASE("outputs: --at names every axis, help shows 0.95, sensitivity names its verb") {
