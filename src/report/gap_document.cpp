@@ -68,6 +68,18 @@ json effect_json(const EffectFit& e, const std::array<std::size_t, kObservationK
   return j;
 }
 
+std::string not_distinguishable(const EffectFit& e) {
+  return " (needs " + std::to_string(e.shape_dof_used) + " shape degrees of freedom where the " +
+         "data leave " + std::to_string(e.shape_dof_free) + ": any shape fits)";
+}
+
+// What a candidate's row says: its fit when significant; a rejected candidate's parameters
+// are whatever least squares made of noise (a tool offset of -2.6e5 mm) and are not shown.
+std::string candidate_text(const EffectFit& e) {
+  if (!e.significant) return "not significant";
+  return e.summary + (e.distinguishable ? "" : not_distinguishable(e));
+}
+
 }  // namespace
 
 std::string gap_csv(const GapResult& r, const std::string& data) {
@@ -91,7 +103,7 @@ std::string gap_csv(const GapResult& r, const std::string& data) {
     t.count(k + 1).text(e.name).text(e.variant).count(e.extra_parameters);
     t.number(e.heldout_rms_before_um).number(e.heldout_rms_after_um).number(e.shrink_pct);
     t.number(e.explained_fraction).number(e.f_statistic).number(e.p_value);
-    t.text(e.significant ? "yes" : "no").text(explains ? "yes" : "no").text(e.summary);
+    t.text(e.significant ? "yes" : "no").text(explains ? "yes" : "no").text(candidate_text(e));
     t.end_row();
   }
   return t.str();
@@ -142,22 +154,6 @@ nlohmann::json gap_json(const GapResult& r, const Model& model, const std::strin
                           {"remaining_excess_um", json_number(r.final_excess_um)},
                           {"remaining_p_value", json_number(r.final_p_value)}}}});
 }
-
-namespace {
-
-std::string not_distinguishable(const EffectFit& e) {
-  return " (needs " + std::to_string(e.shape_dof_used) + " shape degrees of freedom where the " +
-         "data leave " + std::to_string(e.shape_dof_free) + ": any shape fits)";
-}
-
-// What a candidate's row says: its fit when significant; a rejected candidate's parameters
-// are whatever least squares made of noise (a tool offset of -2.6e5 mm) and are not shown.
-std::string candidate_text(const EffectFit& e) {
-  if (!e.significant) return "not significant";
-  return e.summary + (e.distinguishable ? "" : not_distinguishable(e));
-}
-
-}  // namespace
 
 std::string gap_text(const GapResult& r, const Model& model, const std::string& data,
                      bool markdown) {
