@@ -203,7 +203,8 @@ TEST_CASE("gap display: --plot draws every coordinate that varies, rotary ones i
   for (int k = 0; k < 8; ++k) c.push_back(std::to_string(45 * k));
   const Description& desc = test::builtin_model("five_axis_ac")->description();
   const GapData d = gap_data(parse_measurements(five_axis_rows(c), "r.csv"), desc);
-  const GapResult r = hand_result(d.points.observations.size());
+  GapResult r = hand_result(d.points.observations.size());
+  r.explanation = {r.effects[0]};
   std::vector<std::string> stems;
   for (const GapPlot& p : gap_plots(d, r)) stems.push_back(p.stem);
   CHECK(stems == std::vector<std::string>{"residual_t_s", "residual_A", "residual_C", "effects"});
@@ -219,6 +220,12 @@ TEST_CASE("gap display: --plot draws every coordinate that varies, rotary ones i
     CHECK(lp.lines[2].second == std::vector<double>(8, 0.5));
     for (double v : lp.lines[1].second) CHECK(v == doctest::Approx(0.5));
   }
+  // Nothing accepted: no "after" line drawn over the baseline.
+  r.explanation.clear();
+  const std::vector<GapPlot> plain = gap_plots(d, r);
+  const LinePlot& none = std::get<LinePlot>(plain.at(2).panels.at(0));
+  REQUIRE(none.lines.size() == 2);
+  CHECK(none.lines[1].first == "noise floor");
 }
 
 namespace {

@@ -293,9 +293,10 @@ LinePlot residual_plot(const GapData& d, const GapResult& r, const std::string& 
     before.push_back(std::sqrt(sb / n));
     after.push_back(std::sqrt(sa / n));
   }
-  p.lines = {{"baseline", before},
-             {"with the explanation", after},
-             {"noise floor", std::vector<double>(before.size(), r.noise.sigma_um)}};
+  // Without an accepted effect "after" is "before": one line, not two on top of each other.
+  p.lines = {{"baseline", before}};
+  if (!r.explanation.empty()) p.lines.push_back({"with the explanation", after});
+  p.lines.push_back({"noise floor", std::vector<double>(before.size(), r.noise.sigma_um)});
   return p;
 }
 
