@@ -232,8 +232,9 @@ namespace {
 
 // vmc_3axis along the diagonal (X 0..500, Y -350..-50, Z -250..-50 together), back and forth in
 // `cycles` cycles, so dir_X, dir_Y and dir_Z are one column; deviation = `effect` + N(0, 0.5²).
+// `line`: an ISO line run along X instead (Y, Z fixed; dir_Y, dir_Z constant).
 std::string diagonal(std::uint32_t seed, int cycles,
-                     const std::function<double(double dir, double s)>& effect) {
+                     const std::function<double(double dir, double s)>& effect, bool line = false) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> n01(0, 1);
   std::ostringstream csv;
@@ -243,8 +244,9 @@ std::string diagonal(std::uint32_t seed, int cycles,
     for (int k = 0; k < 24; ++k) {
       const bool up = k < 12;
       const double s = (up ? k : 23 - k) / 11.0, dir = up ? 1 : -1;
-      csv << 500 * s << "," << -350 + 300 * s << "," << -250 + 200 * s << "," << dir << "," << dir
-          << "," << dir << "," << cy << "," << t;
+      const double m = line ? 0 : 1, other = line ? 1 : dir;
+      csv << 500 * s << "," << -350 + 300 * s * m << "," << -250 + 200 * s * m << "," << dir << ","
+          << other << "," << other << "," << cy << "," << t;
       for (int o = 0; o < 3; ++o) csv << "," << (o == 0 ? effect(dir, s) : 0) + 0.5 * n01(rng);
       csv << "\n";
       t += 60;
@@ -332,11 +334,14 @@ TEST_CASE("gap where: on a rotary table the bins along A and C are in deg") {
 }
 
 TEST_CASE("gap verdict: no significant baseline gap is none, and the near candidates are named") {
-  // Effect-free diagonal runs: the baseline's held-out gap decides (docs/gap.md, "Verdict").
+  // Effect-free diagonal and line runs (the issue's case: a reversal accepted on an effect-free
+  // line set at baseline p = 0.53): the baseline's held-out gap decides (docs/gap.md, "Verdict").
   int none = 0, named_close = 0;
-  for (std::uint32_t seed = 0; seed < 6; ++seed) {
-    const GapResult r = diagnose(diagonal(100 + seed, 5, [](double, double) { return 0.0; }),
-                                 "vmc_3axis", "cycle:5");
+  for (std::uint32_t seed = 0; seed < 12; ++seed) {
+    const GapResult r =
+        diagnose(diagonal(
+                     100 + seed, 5, [](double, double) { return 0.0; }, seed % 2 == 1),
+                 "vmc_3axis", "cycle:5");
     INFO("seed " << seed << ": " << r.verdict << " (" << r.verdict_reason << "), baseline p "
                  << r.baseline_p_value);
     if (r.baseline_p_value < 0.01) continue;
@@ -350,6 +355,42 @@ TEST_CASE("gap verdict: no significant baseline gap is none, and the near candid
         ++named_close;
       }
   }
-  CHECK(none >= 5);  // the test is not vacuous: the baseline gap is at the floor
+  CHECK(none >= 10);  // the test is not vacuous: the baseline gap is at the floor
   MESSAGE("near candidates named: " << named_close);
+}
+
+TEST_CASE(
+    "gap verdict: a candidate significant in training, with no held-out gap, is named close") {
+  // A 0.4 µm reversal of X on a diagonal run (noise 0.5 µm): the training F test sees it
+  // (corrected p 7.6e-5), the held-out gap does not (p 0.67): none, and the reason says why.
+  const GapResult r = diagnose(diagonal(200, 5, [](double dir, double) { return 0.2 * dir; }),
+                               "vmc_3axis", "cycle:5");
+  INFO(r.verdict_reason);
+  CHECK(r.baseline_p_value > 0.5);
+  CHECK(r.verdict == "none");
+  CHECK(r.verdict_reason.find("closest candidates: reversal (p = ") != std::string::npos);
+  CHECK(r.verdict_reason.find("significant in training but not needed") != std::string::npos);
+}
+
+// Known failure (issue 14 item 6, src/analysis/gap/diagnosis.cpp decide_verdict, not this
+// branch's file): with no significant baseline gap, a candidate accepted by the overwhelming-
+// evidence exception (corrected p < alpha^3) is then judged by the share of the baseline's
+// "excess" it removes — an excess at the noise floor (0 in the second case) — and the verdict
+// reads "unexplained: the accepted effects remove only 11 % of the excess", although the gap was
+// never significant, the reversal is the truth, its size is right and the remaining gap is at
+// the floor. Expected: the accepted effect is named (or none); never "unexplained".
+TEST_CASE("gap verdict: an effect accepted without a significant baseline gap is not unexplained" *
+          doctest::may_fail()) {
+  for (const auto& [b, seed] : std::vector<std::pair<double, std::uint32_t>>{
+           {0.2, 202}, {0.3, 200}, {0.3, 203}, {0.4, 203}}) {
+    const double size = b;
+    const GapResult r =
+        diagnose(diagonal(seed, 5, [size](double dir, double) { return size * dir; }), "vmc_3axis",
+                 "cycle:5");
+    INFO("reversal " << 2 * b << " um, seed " << seed << ": baseline p " << r.baseline_p_value
+                     << ", " << r.verdict << " (" << r.verdict_reason << ")");
+    REQUIRE(r.baseline_p_value > 0.01);
+    CHECK(r.verdict != "unexplained");
+    CHECK(r.verdict == "reversal");
+  }
 }
