@@ -30,12 +30,12 @@ std::string error_of(const std::function<void()>& f) {
 
 // five_axis_ac rows: X, Y, Z fixed, A over {-30, 0, 30} deg, C over `c` (written as given).
 std::string five_axis_rows(const std::vector<std::string>& c) {
-  std::string s = "X,Y,Z,A,C,t_s,dx_um\n";
+  std::string s = "X,Y,Z,A,C,t_s,dx_um,rpm\n";
   int t = 0;
   for (const char* a : {"-30", "0", "30"})
     for (const std::string& ci : c) {
       s += std::string("10,0,-100,") + a + "," + ci + "," + std::to_string(60 * t) + "," +
-           std::to_string(0.1 * t) + "\n";
+           std::to_string(0.1 * t) + "," + std::to_string(1000 + 10 * t) + "\n";
       ++t;
     }
   return s;
@@ -205,10 +205,20 @@ TEST_CASE("gap display: --plot draws every coordinate that varies, rotary ones i
   const GapData d = gap_data(parse_measurements(five_axis_rows(c), "r.csv"), desc);
   GapResult r = hand_result(d.points.observations.size());
   r.explanation = {r.effects[0]};
+  GapRegion speed;  // a significant dimension: drawn too, in its unit
+  speed.by = "rpm";
+  speed.significant = true;
+  r.where = {speed};
   std::vector<std::string> stems;
   for (const GapPlot& p : gap_plots(d, r)) stems.push_back(p.stem);
-  CHECK(stems == std::vector<std::string>{"residual_t_s", "residual_A", "residual_C", "effects"});
+  CHECK(stems == std::vector<std::string>{"residual_t_s", "residual_A", "residual_C",
+                                          "residual_rpm", "effects"});
   for (const GapPlot& p : gap_plots(d, r)) {
+    if (p.stem == "effects") continue;  // the bar chart of the candidates
+    const std::string x = std::get<LinePlot>(p.panels.at(0)).xlabel;
+    if (p.stem == "residual_t_s") CHECK(x == "t (s)");
+    if (p.stem == "residual_A") CHECK(x == "A (deg)");
+    if (p.stem == "residual_rpm") CHECK(x == "rpm (1/min)");
     if (p.stem != "residual_C") continue;
     const LinePlot& lp = std::get<LinePlot>(p.panels.at(0));
     CHECK(lp.xlabel == "C (deg)");

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "weilgen/base/format.hpp"
+#include "weilgen/measure/measurement_csv.hpp"
 #include "weilgen/report/csv_table.hpp"
 #include "weilgen/report/json_common.hpp"
 
@@ -249,10 +250,12 @@ namespace {
 LinePlot residual_plot(const GapData& d, const GapResult& r, const std::string& by) {
   LinePlot p;
   p.title = "held-out residual RMS along " + by;
-  p.xlabel = by;
+  // In the dimension's unit: the machine's for a coordinate, else the data format's (degC, 1/min).
+  std::string unit = classify_column(by, ReadOptions{}).unit;
   for (std::size_t a = 0; a < d.axes.size() && a < d.axis_units.size(); ++a)
-    if (d.axes[a] == by) p.xlabel = by + " (" + d.axis_units[a] + ")";
-  if (by == "t_s") p.xlabel = "t (s)";
+    if (d.axes[a] == by) unit = d.axis_units[a];
+  p.xlabel = by == "t_s" ? "t" : by;
+  if (!unit.empty()) p.xlabel += " (" + unit + ")";
   p.ylabel = "RMS (µm)";
   const auto& obs = d.points.observations;
   std::vector<std::pair<double, std::size_t>> key;
