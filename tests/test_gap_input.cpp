@@ -132,6 +132,16 @@ TEST_CASE("gap input: a covariate with gaps names the file, the first empty cell
   CHECK(gap_error(rows("t_s", {0, 11}, 12)) ==
         "b.csv:2:7: column 't_s' is empty in 2 rows where a deviation is measured (lines 2, 13): "
         "the diagnosis needs it in every row; fill or drop those rows");
+  // A cycle or a direction with gaps too (neither needs to vary).
+  CHECK(gap_error(rows("cycle", {5}, 12)) ==
+        "b.csv:7:8: column 'cycle' is empty in 1 row where a deviation is measured (line 7): the "
+        "diagnosis needs it in every row; fill or drop those rows");
+  std::string dir = "X,Y,Z,dir_X,dx_um\n";
+  for (int i = 0; i < 12; ++i)
+    dir += std::to_string(i * 10) + ",0,0," + (i == 8 ? "" : "1") + ",1\n";
+  CHECK(gap_error(dir) ==
+        "b.csv:10:8: column 'dir_X' is empty in 1 row where a deviation is measured (line 10): "
+        "the diagnosis needs it in every row; fill or drop those rows");
   // A row that measures nothing may leave the covariate empty.
   std::string unmeasured = rows("rpm", {}, 12) + "5,0,0,,\n";
   CHECK_NOTHROW(gap_data(parse_measurements(unmeasured, "b.csv"), desc));
