@@ -294,9 +294,10 @@ TEST_CASE("gap: bad data get a message, not a verdict") {
   for (int i = 0; i < 12; ++i)
     nan += std::to_string(i * 10) + ",0,0," + (i == 4 || i == 7 ? "" : "21." + std::to_string(i)) +
            ",1\n";
-  CHECK(error_of(nan) ==
-        "b.csv:6: column 'T_a' is empty in 2 rows where a deviation is measured (lines 6, 9): the "
-        "diagnosis needs it in every row; fill or drop those rows");
+  CHECK(
+      error_of(nan) ==
+      "b.csv:6:8: column 'T_a' is empty in 2 rows where a deviation is measured (lines 6, 9): the "
+      "diagnosis needs it in every row; fill or drop those rows");
   CHECK(error_of("X,Y,Z,dx_um\n0,0,0,1\n1,0,0,2\n") ==
         "b.csv: only 2 observations: the diagnosis needs at least 10");
   std::string few = "X,Y,Z,cycle,dx_um\n";
@@ -308,23 +309,7 @@ TEST_CASE("gap: bad data get a message, not a verdict") {
   CHECK(error_of("Y,Z,dx_um\n0,0,1\n") ==
         "b.csv:1: missing column 'X' (give the coordinate of a pose the data do not vary with "
         "--at X=VALUE; columns: Y, Z, dx_um)");
-  // A rotary coordinate in radians where five_axis_ac says degrees.
-  {
-    const Description& five = test::builtin_model("five_axis_ac")->description();
-    std::string rad = "X,Y,Z,A,C,dx_um\n";
-    for (int i = 0; i < 12; ++i)
-      rad += "10,0,-100,0," + std::to_string(0.5 * i) + "," + std::to_string(i) + "\n";
-    std::string message;
-    try {
-      gap_data(parse_measurements(rad, "r.csv"), five);
-    } catch (const InputError& e) {
-      message = e.what();
-    }
-    CHECK(
-        message ==
-        "r.csv:13:13: column 'C' looks like radians: every value lies within ±2π (0 .. 5.5) while "
-        "C is in deg over [-360, 360] deg; write it in degrees");
-  }
+  // A rotary coordinate in radians, a covariate with gaps: tests/test_gap_input.cpp.
   CHECK_THROWS_WITH_AS(parse_holdout("weekly"),
                        "--holdout \"weekly\": unknown scheme 'weekly' (expected cycle[:K], "
                        "time[:K], space[:AXIS][:K], forward[:FRACTION] or auto)",

@@ -189,8 +189,58 @@ std::string MeasurementTable::header_key(const std::string& key,
 
 namespace {
 
+// An angle column in degrees that holds radians (docs/data-format.md, "Angles in radians"). The
+// radian reading must be possible: the column turns (3 or more distinct values), every value
+// lies within ±2π and, read as radians, inside the travel [min, max] deg of an axis that turns
+// 90° or more. Then, when the values read as radians land on whole degrees (0.523599 = 30°, each
+// of 2 or more nonzero values within 0.03°, half the rounding of 3 decimals) and are not whole
+// numbers as written, it is an error; when only the range says so (the data would turn the axis
+// by 0.5 to 2π degrees of its travel) it is a warning: a short sweep in degrees is possible.
+void check_radians(const MeasurementTable& t, std::size_t c, double min, double max,
+                   std::vector<std::string>& warnings) {
+  const std::string& name = t.columns[c];
+  const std::vector<double>& v = t.values.at(name);
+  constexpr double kPi = 3.14159265358979323846, kDeg = 180 / kPi;
+  if (max - min < 90) return;
+  std::vector<double> seen;
+  std::size_t at = 0;  // the row of the largest magnitude
+  for (std::size_t row = 0; row < v.size(); ++row) {
+    const double x = v[row];
+    if (std::isnan(x)) continue;
+    if (std::fabs(x) > 2 * kPi + 1e-6 || x * kDeg < min - 1 || x * kDeg > max + 1) return;
+    if (std::find(seen.begin(), seen.end(), x) == seen.end()) seen.push_back(x);
+    if (std::fabs(x) > std::fabs(v[at]) || std::isnan(v[at])) at = row;
+  }
+  if (seen.size() < 3) return;
+  const auto [lo, hi] = std::minmax_element(seen.begin(), seen.end());
+  std::size_t nonzero = 0;
+  bool whole_as_radians = true, whole_as_written = true;
+  for (double x : seen) {
+    if (x == 0) continue;
+    ++nonzero;
+    whole_as_radians = whole_as_radians && std::fabs(x * kDeg - std::round(x * kDeg)) <= 0.03;
+    whole_as_written = whole_as_written && x == std::round(x);
+  }
+  const SourceLoc cell{t.file, t.lines[at], t.cell_columns[at][c]};
+  const std::string range = " (" + format_short(*lo) + " .. " + format_short(*hi) + ") while " +
+                            name + " is in deg over [" + format_short(min) + ", " +
+                            format_short(max) + "] deg";
+  if (nonzero >= 2 && whole_as_radians && !whole_as_written)
+    throw InputError(cell, "column '" + name + "' looks like radians: every value lies within ±2π" +
+                               range + ", and read as radians they are whole degrees (" +
+                               format_short(v[at]) +
+                               " rad = " + format_short(std::round(v[at] * kDeg)) +
+                               " deg); write it in degrees (times 180/π)");
+  if (*hi - *lo >= 0.5)
+    warnings.push_back(cell.str() + ": warning: column '" + name +
+                       "' looks like radians: every value lies within ±2π" + range +
+                       ", so as degrees the data turn " + name + " by only " +
+                       format_short(*hi - *lo) +
+                       " deg; if they are radians, write them in degrees");
+}
+
 // The checks that need every row: the machine named in the header, values that cannot be real,
-// coordinates outside the travel (docs/data-format.md, "Checks on values").
+// coordinates outside the travel, angles in radians (docs/data-format.md, "Checks on values").
 void check_values(MeasurementTable& t, const ReadOptions& o) {
   const auto where = [&](std::size_t row, std::size_t c) {
     return SourceLoc{t.file, t.lines[row], t.cell_columns[row][c]};
@@ -242,6 +292,13 @@ void check_values(MeasurementTable& t, const ReadOptions& o) {
   if (more > 0)
     t.warnings.push_back(t.file + ": warning: " + std::to_string(more) +
                          " more value(s) like those above");
+  for (std::size_t c = 0; c < t.columns.size(); ++c) {
+    if (t.info[c].role == ColumnRole::Angle) check_radians(t, c, -360, 720, t.warnings);
+    for (const auto& r : o.travel)
+      if (r.coordinate == t.columns[c] && r.unit == "deg" &&
+          t.info[c].role == ColumnRole::Coordinate)
+        check_radians(t, c, r.min, r.max, t.warnings);
+  }
 }
 
 }  // namespace

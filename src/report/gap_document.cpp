@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "weilgen/base/format.hpp"
+#include "weilgen/measure/measurement_csv.hpp"
 #include "weilgen/report/csv_table.hpp"
 #include "weilgen/report/json_common.hpp"
 
@@ -68,6 +69,18 @@ json effect_json(const EffectFit& e, const std::array<std::size_t, kObservationK
   return j;
 }
 
+std::string not_distinguishable(const EffectFit& e) {
+  return " (needs " + std::to_string(e.shape_dof_used) + " shape degrees of freedom where the " +
+         "data leave " + std::to_string(e.shape_dof_free) + ": any shape fits)";
+}
+
+// What a candidate's row says: its fit when significant; a rejected candidate's parameters
+// are whatever least squares made of noise (a tool offset of -2.6e5 mm) and are not shown.
+std::string candidate_text(const EffectFit& e) {
+  if (!e.significant) return "not significant";
+  return e.summary + (e.distinguishable ? "" : not_distinguishable(e));
+}
+
 }  // namespace
 
 std::string gap_csv(const GapResult& r, const std::string& data) {
@@ -91,7 +104,7 @@ std::string gap_csv(const GapResult& r, const std::string& data) {
     t.count(k + 1).text(e.name).text(e.variant).count(e.extra_parameters);
     t.number(e.heldout_rms_before_um).number(e.heldout_rms_after_um).number(e.shrink_pct);
     t.number(e.explained_fraction).number(e.f_statistic).number(e.p_value);
-    t.text(e.significant ? "yes" : "no").text(explains ? "yes" : "no").text(e.summary);
+    t.text(e.significant ? "yes" : "no").text(explains ? "yes" : "no").text(candidate_text(e));
     t.end_row();
   }
   return t.str();
@@ -142,22 +155,6 @@ nlohmann::json gap_json(const GapResult& r, const Model& model, const std::strin
                           {"remaining_excess_um", json_number(r.final_excess_um)},
                           {"remaining_p_value", json_number(r.final_p_value)}}}});
 }
-
-namespace {
-
-std::string not_distinguishable(const EffectFit& e) {
-  return " (needs " + std::to_string(e.shape_dof_used) + " shape degrees of freedom where the " +
-         "data leave " + std::to_string(e.shape_dof_free) + ": any shape fits)";
-}
-
-// What a candidate's row says: its fit when significant; a rejected candidate's parameters
-// are whatever least squares made of noise (a tool offset of -2.6e5 mm) and are not shown.
-std::string candidate_text(const EffectFit& e) {
-  if (!e.significant) return "not significant";
-  return e.summary + (e.distinguishable ? "" : not_distinguishable(e));
-}
-
-}  // namespace
 
 std::string gap_text(const GapResult& r, const Model& model, const std::string& data,
                      bool markdown) {
@@ -253,10 +250,12 @@ namespace {
 LinePlot residual_plot(const GapData& d, const GapResult& r, const std::string& by) {
   LinePlot p;
   p.title = "held-out residual RMS along " + by;
-  p.xlabel = by;
+  // In the dimension's unit: the machine's for a coordinate, else the data format's (degC, 1/min).
+  std::string unit = classify_column(by, ReadOptions{}).unit;
   for (std::size_t a = 0; a < d.axes.size() && a < d.axis_units.size(); ++a)
-    if (d.axes[a] == by) p.xlabel = by + " (" + d.axis_units[a] + ")";
-  if (by == "t_s") p.xlabel = "t (s)";
+    if (d.axes[a] == by) unit = d.axis_units[a];
+  p.xlabel = by == "t_s" ? "t" : by;
+  if (!unit.empty()) p.xlabel += " (" + unit + ")";
   p.ylabel = "RMS (µm)";
   const auto& obs = d.points.observations;
   std::vector<std::pair<double, std::size_t>> key;
@@ -297,9 +296,10 @@ LinePlot residual_plot(const GapData& d, const GapResult& r, const std::string& 
     before.push_back(std::sqrt(sb / n));
     after.push_back(std::sqrt(sa / n));
   }
-  p.lines = {{"baseline", before},
-             {"with the explanation", after},
-             {"noise floor", std::vector<double>(before.size(), r.noise.sigma_um)}};
+  // Without an accepted effect "after" is "before": one line, not two on top of each other.
+  p.lines = {{"baseline", before}};
+  if (!r.explanation.empty()) p.lines.push_back({"with the explanation", after});
+  p.lines.push_back({"noise floor", std::vector<double>(before.size(), r.noise.sigma_um)});
   return p;
 }
 

@@ -13,6 +13,7 @@ CSVs, a tolerance file) and outputs that already exist ("previous"). A case pass
 Usage: hostile_cli.py WEILGEN SOURCE_DIR [-v] [-k SUBSTRING]
 """
 import hashlib
+import math
 import os
 import re
 import shutil
@@ -243,6 +244,16 @@ CASES = [
     ("identify vmc_3axis --data p.csv --predict sub --quiet", 3, ["sub:", "is a directory"]),
     ("gap vmc_3axis --data sub --quiet", 3, ["sub:", "is a directory"]),
     ("gap gantry_grinder --data p.csv --quiet", 3, ["p.csv:4:", "'# machine: vmc_3axis'"]),
+    # Issue 14, bad input: a rotary column in radians (the reader: gap and identify alike), a
+    # covariate with gaps (every empty row named, the first cell located).
+    ("gap five_axis_ac --data rad.csv --quiet --json keep.json", 3,
+     ["rad.csv:13:15: column 'C' looks like radians", "write it in degrees"]),
+    ("identify five_axis_ac --data rad.csv --quiet --json keep.json", 3,
+     ["rad.csv:13:15: column 'C' looks like radians"]),
+    ("gap vmc_3axis --data gap_t.csv --quiet --json keep.json --report keep.md --plot plots", 3,
+     ["gap_t.csv:", "column 't_s' is empty in 2 rows where a deviation is measured (lines "]),
+    ("gap vmc_3axis --data nan_t.csv --quiet --json keep.json", 3,
+     ["nan_t.csv:", "column 't_s': 'nan' is not a number"]),
 ]
 
 
@@ -285,11 +296,25 @@ def fixtures(d):
     x = list(pts)
     x[head + 1] = "," + x[head + 1].split(",", 1)[1]
     w("empty_x.csv", "\n".join(x))
-    big = list(pts)
-    cells = big[head + 1].split(",")
-    cells[cols.index("dx_um")] = "1e300"
-    big[head + 1] = ",".join(cells)
-    w("dev1e300.csv", "\n".join(big))
+
+    def points_with(path, name, cells_by_row):
+        """vmc_3axis_points.csv with the cells {data row: value} of column `name` replaced."""
+        out = list(pts)
+        for k, value in cells_by_row.items():
+            cells = out[head + k].split(",")
+            cells[cols.index(name)] = value
+            out[head + k] = ",".join(cells)
+        w(path, "\n".join(out))
+
+    points_with("dev1e300.csv", "dx_um", {1: "1e300"})
+    points_with("gap_t.csv", "t_s", {3: "", 7: ""})  # t_s empty in two measured rows
+    points_with("nan_t.csv", "t_s", {2: "nan"})
+    # five_axis_ac poses with C at 0, 30 ... 330 deg written in radians (line 13: 330 deg).
+    rows = ["X,Y,Z,A,C,t_s,dx_um"]
+    for i, a in enumerate((-30, 0, 30)):
+        for k in range(12):
+            rows.append(f"10,0,-100,{a},{math.radians(30 * k):.6f},{60 * (12 * i + k)},{0.1 * k:.1f}")
+    w("rad.csv", "\n".join(rows) + "\n")
 
 
 def snapshot(d):

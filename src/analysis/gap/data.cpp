@@ -82,31 +82,8 @@ GapData gap_data(const MeasurementTable& table, const Description& desc,
     t.info.push_back(info);
     g.fixed_axes.push_back(c);
   }
-  // A rotary coordinate written in radians where the machine says degrees: every value within
-  // ±2π while the axis travels over 90° or more, and the data turning it by more than a degree.
-  for (int b : desc.axes()) {
-    const Joint& j = desc.bodies[static_cast<std::size_t>(b)].joint;
-    if (trace || j.type != JointType::Revolute || j.unit != "deg" || !t.has(j.coordinate) ||
-        std::count(g.fixed_axes.begin(), g.fixed_axes.end(), j.coordinate))
-      continue;
-    const std::vector<double>& v = t.column(j.coordinate);
-    double lo = INFINITY, hi = -INFINITY;
-    for (double x : v)
-      if (std::isfinite(x)) lo = std::min(lo, x), hi = std::max(hi, x);
-    const double two_pi = 2 * 3.14159265358979323846;
-    if (hi > lo + 1 && lo >= -two_pi - 1e-9 && hi <= two_pi + 1e-9 && j.max - j.min >= 90 &&
-        distinct(v) >= 5) {
-      std::size_t r = 0;
-      while (r < v.size() && !(std::isfinite(v[r]) && v[r] == hi)) ++r;
-      throw InputError(r < v.size() ? t.cell(r, j.coordinate) : SourceLoc{t.file, t.header_line, 0},
-                       "column '" + j.coordinate +
-                           "' looks like radians: every value lies within "
-                           "±2π (" +
-                           format_short(lo) + " .. " + format_short(hi) + ") while " +
-                           j.coordinate + " is in deg over [" + format_short(j.min) + ", " +
-                           format_short(j.max) + "] deg; write it in degrees");
-    }
-  }
+  // A rotary coordinate in radians where the machine says degrees is the reader's check
+  // (measurement_csv.cpp, check_radians): identify reads the same columns.
   g.points = trace ? ballbar_points(t, desc, ballbar, parameters, g.circle) : point_data(t, desc);
   const std::size_t rows = t.rows();
   g.time_s = t.has("t_s") ? t.column("t_s") : std::vector<double>(rows, kNaN);
@@ -114,13 +91,16 @@ GapData gap_data(const MeasurementTable& table, const Description& desc,
   // Observed rows only decide what varies.
   std::vector<bool> observed(rows, false);
   for (const PointObservation& o : g.points.observations) observed[o.row] = true;
-  auto check_varies = [&](const std::string& name, const std::vector<double>& v, const char* unit) {
+  // Every measured row needs the column's value (a gap is named with its rows); a covariate must
+  // also vary, a direction or a cycle need not (one direction, one cycle).
+  auto check_varies = [&](const std::string& name, const std::vector<double>& v, const char* unit,
+                          bool must_vary = true) {
     double lo = INFINITY, hi = -INFINITY;
-    std::vector<int> gaps;  // lines of measured rows without a value
+    std::vector<std::size_t> gaps;  // measured rows without a value
     for (std::size_t r = 0; r < rows; ++r) {
       if (!observed[r]) continue;
       if (!std::isfinite(v[r])) {
-        gaps.push_back(t.lines[r]);
+        gaps.push_back(r);
         continue;
       }
       lo = std::min(lo, v[r]), hi = std::max(hi, v[r]);
@@ -128,15 +108,15 @@ GapData gap_data(const MeasurementTable& table, const Description& desc,
     if (!gaps.empty()) {
       std::string list;
       for (std::size_t k = 0; k < gaps.size() && k < 10; ++k)
-        list += (k ? ", " : "") + std::to_string(gaps[k]);
+        list += (k ? ", " : "") + std::to_string(t.lines[gaps[k]]);
       if (gaps.size() > 10) list += " and " + std::to_string(gaps.size() - 10) + " more";
-      throw InputError(SourceLoc{t.file, gaps.front(), 0},
+      throw InputError(t.cell(gaps.front(), name),
                        "column '" + name + "' is empty in " + std::to_string(gaps.size()) + " row" +
-                           (gaps.size() > 1 ? "s" : "") + " where a deviation is measured (lines " +
-                           list +
+                           (gaps.size() > 1 ? "s" : "") + " where a deviation is measured (line" +
+                           (gaps.size() > 1 ? "s " : " ") + list +
                            "): the diagnosis needs it in every row; fill or drop those rows");
     }
-    if (!(hi > lo))
+    if (must_vary && !(hi > lo))
       throw InputError(SourceLoc{t.file, t.header_line, 0},
                        "column '" + name + "' is constant (" + format_short(lo) + " " + unit +
                            "): it cannot explain anything; drop the column");
@@ -150,6 +130,7 @@ GapData gap_data(const MeasurementTable& table, const Description& desc,
     g.covariate[c] = t.column(c);
   }
   if (t.has("t_s")) check_varies("t_s", g.time_s, "s");
+  if (t.has("cycle")) check_varies("cycle", g.cycle, "", false);
   // Directions: dir_<axis>, or `dir` for the axis that varies most.
   if (trace) {
     check_varies("angle_deg", t.column("angle_deg"), "deg");
@@ -169,6 +150,7 @@ GapData gap_data(const MeasurementTable& table, const Description& desc,
         if (n > best) best = n, axis = a;
       }
     }
+    check_varies(c, t.column(c), "", false);
     if (!axis.empty()) g.dir[axis] = t.column(c);
   }
   if (g.points.observations.size() < 10)
