@@ -71,6 +71,8 @@ struct Builder {
   SymbolicModel& model;
   const Algebra& alg;
   CanonicalText& canon;
+  // as_fraction by coefficient: at order 3 the same coefficient recurs in many monomials.
+  std::map<ex, ex, GiNaC::ex_is_less>& fractions;
 
   void unit_vector(const Vec3& v, ex (&u)[3]) const {
     for (int i = 0; i < 3; ++i) u[i] = exact_decimal(v[i]);
@@ -237,7 +239,34 @@ struct Builder {
     std::vector<const Reciprocal*> present;
     for (const Reciprocal& r : model.reciprocals)
       if (c.has(r.symbol)) present.push_back(&r);
-    return present.empty() ? c : over_divisors(c, present);
+    if (present.empty()) return c;
+    const auto it = fractions.find(c);
+    if (it != fractions.end()) return it->second;
+    return fractions.emplace(c, over_divisors(c, present)).first->second;
+  }
+
+  static bool is_monomial(const ex& d) {
+    if (GiNaC::is_a<GiNaC::symbol>(d) || GiNaC::is_a<GiNaC::numeric>(d)) return true;
+    if (GiNaC::is_a<GiNaC::power>(d))
+      return GiNaC::is_a<GiNaC::symbol>(d.op(0)) && d.op(1).info(GiNaC::info_flags::posint);
+    if (!GiNaC::is_a<GiNaC::mul>(d)) return false;
+    for (std::size_t i = 0; i < d.nops(); ++i)
+      if (!is_monomial(d.op(i))) return false;
+    return true;
+  }
+
+  // n = d·q with q a polynomial. A monomial divisor (2·y) divides when every term has its
+  // powers; a sum is tried by the cheap test first, then by GiNaC's exact division.
+  static bool divides_exactly(const ex& n, const ex& d, ex& q) {
+    if (is_monomial(d)) {
+      GiNaC::exset syms;
+      collect_symbols(d, syms);
+      for (const ex& s : syms)
+        if (n.ldegree(s) < d.degree(s)) return false;
+      q = (n / d).expand();
+      return true;
+    }
+    return may_divide(n, d) && GiNaC::divide(n, d, q);
   }
 
   // False when d certainly does not divide n: n does not vanish at a rational point of d = 0 (every
@@ -292,10 +321,10 @@ struct Builder {
         acc += num.coeff(present[i]->symbol, j) * GiNaC::pow(den[i], k[i] - j);
       num = acc.expand();
     }
+    if (num.is_zero()) return 0;  // c vanishes: the reciprocals' terms cancel
     try {
       for (std::size_t i = 0; i < present.size(); ++i)
-        for (ex q; k[i] > 0 && may_divide(num, den[i]) && GiNaC::divide(num, den[i], q); --k[i])
-          num = q;
+        for (ex q; k[i] > 0 && divides_exactly(num, den[i], q); --k[i]) num = q;
     } catch (const std::exception&) {
       return c;  // not a polynomial over the rationals (a function of a linked angle): as it is
     }
@@ -551,7 +580,8 @@ SymbolicModel build_model(const Description& desc, int order_override) {
   const Algebra alg(model.order, relation_monomials(desc), trig_rules);
   model.relations = alg.relations();
   CanonicalText canon;
-  const Builder b{desc, model, alg, canon};
+  std::map<ex, ex, GiNaC::ex_is_less> fractions;
+  const Builder b{desc, model, alg, canon, fractions};
 
   // P: the tool frame (at the tool point) in the workpiece frame, or the output transform.
   const Mat4 p = desc.output
