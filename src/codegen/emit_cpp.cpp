@@ -184,7 +184,8 @@ struct Coefficients {
       }
     }
     GiNaC::exvector parts{factored_sum(std::move(direct), errors)};
-    for (auto& [name, g] : grouped) parts.push_back(g.first * factored_sum(std::move(g.second), errors));
+    for (auto& [name, g] : grouped)
+      parts.push_back(g.first * factored_sum(std::move(g.second), errors));
     return GiNaC::add(parts);
   }
 };

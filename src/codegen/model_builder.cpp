@@ -288,9 +288,9 @@ struct Builder {
       GiNaC::exmap rest = at;
       rest.erase(s);
       const ex a = d.coeff(s, 1);
-      rest[s] = (-(d - a * s) / a).subs(rest).expand();
+      rest[s] = (-(d - a * s) / a).subs(rest, GiNaC::subs_options::no_pattern).expand();
       if (!GiNaC::is_a<GiNaC::numeric>(rest[s])) return true;
-      const ex v = n.subs(rest).expand();
+      const ex v = n.subs(rest, GiNaC::subs_options::no_pattern).expand();
       return !GiNaC::is_a<GiNaC::numeric>(v) || v.is_zero();
     }
     return true;
@@ -304,8 +304,8 @@ struct Builder {
     for (std::size_t i = 0; i < e.nops(); ++i) collect_symbols(e.op(i), out);
   }
 
-  // The reciprocals r_i = 1/D_i present in c: c = N / Π D_i^K_i with N a polynomial; each D_i is divided
-  // out of N while it divides exactly (no gcd: the divisors are distinct, and a divisor is
+  // The reciprocals r_i = 1/D_i present in c: c = N / Π D_i^K_i with N a polynomial; each D_i is
+  // divided out of N while it divides exactly (no gcd: the divisors are distinct, and a divisor is
   // removed only when it divides N). A polynomial, or N·r_i over one remaining D_i, replaces c;
   // anything else stays as it is.
   ex over_divisors(const ex& c, const std::vector<const Reciprocal*>& present) const {
@@ -519,7 +519,7 @@ ex SymbolicModel::with_divisors(const ex& c) const {
   if (reciprocals.empty()) return c;
   GiNaC::exmap m;
   for (const Reciprocal& r : reciprocals) m[r.symbol] = GiNaC::pow(r.divisor, -1);
-  return c.subs(m);
+  return c.subs(m, GiNaC::subs_options::no_pattern);  // symbols only: no pattern matching
 }
 
 ex SymbolicModel::coefficient(int o, const Monomial& m) const {
