@@ -82,3 +82,23 @@ TEST_CASE("Neumann inverse of a chain with symbolic nominal rotation is exact in
   for (int i = 0; i < 4; ++i)
     for (int j = 0; j < 4; ++j) CHECK((p.m[i][j] - Poly(i == j ? 1 : 0)).is_zero());
 }
+
+TEST_CASE("factored_sum: nested form equal to the sum of monomials, with fewer products") {
+  const std::vector<GiNaC::symbol> e = {GiNaC::symbol("a"), GiNaC::symbol("b"), GiNaC::symbol("c")};
+  const GiNaC::symbol k("k");
+  const std::vector<std::pair<Monomial, ex>> terms = {
+      {{0}, 3}, {{0, 0}, 2}, {{0, 1}, k}, {{0, 1, 2}, -1}, {{1, 2}, ex(1) / 2}, {{2}, k * k}};
+  ex flat = 0;
+  for (const auto& [m, c] : terms) {
+    ex t = c;
+    for (auto i : m) t *= e[i];
+    flat += t;
+  }
+  const ex nested = factored_sum(terms, e);
+  CHECK((nested - flat).expand().is_zero());
+  // a occurs in four terms and is factored out first, b then c in what is left:
+  // a·(3 + 2a + b·(k − c)) + c·(b/2 + k²): two top-level terms instead of six.
+  REQUIRE(GiNaC::is_a<GiNaC::add>(nested));
+  CHECK(nested.nops() == 2);
+  CHECK(nested.expand().nops() == terms.size());
+}

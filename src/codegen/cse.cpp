@@ -90,7 +90,15 @@ const std::string& CanonicalText::of(const ex& e) {
 }
 
 CanonicalText::Signed CanonicalText::canonical_sign(const ex& sum) {
-  const ex neg = (-sum).expand();
+  // Term by term, not expand(): a nested (factored) sum keeps its form.
+  ex neg;
+  if (GiNaC::is_a<GiNaC::add>(sum)) {
+    GiNaC::exvector terms;
+    for (std::size_t i = 0; i < sum.nops(); ++i) terms.push_back(-sum.op(i));
+    neg = GiNaC::add(terms);
+  } else {
+    neg = (-sum).expand();
+  }
   if (of(neg) < of(sum)) return {neg, true};
   return {sum, false};
 }
@@ -132,6 +140,19 @@ struct Eliminator {
   CseResult result;
   std::string prefix;
 
+  // A product's key ignores its sign: GiNaC may hold x·(a − b) in one run and −x·(b − a) in the
+  // next (the sign of a sum inside a product follows hash order), and both must share one
+  // temporary whose value has the canonical sign.
+  std::string key_of(const ex& node) {
+    return GiNaC::is_a<GiNaC::mul>(node) ? canon.unsigned_text(node) : canon.of(node);
+  }
+  // −1 when the canonical text of a product has a negative coefficient, else 1.
+  int canonical_sign_of(const ex& node) {
+    if (!GiNaC::is_a<GiNaC::mul>(node)) return 1;
+    const std::string& t = canon.of(node);
+    return t.size() > 4 && t[4] == '-' ? -1 : 1;
+  }
+
   void tally(const ex& node) {
     if (is_atom(node)) return;
     const ex core = strip_coefficient(node);
@@ -139,7 +160,7 @@ struct Eliminator {
       tally(core);
       return;
     }
-    if (count[canon.of(node)]++ > 0) return;
+    if (count[key_of(node)]++ > 0) return;
     for (const ex& op : canon.sorted_ops(node)) tally(op);
   }
 
@@ -147,8 +168,9 @@ struct Eliminator {
     if (is_atom(node)) return node;
     const ex core = strip_coefficient(node);
     if (!core.is_equal(node)) return rewrite(core) * (node / core).expand();
-    const std::string& key = canon.of(node);
-    if (auto it = replaced.find(key); it != replaced.end()) return it->second;
+    const std::string key = key_of(node);
+    const int sign = canonical_sign_of(node);
+    if (auto it = replaced.find(key); it != replaced.end()) return sign * it->second;
     ex rebuilt;
     if (GiNaC::is_a<GiNaC::add>(node)) {
       GiNaC::exvector v;
@@ -168,6 +190,8 @@ struct Eliminator {
       } rewriter(this);
       rebuilt = node.map(rewriter);
     }
+    // A product is stored with the canonical sign (positive coefficient) and used as sign·value.
+    if (sign < 0) rebuilt = -rebuilt;
     if (count[key] >= 2) {
       GiNaC::symbol t(prefix + std::to_string(result.temps.size()));
       // A sum's sign is GiNaC's (hash-order) choice: store the canonical sign in the temporary.
@@ -179,10 +203,10 @@ struct Eliminator {
       }
       result.temps.push_back({t, value});
       replaced.emplace(key, use);
-      return use;
+      return sign * use;
     }
     replaced.emplace(key, rebuilt);
-    return rebuilt;
+    return sign * rebuilt;
   }
 };
 }  // namespace

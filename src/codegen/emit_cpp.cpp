@@ -118,6 +118,7 @@ void collect_symbols(const ex& e, std::set<std::string>& out) {
 struct OutputGroup {
   std::string pointer;  // argument name
   std::vector<ex> values;
+  bool fill_zeros = false;  // one fill() instead of an assignment per zero (sparse outputs)
 };
 
 // Named coefficient polynomials of a Deviation-style function: every coefficient that is a sum
@@ -167,23 +168,25 @@ struct Coefficients {
     return std::make_pair(factor, it->second);
   }
 
-  // Σ c_m · monomial_m of one output, grouped by placeholder.
+  // Σ c_m · monomial_m of one output, grouped by placeholder, each group's monomials (and those
+  // with an inline coefficient) in nested form (factored_sum).
   ex output(const Poly& p, const std::vector<GiNaC::symbol>& errors) {
-    GiNaC::exvector direct;
-    std::map<std::string, std::pair<GiNaC::symbol, GiNaC::exvector>> grouped;
+    using Terms = std::vector<std::pair<Monomial, ex>>;
+    Terms direct;
+    std::map<std::string, std::pair<GiNaC::symbol, Terms>> grouped;
     for (const auto& [mono, c] : p.terms()) {
-      ex monomial = 1;
-      for (auto i : mono) monomial *= errors[i];
       if (auto s = split(c)) {
         auto& g = grouped[s->second.get_name()];
         g.first = s->second;
-        g.second.push_back(s->first * monomial);
+        g.second.emplace_back(mono, s->first);
       } else {
-        direct.push_back(c * monomial);
+        direct.emplace_back(mono, c);
       }
     }
-    for (auto& [name, g] : grouped) direct.push_back(g.first * GiNaC::add(g.second));
-    return GiNaC::add(direct);
+    GiNaC::exvector parts{factored_sum(std::move(direct), errors)};
+    for (auto& [name, g] : grouped)
+      parts.push_back(g.first * factored_sum(std::move(g.second), errors));
+    return GiNaC::add(parts);
   }
 };
 
@@ -245,7 +248,9 @@ FunctionCode function_body(const InputTable& inputs, const std::vector<OutputGro
   for (const auto& g : groups) {
     os << "  if (" << g.pointer << " != nullptr) {\n";
     os << "    auto& _" << g.pointer << " = *" << g.pointer << ";\n";
+    if (g.fill_zeros) os << "    _" << g.pointer << ".fill(Scalar(0));\n";
     for (std::size_t i = 0; i < g.values.size(); ++i, ++k) {
+      if (g.fill_zeros && cse.outputs[k].is_zero()) continue;
       os << "    _" << g.pointer << "[" << i << "] = " << printer.print(cse.outputs[k]) << ";\n";
     }
     os << "  }\n";
@@ -288,7 +293,7 @@ std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_la
     std::vector<ex> h;
     for (int o = 0; o < 6; ++o)
       for (const auto& mono : higher) h.push_back(m.coefficient(o, mono));
-    high = function_body(inputs, {{"terms", h}});
+    high = function_body(inputs, {{"terms", h, true}});
   }
 
   // Nominal kinematics: the pose at zero errors and its Jacobian in the axes' units (a revolute

@@ -71,6 +71,8 @@ struct Builder {
   SymbolicModel& model;
   const Algebra& alg;
   CanonicalText& canon;
+  // as_fraction by coefficient: at order 3 the same coefficient recurs in many monomials.
+  std::map<ex, ex, GiNaC::ex_is_less>& fractions;
 
   void unit_vector(const Vec3& v, ex (&u)[3]) const {
     for (int i = 0; i < 3; ++i) u[i] = exact_decimal(v[i]);
@@ -230,44 +232,109 @@ struct Builder {
   // A coefficient with reciprocals as one fraction over a single divisor when it has one:
   // 1 + (L01 + x − L04)·_inv0 with _inv0 = 1/(L04 − L01 − x − LW) becomes −LW·_inv0. With one
   // reciprocal r = 1/D in c = Σ_k a_k r^k (k ≤ K): N = Σ_k a_k D^(K−k), so c = N r^K; D is divided
-  // out of N while it divides exactly (over_one_divisor: no gcd per coefficient). With several
-  // reciprocals GiNaC's normal(), which may cancel all but one divisor. Anything else (several
-  // divisors left, or a power of one) stays as it is.
+  // out of N while it divides exactly (no gcd per coefficient). With several reciprocals the
+  // same, divisor by divisor. Anything else (several divisors left, or a power of one) stays as
+  // it is.
   ex as_fraction(const ex& c) const {
-    const Reciprocal* only = nullptr;
-    std::size_t present = 0;
+    std::vector<const Reciprocal*> present;
     for (const Reciprocal& r : model.reciprocals)
-      if (c.has(r.symbol)) {
-        only = &r;
-        ++present;
-      }
-    if (present == 0) return c;
-    if (present == 1) return over_one_divisor(c, *only);
-    const ex nd = GiNaC::normal(model.with_divisors(c)).numer_denom();
-    const ex num = nd.op(0).expand(), den = nd.op(1).expand();
-    if (GiNaC::is_a<GiNaC::numeric>(den)) return alg.normalize(num / den);
-    for (const Reciprocal& r : model.reciprocals) {
-      if ((den - r.divisor).expand().is_zero()) return alg.normalize(num * r.symbol);
-      if ((den + r.divisor).expand().is_zero()) return alg.normalize(-num * r.symbol);
-    }
-    return c;
+      if (c.has(r.symbol)) present.push_back(&r);
+    if (present.empty()) return c;
+    const auto it = fractions.find(c);
+    if (it != fractions.end()) return it->second;
+    return fractions.emplace(c, over_divisors(c, present)).first->second;
   }
 
-  ex over_one_divisor(const ex& c, const Reciprocal& r) const {
-    const ex e = c.expand();
-    int k_max = e.degree(r.symbol);
-    if (k_max <= 0) return c;
-    const ex den = r.divisor.expand();
-    ex num = 0;
-    for (int k = 0; k <= k_max; ++k) num += e.coeff(r.symbol, k) * GiNaC::pow(den, k_max - k);
-    num = num.expand();
+  static bool is_monomial(const ex& d) {
+    if (GiNaC::is_a<GiNaC::symbol>(d) || GiNaC::is_a<GiNaC::numeric>(d)) return true;
+    if (GiNaC::is_a<GiNaC::power>(d))
+      return GiNaC::is_a<GiNaC::symbol>(d.op(0)) && d.op(1).info(GiNaC::info_flags::posint);
+    if (!GiNaC::is_a<GiNaC::mul>(d)) return false;
+    for (std::size_t i = 0; i < d.nops(); ++i)
+      if (!is_monomial(d.op(i))) return false;
+    return true;
+  }
+
+  // n = d·q with q a polynomial. A monomial divisor (2·y) divides when every term has its
+  // powers; a sum is tried by the cheap test first, then by GiNaC's exact division.
+  static bool divides_exactly(const ex& n, const ex& d, ex& q) {
+    if (is_monomial(d)) {
+      GiNaC::exset syms;
+      collect_symbols(d, syms);
+      for (const ex& s : syms)
+        if (n.ldegree(s) < d.degree(s)) return false;
+      q = (n / d).expand();
+      return true;
+    }
+    return may_divide(n, d) && GiNaC::divide(n, d, q);
+  }
+
+  // False when d certainly does not divide n: n does not vanish at a rational point of d = 0 (every
+  // symbol but one at a fixed rational value, the last one, in which d is linear, at d's root).
+  // GiNaC's exact division is far dearer than this evaluation, and most divisions fail.
+  static bool may_divide(const ex& n, const ex& d) {
+    // Whatever point is drawn, the answer is the same (a divisor vanishes everywhere on d = 0).
+    GiNaC::exset syms;
+    collect_symbols(d, syms);
+    collect_symbols(n, syms);
+    GiNaC::exmap at;
+    int k = 0;
+    for (const ex& s : syms) {
+      at[s] = GiNaC::numeric(2 * (k % 7) + 3, 13 + 2 * k);
+      ++k;
+    }
+    for (const ex& s : syms) {
+      if (d.degree(s) != 1 || !GiNaC::is_a<GiNaC::numeric>(d.coeff(s, 1))) continue;
+      GiNaC::exmap rest = at;
+      rest.erase(s);
+      const ex a = d.coeff(s, 1);
+      rest[s] = (-(d - a * s) / a).subs(rest, GiNaC::subs_options::no_pattern).expand();
+      if (!GiNaC::is_a<GiNaC::numeric>(rest[s])) return true;
+      const ex v = n.subs(rest, GiNaC::subs_options::no_pattern).expand();
+      return !GiNaC::is_a<GiNaC::numeric>(v) || v.is_zero();
+    }
+    return true;
+  }
+
+  static void collect_symbols(const ex& e, GiNaC::exset& out) {
+    if (GiNaC::is_a<GiNaC::symbol>(e)) {
+      out.insert(e);
+      return;
+    }
+    for (std::size_t i = 0; i < e.nops(); ++i) collect_symbols(e.op(i), out);
+  }
+
+  // The reciprocals r_i = 1/D_i present in c: c = N / Π D_i^K_i with N a polynomial; each D_i is
+  // divided out of N while it divides exactly (no gcd: the divisors are distinct, and a divisor is
+  // removed only when it divides N). A polynomial, or N·r_i over one remaining D_i, replaces c;
+  // anything else stays as it is.
+  ex over_divisors(const ex& c, const std::vector<const Reciprocal*>& present) const {
+    ex num = c.expand();
+    std::vector<int> k(present.size(), 0);
+    std::vector<ex> den(present.size());
+    for (std::size_t i = 0; i < present.size(); ++i) {
+      den[i] = present[i]->divisor.expand();
+      k[i] = num.degree(present[i]->symbol);
+      if (k[i] <= 0) continue;
+      ex acc = 0;
+      for (int j = 0; j <= k[i]; ++j)
+        acc += num.coeff(present[i]->symbol, j) * GiNaC::pow(den[i], k[i] - j);
+      num = acc.expand();
+    }
+    if (num.is_zero()) return 0;  // c vanishes: the reciprocals' terms cancel
     try {
-      for (ex q; k_max > 0 && GiNaC::divide(num, den, q); --k_max) num = q;
+      for (std::size_t i = 0; i < present.size(); ++i)
+        for (ex q; k[i] > 0 && divides_exactly(num, den[i], q); --k[i]) num = q;
     } catch (const std::exception&) {
       return c;  // not a polynomial over the rationals (a function of a linked angle): as it is
     }
-    if (k_max > 1) return c;
-    return alg.normalize(k_max == 0 ? num : num * r.symbol);
+    const Reciprocal* left = nullptr;
+    for (std::size_t i = 0; i < present.size(); ++i) {
+      if (k[i] == 0) continue;
+      if (k[i] > 1 || left) return c;
+      left = present[i];
+    }
+    return alg.normalize(left ? num * left->symbol : num);
   }
 
   // P = Π steps · Trans(point), with the chain points' deviations P(e) − P(0) (base frame) and the
@@ -452,7 +519,7 @@ ex SymbolicModel::with_divisors(const ex& c) const {
   if (reciprocals.empty()) return c;
   GiNaC::exmap m;
   for (const Reciprocal& r : reciprocals) m[r.symbol] = GiNaC::pow(r.divisor, -1);
-  return c.subs(m);
+  return c.subs(m, GiNaC::subs_options::no_pattern);  // symbols only: no pattern matching
 }
 
 ex SymbolicModel::coefficient(int o, const Monomial& m) const {
@@ -513,7 +580,8 @@ SymbolicModel build_model(const Description& desc, int order_override) {
   const Algebra alg(model.order, relation_monomials(desc), trig_rules);
   model.relations = alg.relations();
   CanonicalText canon;
-  const Builder b{desc, model, alg, canon};
+  std::map<ex, ex, GiNaC::ex_is_less> fractions;
+  const Builder b{desc, model, alg, canon, fractions};
 
   // P: the tool frame (at the tool point) in the workpiece frame, or the output transform.
   const Mat4 p = desc.output

@@ -131,22 +131,29 @@ Poly Poly::scaled(const ex& c, const Algebra& alg) const {
 }
 
 Poly Poly::mul(const Poly& o, const Algebra& alg) const {
-  if (is_zero() || o.is_zero()) return {};
-  // o's terms by degree: a term of degree d meets only those of degree <= r - d, so the pairs
-  // that truncation drops are never visited.
+  return sum_of_products({{this, &o}}, alg);
+}
+
+Poly Poly::sum_of_products(const std::vector<std::pair<const Poly*, const Poly*>>& pairs,
+                           const Algebra& alg) {
+  // Raw products per monomial over all pairs, each sum normalised once.
   const int r = alg.order();
-  std::vector<std::vector<const Terms::value_type*>> by_degree(static_cast<std::size_t>(r) + 1);
-  for (const auto& t : o.terms_)
-    if (static_cast<int>(t.first.size()) <= r) by_degree[t.first.size()].push_back(&t);
-  // Sum raw products per monomial, normalise each sum once.
   std::map<Monomial, GiNaC::exvector> raw;
-  for (const auto& [ma, ca] : terms_) {
-    const int room = r - static_cast<int>(ma.size());
-    for (int d = 0; d <= room; ++d) {
-      for (const auto* tb : by_degree[static_cast<std::size_t>(d)]) {
-        Monomial m = monomial_product(ma, tb->first);
-        if (alg.vanishes(m)) continue;  // never formed: truncation inside the product
-        raw[std::move(m)].push_back(ca * tb->second);
+  for (const auto& [a, b] : pairs) {
+    if (a->is_zero() || b->is_zero()) continue;
+    // b's terms by degree: a term of degree d meets only those of degree <= r - d, so the pairs
+    // that truncation drops are never visited.
+    std::vector<std::vector<const Terms::value_type*>> by_degree(static_cast<std::size_t>(r) + 1);
+    for (const auto& t : b->terms_)
+      if (static_cast<int>(t.first.size()) <= r) by_degree[t.first.size()].push_back(&t);
+    for (const auto& [ma, ca] : a->terms_) {
+      const int room = r - static_cast<int>(ma.size());
+      for (int d = 0; d <= room; ++d) {
+        for (const auto* tb : by_degree[static_cast<std::size_t>(d)]) {
+          Monomial m = monomial_product(ma, tb->first);
+          if (alg.vanishes(m)) continue;  // never formed: truncation inside the product
+          raw[std::move(m)].push_back(ca * tb->second);
+        }
       }
     }
   }
@@ -168,6 +175,42 @@ ex Poly::to_ex(const std::vector<GiNaC::symbol>& error_symbols) const {
   return GiNaC::add(parts);
 }
 
+ex factored_sum(std::vector<std::pair<Monomial, ex>> terms,
+                const std::vector<GiNaC::symbol>& error_symbols) {
+  GiNaC::exvector parts;
+  while (!terms.empty()) {
+    std::map<std::uint16_t, int> count;  // terms in which each error occurs
+    for (const auto& t : terms) {
+      const Monomial& m = t.first;
+      for (std::size_t i = 0; i < m.size(); ++i)
+        if (i == 0 || m[i] != m[i - 1]) ++count[m[i]];
+    }
+    auto best = count.end();
+    for (auto it = count.begin(); it != count.end(); ++it)
+      if (best == count.end() || it->second > best->second) best = it;
+    if (best == count.end() || best->second < 2) break;
+    const std::uint16_t e = best->first;
+    std::vector<std::pair<Monomial, ex>> with, without;
+    for (auto& t : terms) {
+      auto pos = std::find(t.first.begin(), t.first.end(), e);
+      if (pos == t.first.end()) {
+        without.push_back(std::move(t));
+        continue;
+      }
+      t.first.erase(pos);
+      with.push_back(std::move(t));
+    }
+    parts.push_back(error_symbols.at(e) * factored_sum(std::move(with), error_symbols));
+    terms = std::move(without);
+  }
+  for (const auto& [m, c] : terms) {
+    ex t = c;
+    for (auto i : m) t *= error_symbols.at(i);
+    parts.push_back(t);
+  }
+  return GiNaC::add(parts);
+}
+
 Mat4 Mat4::identity() {
   Mat4 r;
   for (int i = 0; i < 4; ++i) r.m[i][i] = Poly(1);
@@ -180,12 +223,9 @@ Mat4 Mat4::mul(const Mat4& o, const Algebra& alg) const {
   Mat4 r;
   for (int i = 0; i < 4; ++i) {
     for (int j = 0; j < 4; ++j) {
-      Poly acc;
-      for (int k = 0; k < 4; ++k) {
-        if (m[i][k].is_zero() || o.m[k][j].is_zero()) continue;
-        acc = acc + m[i][k].mul(o.m[k][j], alg);
-      }
-      r.m[i][j] = acc;
+      std::vector<std::pair<const Poly*, const Poly*>> pairs;
+      for (int k = 0; k < 4; ++k) pairs.emplace_back(&m[i][k], &o.m[k][j]);
+      r.m[i][j] = Poly::sum_of_products(pairs, alg);
     }
   }
   return r;

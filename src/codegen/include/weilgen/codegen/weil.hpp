@@ -11,6 +11,7 @@
 
 #include <cstdint>
 #include <map>
+#include <utility>
 #include <vector>
 
 namespace weilgen::gen {
@@ -70,6 +71,10 @@ class Poly {
   Poly scaled(const GiNaC::ex& c, const Algebra& alg) const;
   // The truncating product.
   Poly mul(const Poly& o, const Algebra& alg) const;
+  // Σ a_k · b_k over the pairs, truncating, with one normalisation per monomial of the result
+  // (a matrix product's entry).
+  static Poly sum_of_products(const std::vector<std::pair<const Poly*, const Poly*>>& pairs,
+                              const Algebra& alg);
   // Σ coefficient · Π error_symbols[i]: the element as an expression.
   GiNaC::ex to_ex(const std::vector<GiNaC::symbol>& error_symbols) const;
 
@@ -77,6 +82,13 @@ class Poly {
   void add_term(const Monomial& m, const GiNaC::ex& c);
   Terms terms_;
 };
+
+// Σ c_k · Π error_symbols[m_k] in nested (Horner) form: the error that occurs in most terms is
+// factored out, recursively, so that every monomial costs about one multiplication and the text
+// grows with the number of terms rather than with their degree. Deterministic: ties go to the
+// smaller error index.
+GiNaC::ex factored_sum(std::vector<std::pair<Monomial, GiNaC::ex>> terms,
+                       const std::vector<GiNaC::symbol>& error_symbols);
 
 // A 4x4 matrix over the algebra (homogeneous transforms and their nilpotent parts).
 struct Mat4 {
