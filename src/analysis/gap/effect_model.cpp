@@ -180,8 +180,23 @@ void add_missing_error(const EffectContext& ctx, std::vector<Candidate>& out) {
     }
     return E;
   };
-  c.describe = [missing](const Variant& v, const VectorXd& coef, EffectFit& fit) {
+  c.describe = [missing, &d](const Variant& v, const VectorXd& coef, EffectFit& fit) {
     const Missing& mi = (*missing)[static_cast<std::size_t>(v.hyper[0])];
+    // Its region: along its axis' travel for a PDGE, all the data for a constant; the diagnosis
+    // puts it in the output where it removed the most.
+    GapRegion r;
+    r.by = "output";
+    if (mi.pdge) {
+      r.by = mi.coordinate;
+      r.from = mi.basis.a, r.to = mi.basis.b;
+    }
+    std::array<double, kObservationKinds> size{};  // the output it moves most, until then
+    for (std::size_t i = 0; i < d.points.observations.size(); ++i)
+      size[static_cast<std::size_t>(d.points.observations[i].output)] +=
+          std::abs(mi.unit(static_cast<Index>(i), 0));
+    r.output = observation_name(
+        static_cast<std::size_t>(std::max_element(size.begin(), size.end()) - size.begin()));
+    fit.region = r;
     const bool rot =
         mi.name.size() > 2 && (mi.name[2] == 'A' || mi.name[2] == 'B' || mi.name[2] == 'C');
     const char* unit = rot ? "µrad" : "µm";
