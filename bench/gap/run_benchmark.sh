@@ -5,7 +5,7 @@
 #   bench/gap/run_benchmark.sh WEILGEN [WORKDIR] [--quick] [--jobs N] [--machines M1,M2]
 #                              [--layouts L1,L2] [--effects E1,E2,pairs,outliers,hetero]
 #                              [--reps N] [--nones N] [--spindle DATA.csv | --no-spindle]
-#                              [--resume] [-- EXTRA GAP ARGS]
+#                              [--rotary-fourier H] [--resume] [-- EXTRA GAP ARGS]
 #
 # WEILGEN is the weilgen executable (or any program with its `gap` interface, e.g.
 # bench/gap/fake_gap.sh). WORKDIR defaults to build-gap/gap-bench. Results: WORKDIR/results.md
@@ -46,6 +46,9 @@ while [[ $# -gt 0 ]]; do
     --quick) synth_args+=(--quick); shift ;;
     --jobs) jobs=$2; shift 2 ;;
     --layouts | --reps | --nones | --machines | --effects) synth_args+=("$1" "$2"); shift 2 ;;
+    # Rotary PDGEs as Fourier series of H harmonics: the model keeps its default basis there
+    # (fourier:2 on a rotary axis, poly:3 on a linear one), so --pdge poly:3 is not passed.
+    --rotary-fourier) synth_args+=("$1" "$2"); gap_args=(); shift 2 ;;
     --spindle) spindle=$2; shift 2 ;;
     --no-spindle) spindle=; shift ;;
     --resume) resume=1; shift ;;

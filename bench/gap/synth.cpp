@@ -34,12 +34,17 @@ const char* const kUsage = R"(weilgen_gap_synth: synthetic measurement sets for 
 
   weilgen_gap_synth --effect E[+E2] --factor F --noise-um S --layout L --seed N --out DIR
                     [--machine vmc_3axis] [--missing E_AX] [--truth-degree 3] [--fit-degree 3]
+                    [--rotary-fourier H]
                     [--outliers N] [--hetero] [--observations N]
       one scenario: DIR/data.csv and DIR/truth.json; --observations N repeats the grid's
       cycles as often as needed and cuts the layout after N observations (the speed benchmark)
   weilgen_gap_synth --suite DIR [--quick] [--reps N] [--nones N] [--machines M1,M2]
                     [--layouts L1,L2] [--effects E1,E2,pairs,outliers,hetero] [--threads 2]
+                    [--rotary-fourier H]
       the benchmark suite (fixed seeds): DIR/sNNNN/{data.csv,truth.json}, DIR/manifest.tsv
+  --rotary-fourier H: a rotary axis' PDGEs are Fourier series of H harmonics over one turn (in
+      the truth and in what defines "absorbable"; weilgen's default there is fourier:2), not
+      Legendre cubics on the travel
   weilgen_gap_synth --self-check [--machines M1,M2]
       checks the generator against the exact chain and its own scaling; exit 1 on failure
   weilgen_gap_synth --probe-missing [--layout grid] [--machine vmc_3axis] [--seed N]
@@ -162,6 +167,8 @@ std::vector<SuiteEntry> suite_entries(const Args& args) {
   const std::vector<std::string> layouts = list_arg(args, "--layouts");
   const std::vector<std::string> only = list_arg(args, "--effects");
   const double noise_levels[2] = {0.5, 1.0};
+  const int harmonics =
+      static_cast<int>(number("--rotary-fourier", args.get("--rotary-fourier", "0")));
   std::vector<SuiteEntry> out;
   int li = 0;
   auto add = [&](const std::string& machine, const std::string& layout, const std::string& effect,
@@ -176,6 +183,7 @@ std::vector<SuiteEntry> suite_entries(const Args& args) {
     e.spec.noise_um = noise_levels[(rep + li) % 2];
     e.spec.outliers = outliers;
     e.spec.heteroscedastic = hetero;
+    e.spec.rotary_harmonics = harmonics;
     e.spec.seed = seed_from("weilgen-gap-bench-2/" + e.id);
     out.push_back(e);
   };
@@ -300,10 +308,12 @@ std::vector<double> observations(const MeasurementTable& t, const std::vector<st
 
 // Effect none, noise 0: every deviation in the file equals the exact chain at the row's pose
 // with the truth errors rebuilt from truth.json alone (not from the generator's state).
-void check_chain(Checker& ck, const std::string& machine, const std::string& layout) {
+void check_chain(Checker& ck, const std::string& machine, const std::string& layout,
+                 int rotary_harmonics = 0) {
   ScenarioSpec spec;
   spec.machine = machine;
   spec.layout = layout;
+  spec.rotary_harmonics = rotary_harmonics;
   spec.noise_um = 0;
   spec.seed = 7;
   const Synthesiser s(spec);
@@ -336,10 +346,13 @@ void check_chain(Checker& ck, const std::string& machine, const std::string& lay
         v = je["value"].get<double>();
       } else {
         const double a = je["travel"][0].get<double>(), b = je["travel"][1].get<double>();
-        const double u = (2 * t.column(je["axis"].get<std::string>())[r] - a - b) / (b - a);
-        std::vector<double> p(je["legendre"].size());
-        legendre(static_cast<int>(p.size()) - 1, u, p.data());
-        for (std::size_t k = 0; k < p.size(); ++k) v += je["legendre"][k].get<double>() * p[k];
+        const bool fourier = je.contains("fourier");
+        const json& c = je[fourier ? "fourier" : "legendre"];
+        std::vector<double> p(c.size());
+        const int n = static_cast<int>(p.size());
+        pdge_basis(fourier ? (n - 1) / 2 : 0, n - 1, t.column(je["axis"].get<std::string>())[r], a,
+                   b, p.data());
+        for (std::size_t k = 0; k < p.size(); ++k) v += c[k].get<double>() * p[k];
       }
       e.push_back(v * je["to_base"].get<double>());
     }
@@ -432,7 +445,10 @@ int self_check(const Args& args) {
   std::vector<std::string> machines = split(args.get("--machines", ""), ',');
   for (const MachineLayouts& ml : suite_machines()) {
     if (!selected(machines, ml.machine)) continue;
-    for (const std::string& layout : ml.layouts) check_chain(ck, ml.machine, layout);
+    for (const std::string& layout : ml.layouts) {
+      check_chain(ck, ml.machine, layout);
+      check_chain(ck, ml.machine, layout, 2);  // rotary PDGEs as Fourier series (truth.json)
+    }
     for (const std::string& layout : ml.layouts) {
       std::vector<std::string> effects = library_effects();
       effects.push_back("step");
@@ -508,6 +524,8 @@ int main(int argc, char** argv) {
     spec.seed = static_cast<std::uint64_t>(number("--seed", args.get("--seed", "1")));
     spec.truth_degree = static_cast<int>(number("--truth-degree", args.get("--truth-degree", "3")));
     spec.fit_degree = static_cast<int>(number("--fit-degree", args.get("--fit-degree", "3")));
+    spec.rotary_harmonics =
+        static_cast<int>(number("--rotary-fourier", args.get("--rotary-fourier", "0")));
     spec.missing_error = args.get("--missing");
     spec.outliers = static_cast<int>(number("--outliers", args.get("--outliers", "0")));
     spec.heteroscedastic = args.has("--hetero");

@@ -167,6 +167,20 @@ void legendre(int n, double u, double* out) {
   for (int k = 1; k < n; ++k) out[k + 1] = ((2 * k + 1) * u * out[k] - k * out[k - 1]) / (k + 1);
 }
 
+int pdge_basis(int harmonics, int degree, double q, double a, double b, double* out) {
+  if (harmonics <= 0) {
+    legendre(degree, (2 * q - a - b) / (b - a), out);
+    return degree + 1;
+  }
+  const double theta = 2 * 3.14159265358979323846 * q / 360;
+  out[0] = 1;
+  for (int h = 1; h <= harmonics; ++h) {
+    out[2 * h - 1] = std::cos(h * theta);
+    out[2 * h] = std::sin(h * theta);
+  }
+  return 2 * harmonics + 1;
+}
+
 Synthesiser::~Synthesiser() = default;
 
 Synthesiser::Synthesiser(ScenarioSpec spec) : spec_(std::move(spec)) {
@@ -175,7 +189,7 @@ Synthesiser::Synthesiser(ScenarioSpec spec) : spec_(std::move(spec)) {
     throw fail("unknown layout '" + spec_.layout + "'");
   if (!(spec_.factor >= 0) || !(spec_.noise_um >= 0)) throw fail("factor and noise must be >= 0");
   if (spec_.truth_degree < 0 || spec_.truth_degree > 8 || spec_.fit_degree < 0 ||
-      spec_.fit_degree > 8)
+      spec_.fit_degree > 8 || spec_.rotary_harmonics < 0 || spec_.rotary_harmonics > 7)
     throw fail("degrees must be within 0..8");
   if (spec_.outliers < 0) throw fail("outliers must be >= 0");
   std::vector<std::string> names;
@@ -270,8 +284,17 @@ Synthesiser::Synthesiser(ScenarioSpec spec) : spec_(std::move(spec)) {
           axes_[k].max > axes_[k].min)
         t.axis = static_cast<int>(k);
     }
+    if (t.axis >= 0 && !axes_[static_cast<std::size_t>(t.axis)].linear)
+      t.harmonics = spec_.rotary_harmonics;
     if (t.axis < 0) {
       t.coeff = {draw(e.distribution, truth_rng)};
+    } else if (t.harmonics > 0) {
+      // c_0 ~ N(0, sd²/(2H+1)), each cos and sin coefficient ~ N(0, 2 sd²/(2H+1)): the mean
+      // square over a turn, c_0² + Σ (a_h² + b_h²)/2, is sd² on average.
+      const Spread s = spread_of(e.distribution);
+      const double m = 2.0 * t.harmonics + 1;
+      t.coeff.push_back(s.mean + s.sd * truth_rng.normal() / std::sqrt(m));
+      for (int k = 1; k < m; ++k) t.coeff.push_back(s.sd * truth_rng.normal() * std::sqrt(2 / m));
     } else {
       const Spread s = spread_of(e.distribution);
       const int n = spec_.truth_degree;
@@ -437,12 +460,10 @@ std::vector<double> Synthesiser::errors_at(const Row& row, const std::vector<dou
     double v = t.coeff[0];
     if (t.axis >= 0) {
       const AxisInfo& a = axes_[static_cast<std::size_t>(t.axis)];
-      const double u =
-          (2 * row.axes[static_cast<std::size_t>(t.axis)] - a.min - a.max) / (a.max - a.min);
-      const int deg = static_cast<int>(t.coeff.size()) - 1;
-      legendre(deg, u, p);
+      const int terms = pdge_basis(t.harmonics, static_cast<int>(t.coeff.size()) - 1,
+                                   row.axes[static_cast<std::size_t>(t.axis)], a.min, a.max, p);
       v = 0;
-      for (int k = 0; k <= deg; ++k) v += t.coeff[static_cast<std::size_t>(k)] * p[k];
+      for (int k = 0; k < terms; ++k) v += t.coeff[static_cast<std::size_t>(k)] * p[k];
     }
     e[i] = v * truth_desc_.errors[i].to_base;
   }
@@ -647,7 +668,11 @@ void Synthesiser::build_regressors() {
   }
   RegressorLayout lay;
   for (std::size_t i = 0; i < nm; ++i) {
-    const int terms = axis_of[i] >= 0 ? spec_.fit_degree + 1 : 1;
+    // A rotary axis' PDGE in Fourier (rotary_harmonics), others Legendre of fit_degree.
+    const int harmonics = axis_of[i] >= 0 && !axes_[static_cast<std::size_t>(axis_of[i])].linear
+                              ? spec_.rotary_harmonics
+                              : 0;
+    const int terms = axis_of[i] < 0 ? 1 : harmonics > 0 ? 2 * harmonics + 1 : spec_.fit_degree + 1;
     for (int k = 0; k < terms; ++k) {
       lay.error.push_back(static_cast<int>(i));
       lay.term.push_back(k);
@@ -674,12 +699,10 @@ void Synthesiser::build_regressors() {
     for (std::size_t c = 0; c < lay.error.size(); ++c) {
       const int i = lay.error[c];
       if (i != last_error && axis_of[static_cast<std::size_t>(i)] >= 0) {
-        const AxisInfo& a = axes_[static_cast<std::size_t>(axis_of[static_cast<std::size_t>(i)])];
-        const double u =
-            (2 * row.axes[static_cast<std::size_t>(axis_of[static_cast<std::size_t>(i)])] - a.min -
-             a.max) /
-            (a.max - a.min);
-        legendre(spec_.fit_degree, u, phi);
+        const auto ai = static_cast<std::size_t>(axis_of[static_cast<std::size_t>(i)]);
+        const AxisInfo& a = axes_[ai];
+        pdge_basis(a.linear ? 0 : spec_.rotary_harmonics, spec_.fit_degree, row.axes[ai], a.min,
+                   a.max, phi);
       }
       last_error = i;
       const double basis = axis_of[static_cast<std::size_t>(i)] >= 0 ? phi[lay.term[c]] : 1.0;
@@ -1182,6 +1205,7 @@ nlohmann::json Synthesiser::truth() const {
                    {"seed", spec_.seed},
                    {"truth_degree", spec_.truth_degree},
                    {"fit_degree", spec_.fit_degree},
+                   {"rotary_harmonics", spec_.rotary_harmonics},
                    {"outliers", spec_.outliers},
                    {"heteroscedastic", spec_.heteroscedastic}};
   // The verdict expected: every identifiable library effect named; a step makes it unexplained.
@@ -1254,7 +1278,10 @@ nlohmann::json Synthesiser::truth() const {
       je["dependence"] = "PDGE";
       je["axis"] = a.name;
       je["travel"] = {a.min, a.max};
-      je["legendre"] = c;
+      if (t.harmonics > 0)
+        je["fourier"] = c;  // 1, cos θ, sin θ, cos 2θ … with θ = 2π q / 360 (q in deg)
+      else
+        je["legendre"] = c;
     } else {
       je["dependence"] = "PIGE";
       je["value"] = c[0];

@@ -42,6 +42,10 @@ struct ScenarioSpec {
   std::uint64_t seed = 1;
   int truth_degree = 3;  // degree of the truth's PDGE polynomials
   int fit_degree = 3;    // degree of the model's PDGE bases that define "absorbable"
+  // > 0: a rotary axis' PDGEs are Fourier series of this many harmonics over one turn (360 deg),
+  // in the truth and in the bases that define "absorbable" (weilgen's default on a rotary axis
+  // is fourier:2); 0: Legendre series on the travel, like a linear axis'.
+  int rotary_harmonics = 0;
   // missing_error: the error left out of the model machine; empty = the machine's default.
   std::string missing_error;
   int outliers = 0;              // gross readings (30-60 sigma) added to random observations
@@ -84,6 +88,11 @@ std::uint64_t seed_from(const std::string& text);
 
 // Legendre polynomials P_0..P_n at u, into out[0..n].
 void legendre(int n, double u, double* out);
+
+// A PDGE's basis at position q of an axis with travel [a, b]: with harmonics > 0 (a rotary axis
+// in deg) 1, cos θ, sin θ, … cos Hθ, sin Hθ with θ = 2π q / 360 (2H + 1 terms), else the
+// Legendre polynomials P_0..P_degree of u = (2q − a − b)/(b − a). Returns the number of terms.
+int pdge_basis(int harmonics, int degree, double q, double a, double b, double* out);
 
 // One measured pose.
 struct Row {
@@ -140,7 +149,8 @@ class Synthesiser {
   };
   struct TruthError {
     int axis = -1;              // index into axes_ of a PDGE's axis; -1: constant (PIGE)
-    std::vector<double> coeff;  // Legendre coefficients in the declared unit (PIGE: one)
+    std::vector<double> coeff;  // pdge_basis coefficients in the declared unit (PIGE: one)
+    int harmonics = 0;          // > 0: a Fourier series over one turn (pdge_basis)
   };
   // One withheld effect and its realisation.
   struct Effect {

@@ -396,12 +396,25 @@ GapResult GapDiagnosis::run(const Model& model, const ErrorParameterisation& par
   const double explained =
       excess_ss > 0 ? explained_ss / excess_ss : (base.ss > 0 ? explained_ss / base.ss : 0);
   decide_verdict(R, options_, data.axes, gap_significant, explained, accepted_shape);
-  // The accepted effects' own regions lead the list: where the named cause acts.
+  // The accepted effects' own regions lead the list: where the named cause acts, in the output
+  // where it removed the most held-out sum of squares (what the data show of it; the output an
+  // error moves most before the model absorbs part of it can be another on a rotary layout).
+  std::array<std::size_t, kObservationKinds> per_output{};
+  for (std::size_t i = 0; i < obs.size(); ++i)
+    if (std::isfinite(r[static_cast<Index>(i)]))
+      ++per_output[static_cast<std::size_t>(obs[i].output)];
   std::vector<GapRegion> own;
   for (const EffectFit& f : R.explanation) {
     if (!f.region) continue;
     GapRegion g = *f.region;
     g.source = "effect";
+    double most = 0;
+    for (std::size_t o = 0; o < kObservationKinds; ++o) {
+      const double removed = static_cast<double>(per_output[o]) *
+                             (f.rms_before[o] * f.rms_before[o] - f.rms_after[o] * f.rms_after[o]);
+      if (per_output[o] && std::isfinite(removed) && removed > most)
+        most = removed, g.output = observation_name(o);
+    }
     if (data.circle) g.output = "dr";  // a trace's observations are dr
     g.p_value = f.p_value;
     g.significant = f.significant;

@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <numeric>
 #include <optional>
 #include <set>
@@ -59,13 +60,50 @@ void add_higher_order(const EffectContext& ctx, std::vector<Candidate>& out) {
   out.push_back(std::move(c));
 }
 
+namespace {
+
+// The basis a PDGE missing from the machine file would get on joint `j`: the one the run gives
+// the joint's other PDGEs (what --pdge, the machine's `pdge_basis:` or the default chose; the
+// most common if they differ), else that of the PDGEs on joints of the same type, else the
+// default (poly:3, or fourier:2 over a turn). The truth's missing error follows the run's
+// choice, not the default: a Legendre cubic of C seen through fourier:2 is another shape.
+Basis missing_error_basis(const Description& desc, const ErrorParameterisation& param,
+                          const Joint& j) {
+  const bool rotary = j.type == JointType::Revolute;
+  std::map<std::string, std::pair<int, Basis>> same_joint, same_type;
+  for (std::size_t k = 0; k < desc.errors.size(); ++k) {
+    const std::optional<Basis>& b = param.basis_of(k);
+    if (!b || desc.errors[k].body < 0) continue;
+    const Joint& jk = desc.bodies[static_cast<std::size_t>(desc.errors[k].body)].joint;
+    if (jk.coordinate == j.coordinate) {
+      ++same_joint.try_emplace(b->name(), 0, *b).first->second.first;
+    }
+    if ((jk.type == JointType::Revolute) == rotary && j.max > j.min) {
+      BasisSpec spec;  // the kind and order, placed on this joint (a Fourier basis over a turn)
+      spec.kind = b->kind;
+      spec.order = b->order;
+      ++same_type.try_emplace(spec.str(), 0, basis_on_joint(spec, j)).first->second.first;
+    }
+  }
+  for (const auto* m : {&same_joint, &same_type}) {
+    const Basis* best = nullptr;
+    int most = 0;
+    for (const auto& [name, nb] : *m)
+      if (nb.first > most) most = nb.first, best = &nb.second;
+    if (best) return *best;
+  }
+  return basis_on_joint(parse_basis(default_pdge_basis(j)), j);
+}
+
+}  // namespace
+
 void add_missing_error(const EffectContext& ctx, std::vector<Candidate>& out) {
   const Description& desc = ctx.model->description();
   const GapData& d = *ctx.data;
   struct Missing {
     std::string name, coordinate;
     bool pdge;
-    Basis basis;    // a PDGE's default basis on its joint (poly:3, or fourier:2 over a turn)
+    Basis basis;    // the PDGE's basis on its joint (missing_error_basis)
     MatrixXd unit;  // per observation: ∂output/∂error (µm or µrad per declared unit)
   };
   auto missing = std::make_shared<std::vector<Missing>>();
@@ -99,8 +137,7 @@ void add_missing_error(const EffectContext& ctx, std::vector<Candidate>& out) {
       chain.set_parameters(ctx.model->parameters());
       const auto& obs = d.points.observations;
       const bool pdge = e.dependence == Dependence::PDGE && j.max > j.min;
-      Missing mi{n, j.coordinate, pdge,
-                 pdge ? basis_on_joint(parse_basis(default_pdge_basis(j)), j) : Basis{},
+      Missing mi{n, j.coordinate, pdge, pdge ? missing_error_basis(desc, *ctx.param, j) : Basis{},
                  MatrixXd(static_cast<Index>(obs.size()), 1)};
       std::vector<double> err(aug.errors.size(), 0.0);
       std::size_t row = SIZE_MAX;
@@ -124,7 +161,7 @@ void add_missing_error(const EffectContext& ctx, std::vector<Candidate>& out) {
   c.name = "missing_error";
   for (std::size_t k = 0; k < missing->size(); ++k)
     c.variants.push_back({(*missing)[k].name, {static_cast<double>(k)}});
-  // The coordinate of each observation for a PDGE's basis (default_pdge_basis on the joint).
+  // The coordinate of each observation for a PDGE's basis (missing_error_basis).
   c.columns = [&d, missing, axes, &desc](const Variant& v, const std::vector<double>&) {
     const Missing& mi = (*missing)[static_cast<std::size_t>(v.hyper[0])];
     if (!mi.pdge) return MatrixXd(mi.unit);
@@ -143,8 +180,23 @@ void add_missing_error(const EffectContext& ctx, std::vector<Candidate>& out) {
     }
     return E;
   };
-  c.describe = [missing](const Variant& v, const VectorXd& coef, EffectFit& fit) {
+  c.describe = [missing, &d](const Variant& v, const VectorXd& coef, EffectFit& fit) {
     const Missing& mi = (*missing)[static_cast<std::size_t>(v.hyper[0])];
+    // Its region: along its axis' travel for a PDGE, all the data for a constant; the diagnosis
+    // puts it in the output where it removed the most.
+    GapRegion r;
+    r.by = "output";
+    if (mi.pdge) {
+      r.by = mi.coordinate;
+      r.from = mi.basis.a, r.to = mi.basis.b;
+    }
+    std::array<double, kObservationKinds> size{};  // the output it moves most, until then
+    for (std::size_t i = 0; i < d.points.observations.size(); ++i)
+      size[static_cast<std::size_t>(d.points.observations[i].output)] +=
+          std::abs(mi.unit(static_cast<Index>(i), 0));
+    r.output = observation_name(
+        static_cast<std::size_t>(std::max_element(size.begin(), size.end()) - size.begin()));
+    fit.region = r;
     const bool rot =
         mi.name.size() > 2 && (mi.name[2] == 'A' || mi.name[2] == 'B' || mi.name[2] == 'C');
     const char* unit = rot ? "µrad" : "µm";
