@@ -194,7 +194,7 @@ TEST_CASE("generated headers agree with the exact chain and their coefficients a
   Checker<five_axis_ac_model>{"five_axis_ac"}.run();
 }
 
-TEST_CASE("DeviationAndCoefficients equals Deviation and Coefficients to rounding; nulls skip") {
+TEST_CASE("DeviationAndCoefficients equals Deviation and Coefficients to rounding, nulls skip") {
   std::size_t differing = 0, total = 0;
   double worst = 0;
   worst = std::max(worst,
