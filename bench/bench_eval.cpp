@@ -1,23 +1,32 @@
-// Evaluation cost per pose: the generated closed forms (generated/<machine>.hpp) against the
-// straightforward exact numeric Eigen chain (weilgen/model/numeric_chain.hpp), side by side per shipped
-// machine, in one run. One benchmark iteration is one pose (items/s = poses/s):
+// Evaluation cost per pose: the generated closed forms (generated/<machine>.hpp, order 1 as
+// shipped) against what a competent engineer writes by hand, side by side per shipped machine, in
+// one run (docs/performance.md, "Evaluation"). One benchmark iteration is one pose
+// (items/s = poses/s):
 //
-//   generated_dev         Deviation (position + orientation)
-//   generated_coeff       Coefficients (position + orientation, 6 x n)
-//   generated_dev+coeff   (a) both: the deviation and its 6 x n first-order coefficients
-//   chain_dev+fd_coeff    (b) the same information from the numeric chain: NumericChain::deviation
-//                         plus the 6 x n coefficients by central differences of the chain at zero
-//                         error (nominal + 2n perturbed chain evaluations)
-//   chain_dev             (c) NumericChain::deviation alone
+//   generated_dev           Deviation (position + orientation)
+//   generated_coeff         Coefficients (6 x n first-order coefficients)
+//   generated_dev+coeff     Deviation then Coefficients: two calls
+//   generated_combined      DeviationAndCoefficients: the same outputs in one call
+//   eigen_dev               (a) the exact deviation from a fixed-size Eigen chain compiled from the
+//                           machine description at set-up (3x3 rotations and 3-vectors, no
+//                           allocation): actual and nominal pose, AngleAxis of R R0^T
+//   analytic_coeff          (b) the hand-derived first-order Jacobian: one nominal pass recording
+//                           the pose of every error, each column from the adjoint (twist) formula
+//   eigen_dev+analytic_coeff (a) + (b) sharing the nominal pass
+//   extra_chain_dev+fd_coeff labelled extra, the old baseline: weilgen::NumericChain (written for
+//                           clarity, not speed) with central differences (2n + 3 chain evaluations)
 //
 // Poses (axes within their ranges, errors of realistic size) are drawn once, before timing, and
-// cycled through; the generated loop does not allocate. Before timing, the generated model is
-// checked against the chain on a few poses (same axis/error order, coefficients equal to the
-// central differences), so that both sides compute the same thing. After the run, a Markdown table
-// of CPU ns/pose and speed-ups (chain / generated) is printed.
+// cycled through; no timed loop allocates. Before timing, every machine is checked: the Eigen
+// chain's deviation equals NumericChain::deviation to rounding, the analytic Jacobian equals the
+// generated Coefficients to rounding, the generated deviation equals the exact one to O(e^2),
+// DeviationAndCoefficients equals the two separate calls. After the run a Markdown table of CPU
+// ns/pose and ratios is printed. pipe_cutter is not here: its output transform (chain points,
+// linked jaws, derived quantities) is not a serial chain that the hand-written baseline covers.
 #include <benchmark/benchmark.h>
 #include <unistd.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -27,11 +36,13 @@
 #include <random>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "five_axis_ac.hpp"
 #include "gantry_grinder.hpp"
+#include "head_head_bc.hpp"
 #include "two_axis.hpp"
 #include "vmc_3axis.hpp"
 #include "weilgen/machine/yaml_loader.hpp"
@@ -41,6 +52,233 @@ namespace {
 
 constexpr std::size_t kNumPoses = 1024;  // power of two: the pose index wraps with a mask
 constexpr double kFdStep = 1e-6;         // central-difference step, base units (mm, rad)
+
+using Eigen::Matrix3d;
+using Eigen::Vector3d;
+
+// ---- (a), (b): the hand-written baseline ----------------------------------------------------
+
+// A serial machine's chain compiled once from its description into a list of steps, evaluated
+// with fixed-size Eigen types (a rigid pose as a 3x3 rotation and a 3-vector, the product of
+// Isometry3d without the homogeneous row). Body transform as in docs/generator.md:
+// Offset · E_before · E_axis · J(q) · E_axis^-1 · E_after; P = W^-1 T.
+class FixedChain {
+ public:
+  struct Pose {
+    Matrix3d R = Matrix3d::Identity();
+    Vector3d p = Vector3d::Zero();
+  };
+  // Per error step: its pose in the base frame at zero error, recorded by the nominal pass.
+  struct Workspace {
+    std::vector<Pose> at;
+  };
+
+  explicit FixedChain(const weilgen::Description& d) : num_errors_(d.errors.size()) {
+    if (!d.linked_axes().empty() || d.output)
+      throw std::invalid_argument(d.name + ": not a serial chain (links or an output transform)");
+    const std::map<std::string, double> params = d.parameter_defaults();
+    const std::vector<int> axes = d.axes();
+    auto vec = [](const weilgen::Vec3& v) { return Vector3d(v[0], v[1], v[2]); };
+    auto eval = [&](const std::array<weilgen::Expr, 3>& e) {
+      return Vector3d(e[0].eval(params), e[1].eval(params), e[2].eval(params));
+    };
+    auto branch = [&](const weilgen::PointSpec& end, bool tool, std::vector<Step>& steps) {
+      auto fixed = [&](const Pose& f) {
+        if (!steps.empty() && steps.back().kind == Step::Fixed) {  // merge neighbours
+          Step& b = steps.back();
+          b.fixed.p += b.fixed.R * f.p;
+          b.fixed.R = b.fixed.R * f.R;
+        } else {
+          Step s;
+          s.kind = Step::Fixed;
+          s.fixed = f;
+          steps.push_back(s);
+        }
+      };
+      auto errors = [&](int body, weilgen::ErrorPlacement where, bool inverse) {
+        std::vector<int> list;
+        for (int e : d.bodies[static_cast<std::size_t>(body)].errors)
+          if (d.errors[static_cast<std::size_t>(e)].placement == where) list.push_back(e);
+        if (inverse) std::reverse(list.begin(), list.end());
+        for (int e : list) {
+          const weilgen::ErrorDef& def = d.errors[static_cast<std::size_t>(e)];
+          Step s;
+          s.kind = def.effect == weilgen::ErrorEffect::Rotation ? Step::ErrorRotation
+                                                                : Step::ErrorTranslation;
+          s.u = vec(def.direction).normalized();
+          s.index = e;
+          s.sign = (inverse ? -1.0 : 1.0);
+          s.jac_sign = s.sign * (tool ? 1.0 : -1.0);
+          s.slot = num_slots_++;
+          steps.push_back(s);
+        }
+      };
+      for (int b : d.chain_to(end.body)) {
+        const weilgen::Body& body = d.bodies[static_cast<std::size_t>(b)];
+        Pose off;
+        off.p = eval(body.offset.translation);
+        for (const auto& r : body.offset.rotations)
+          off.R = off.R * Eigen::AngleAxisd(r.angle_deg.eval(params) * M_PI / 180.0,
+                                            vec(r.axis).normalized())
+                              .toRotationMatrix();
+        fixed(off);
+        errors(b, weilgen::ErrorPlacement::Before, false);
+        errors(b, weilgen::ErrorPlacement::Axis, false);
+        if (body.joint.type != weilgen::JointType::Fixed) {
+          Step s;
+          s.kind =
+              body.joint.type == weilgen::JointType::Prismatic ? Step::Prismatic : Step::Revolute;
+          s.u = vec(body.joint.axis).normalized();
+          s.to_base = body.joint.to_base;
+          s.index = static_cast<int>(std::find(axes.begin(), axes.end(), b) - axes.begin());
+          s.through = eval(body.joint.through);
+          steps.push_back(s);
+        }
+        errors(b, weilgen::ErrorPlacement::Axis, true);
+        errors(b, weilgen::ErrorPlacement::After, false);
+      }
+      Pose point;
+      point.p = eval(end.point);
+      fixed(point);
+    };
+    branch(d.tool, true, tool_);
+    branch(d.workpiece, false, work_);
+  }
+
+  Workspace workspace() const { return Workspace{std::vector<Pose>(num_slots_)}; }
+
+  // The exact deviation (dx, dy, dz mm; da, db, dc rad), as NumericChain::deviation computes it.
+  void deviation(const double* axes, const double* errors, double* out6) const {
+    const Pose actual =
+        relative(run(tool_, axes, errors, nullptr), run(work_, axes, errors, nullptr));
+    const Pose nominal =
+        relative(run(tool_, axes, nullptr, nullptr), run(work_, axes, nullptr, nullptr));
+    finish(actual, nominal, out6);
+  }
+
+  // d(deviation)/d(error) at zero error, row-major [6][n].
+  void coefficients(Workspace& ws, const double* axes, double* coeff) const {
+    const Pose t = run(tool_, axes, nullptr, &ws), w = run(work_, axes, nullptr, &ws);
+    jacobian(ws, t, w, coeff);
+  }
+
+  // Both, sharing the nominal pass.
+  void deviation_and_coefficients(Workspace& ws, const double* axes, const double* errors,
+                                  double* out6, double* coeff) const {
+    const Pose t = run(tool_, axes, nullptr, &ws), w = run(work_, axes, nullptr, &ws);
+    const Pose actual =
+        relative(run(tool_, axes, errors, nullptr), run(work_, axes, errors, nullptr));
+    finish(actual, relative(t, w), out6);
+    jacobian(ws, t, w, coeff);
+  }
+
+ private:
+  struct Step {
+    enum Kind { Fixed, Prismatic, Revolute, ErrorTranslation, ErrorRotation } kind = Fixed;
+    Pose fixed;
+    Vector3d u = Vector3d::Zero(), through = Vector3d::Zero();
+    double to_base = 1, sign = 1, jac_sign = 1;
+    int index = -1;        // axis index (joints) or error index
+    std::size_t slot = 0;  // error steps: index into Workspace::at
+  };
+
+  // The branch's pose in the base frame; errors == nullptr: nominal (error steps skipped, their
+  // poses recorded into ws when given).
+  static Pose run(const std::vector<Step>& steps, const double* axes, const double* errors,
+                  Workspace* ws) {
+    Pose m;
+    for (const Step& s : steps) {
+      switch (s.kind) {
+        case Step::Fixed:
+          m.p += m.R * s.fixed.p;
+          m.R = m.R * s.fixed.R;
+          break;
+        case Step::Prismatic:
+          m.p += (axes[s.index] * s.to_base) * (m.R * s.u);
+          break;
+        case Step::Revolute: {
+          const Matrix3d r = Eigen::AngleAxisd(axes[s.index] * s.to_base, s.u).toRotationMatrix();
+          m.p += m.R * (s.through - r * s.through);
+          m.R = m.R * r;
+          break;
+        }
+        case Step::ErrorTranslation:
+          if (errors) m.p += (s.sign * errors[s.index]) * (m.R * s.u);
+          if (ws) ws->at[s.slot] = m;
+          break;
+        case Step::ErrorRotation:
+          if (errors)
+            m.R = m.R * Eigen::AngleAxisd(s.sign * errors[s.index], s.u).toRotationMatrix();
+          if (ws) ws->at[s.slot] = m;
+          break;
+      }
+    }
+    return m;
+  }
+
+  static Pose relative(const Pose& t, const Pose& w) {  // W^-1 T
+    Pose p;
+    p.R = w.R.transpose() * t.R;
+    p.p = w.R.transpose() * (t.p - w.p);
+    return p;
+  }
+
+  static void finish(const Pose& actual, const Pose& nominal, double* out6) {
+    const Vector3d dp = actual.p - nominal.p;
+    const Eigen::AngleAxisd aa(Matrix3d(actual.R * nominal.R.transpose()));
+    const Vector3d w = aa.angle() * aa.axis();
+    for (int i = 0; i < 3; ++i) {
+      out6[i] = dp[i];
+      out6[3 + i] = w[i];
+    }
+  }
+
+  // Error k acts at pose A_k (base frame) as exp(e ξ^) with ξ a translation or rotation along u.
+  // dP·P0^-1 = ±(Ad_{W0^-1 A_k} ξ)^ (+ on the tool side; − on the workpiece side, where W is
+  // inverted; an axis error's inverse step counts with the opposite sign), so in the base frame
+  // with w = R_A u: translation dp = w; rotation dω = w, dp = w × (p_T − p_A). Rotated into the
+  // workpiece frame by R_W^T at the end.
+  void jacobian(const Workspace& ws, const Pose& t, const Pose& w, double* coeff) const {
+    const std::size_t n = num_errors_;
+    std::fill(coeff, coeff + 6 * n, 0.0);
+    const auto add = [&](const std::vector<Step>& steps) {
+      for (const Step& s : steps) {
+        if (s.kind != Step::ErrorTranslation && s.kind != Step::ErrorRotation) continue;
+        const Pose& a = ws.at[s.slot];
+        const Vector3d u = s.jac_sign * (a.R * s.u);
+        const auto j = static_cast<std::size_t>(s.index);
+        if (s.kind == Step::ErrorTranslation) {
+          for (int i = 0; i < 3; ++i) coeff[i * n + j] += u[i];
+        } else {
+          const Vector3d v = u.cross(t.p - a.p);
+          for (int i = 0; i < 3; ++i) {
+            coeff[i * n + j] += v[i];
+            coeff[(3 + i) * n + j] += u[i];
+          }
+        }
+      }
+    };
+    add(tool_);
+    add(work_);
+    // Into the workpiece frame: every column (position and orientation part) times R_W^T.
+    const Matrix3d rt = w.R.transpose();
+    for (std::size_t half = 0; half < 2; ++half) {
+      double* c = coeff + 3 * half * n;
+      for (std::size_t j = 0; j < n; ++j) {
+        const Vector3d v = rt * Vector3d(c[j], c[n + j], c[2 * n + j]);
+        c[j] = v[0];
+        c[n + j] = v[1];
+        c[2 * n + j] = v[2];
+      }
+    }
+  }
+
+  std::size_t num_errors_;
+  std::size_t num_slots_ = 0;
+  std::vector<Step> tool_, work_;
+};
+
+// ---- the generated models -------------------------------------------------------------------
 
 // One generated model namespace as a type, so that the benchmarks can be templates.
 #define WEILGEN_BENCH_MODEL(NS)                                               \
@@ -60,12 +298,17 @@ constexpr double kFdStep = 1e-6;         // central-difference step, base units 
     static void Coefficients(const Args&... args) {                           \
       weilgen_models::NS::Coefficients<double>(args...);                      \
     }                                                                         \
+    template <typename... Args>                                               \
+    static void DeviationAndCoefficients(const Args&... args) {               \
+      weilgen_models::NS::DeviationAndCoefficients<double>(args...);          \
+    }                                                                         \
   }
 
 WEILGEN_BENCH_MODEL(gantry_grinder);
 WEILGEN_BENCH_MODEL(vmc_3axis);
 WEILGEN_BENCH_MODEL(two_axis);
 WEILGEN_BENCH_MODEL(five_axis_ac);
+WEILGEN_BENCH_MODEL(head_head_bc);
 
 #undef WEILGEN_BENCH_MODEL
 
@@ -78,8 +321,11 @@ struct PoseSet {
   std::vector<std::vector<double>> chain_axes;
   std::vector<std::vector<double>> chain_errors;
   weilgen::NumericChain chain;
+  FixedChain fixed;
 
-  PoseSet() : chain(weilgen::load_machine_file(weilgen::resolve_machine(M::kName))) {
+  PoseSet()
+      : chain(weilgen::load_machine_file(weilgen::resolve_machine(M::kName))),
+        fixed(chain.description()) {
     std::mt19937 rng(20240611u);
     for (std::size_t k = 0; k < M::kNumParams; ++k) params[k] = M::kParams[k].default_value;
     axes.resize(kNumPoses);
@@ -180,6 +426,68 @@ void BM_GeneratedDeviationCoefficients(benchmark::State& state) {
 }
 
 template <typename M>
+void BM_GeneratedCombined(benchmark::State& state) {
+  const PoseSet<M>& s = poses<M>();
+  std::array<double, 3> position{}, orientation{};
+  std::array<double, 3 * M::kNumErrors> position_coeff{}, orientation_coeff{};
+  std::size_t p = 0;
+  for (auto _ : state) {
+    M::DeviationAndCoefficients(s.axes[p], s.errors[p], s.params, &position, &orientation,
+                                &position_coeff, &orientation_coeff);
+    benchmark::DoNotOptimize(position);
+    benchmark::DoNotOptimize(orientation);
+    benchmark::DoNotOptimize(position_coeff);
+    benchmark::DoNotOptimize(orientation_coeff);
+    p = (p + 1) & (kNumPoses - 1);
+  }
+  state.SetItemsProcessed(static_cast<int64_t>(state.iterations()));
+}
+
+template <typename M>
+void BM_EigenDeviation(benchmark::State& state) {
+  const PoseSet<M>& s = poses<M>();
+  std::array<double, 6> dev{};
+  std::size_t p = 0;
+  for (auto _ : state) {
+    s.fixed.deviation(s.axes[p].data(), s.errors[p].data(), dev.data());
+    benchmark::DoNotOptimize(dev);
+    p = (p + 1) & (kNumPoses - 1);
+  }
+  state.SetItemsProcessed(static_cast<int64_t>(state.iterations()));
+}
+
+template <typename M>
+void BM_AnalyticCoefficients(benchmark::State& state) {
+  const PoseSet<M>& s = poses<M>();
+  FixedChain::Workspace ws = s.fixed.workspace();
+  std::array<double, 6 * M::kNumErrors> coeff{};
+  std::size_t p = 0;
+  for (auto _ : state) {
+    s.fixed.coefficients(ws, s.axes[p].data(), coeff.data());
+    benchmark::DoNotOptimize(coeff);
+    p = (p + 1) & (kNumPoses - 1);
+  }
+  state.SetItemsProcessed(static_cast<int64_t>(state.iterations()));
+}
+
+template <typename M>
+void BM_EigenDeviationAnalyticCoefficients(benchmark::State& state) {
+  const PoseSet<M>& s = poses<M>();
+  FixedChain::Workspace ws = s.fixed.workspace();
+  std::array<double, 6> dev{};
+  std::array<double, 6 * M::kNumErrors> coeff{};
+  std::size_t p = 0;
+  for (auto _ : state) {
+    s.fixed.deviation_and_coefficients(ws, s.axes[p].data(), s.errors[p].data(), dev.data(),
+                                       coeff.data());
+    benchmark::DoNotOptimize(dev);
+    benchmark::DoNotOptimize(coeff);
+    p = (p + 1) & (kNumPoses - 1);
+  }
+  state.SetItemsProcessed(static_cast<int64_t>(state.iterations()));
+}
+
+template <typename M>
 void BM_ChainDeviationFdCoefficients(benchmark::State& state) {
   const PoseSet<M>& s = poses<M>();
   std::vector<double> scratch(M::kNumErrors, 0.0), coeff(6 * M::kNumErrors, 0.0);
@@ -195,19 +503,7 @@ void BM_ChainDeviationFdCoefficients(benchmark::State& state) {
   state.SetItemsProcessed(static_cast<int64_t>(state.iterations()));
 }
 
-template <typename M>
-void BM_ChainDeviation(benchmark::State& state) {
-  const PoseSet<M>& s = poses<M>();
-  std::size_t p = 0;
-  for (auto _ : state) {
-    std::array<double, 6> dev = s.chain.deviation(s.chain_axes[p], s.chain_errors[p]);
-    benchmark::DoNotOptimize(dev);
-    p = (p + 1) & (kNumPoses - 1);
-  }
-  state.SetItemsProcessed(static_cast<int64_t>(state.iterations()));
-}
-
-// ---- the generated model and the chain must compute the same thing ----
+// ---- every side must compute the same thing ----
 
 template <typename M>
 bool check_agreement() {
@@ -224,33 +520,55 @@ bool check_agreement() {
     std::fprintf(stderr, "%s: generated metadata does not match the machine file\n", M::kName);
     return false;
   }
-  double coeff_diff = 0, coeff_max = 0, dev_diff = 0, dev_max = 0;
-  std::vector<double> scratch(M::kNumErrors, 0.0), coeff(6 * M::kNumErrors, 0.0);
-  for (std::size_t p = 0; p < 16; ++p) {
-    std::array<double, 3> position{}, orientation{};
-    std::array<double, 3 * M::kNumErrors> position_coeff{}, orientation_coeff{};
+  constexpr std::size_t n = M::kNumErrors;
+  double eigen_diff = 0, dev_max = 0, gen_diff = 0, coeff_diff = 0, coeff_max = 0, fd_diff = 0,
+         combined_diff = 0;
+  FixedChain::Workspace ws = s.fixed.workspace();
+  std::vector<double> scratch(n, 0.0), fd(6 * n, 0.0);
+  for (std::size_t p = 0; p < 64; ++p) {
+    std::array<double, 3> position{}, orientation{}, position2{}, orientation2{};
+    std::array<double, 3 * n> pc{}, oc{}, pc2{}, oc2{};
     M::Deviation(s.axes[p], s.errors[p], s.params, &position, &orientation);
-    M::Coefficients(s.axes[p], s.params, &position_coeff, &orientation_coeff);
-    const std::array<double, 6> dev = s.chain.deviation(s.chain_axes[p], s.chain_errors[p]);
-    fd_coefficients(s.chain, s.chain_axes[p], scratch, coeff);
+    M::Coefficients(s.axes[p], s.params, &pc, &oc);
+    M::DeviationAndCoefficients(s.axes[p], s.errors[p], s.params, &position2, &orientation2, &pc2,
+                                &oc2);
+    std::array<double, 6> eigen{}, eigen2{};
+    std::array<double, 6 * n> analytic{}, analytic2{};
+    s.fixed.deviation(s.axes[p].data(), s.errors[p].data(), eigen.data());
+    s.fixed.coefficients(ws, s.axes[p].data(), analytic.data());
+    s.fixed.deviation_and_coefficients(ws, s.axes[p].data(), s.errors[p].data(), eigen2.data(),
+                                       analytic2.data());
+    const std::array<double, 6> chain = s.chain.deviation(s.chain_axes[p], s.chain_errors[p]);
+    if (p < 8) fd_coefficients(s.chain, s.chain_axes[p], scratch, fd);
     for (std::size_t o = 0; o < 6; ++o) {
       const double g = o < 3 ? position[o] : orientation[o - 3];
-      dev_diff = std::max(dev_diff, std::abs(g - dev[o]));
-      dev_max = std::max(dev_max, std::abs(dev[o]));
-      for (std::size_t j = 0; j < M::kNumErrors; ++j) {
-        const std::size_t r = (o % 3) * M::kNumErrors + j;
-        const double c = o < 3 ? position_coeff[r] : orientation_coeff[r];
-        coeff_diff = std::max(coeff_diff, std::abs(c - coeff[o * M::kNumErrors + j]));
+      const double g2 = o < 3 ? position2[o] : orientation2[o - 3];
+      dev_max = std::max(dev_max, std::abs(chain[o]));
+      eigen_diff =
+          std::max({eigen_diff, std::abs(eigen[o] - chain[o]), std::abs(eigen2[o] - eigen[o])});
+      gen_diff = std::max(gen_diff, std::abs(g - chain[o]));
+      combined_diff = std::max(combined_diff, std::abs(g2 - g));
+      for (std::size_t j = 0; j < n; ++j) {
+        const std::size_t r = (o % 3) * n + j;
+        const double c = o < 3 ? pc[r] : oc[r], c2 = o < 3 ? pc2[r] : oc2[r];
         coeff_max = std::max(coeff_max, std::abs(c));
+        coeff_diff = std::max({coeff_diff, std::abs(c - analytic[o * n + j]),
+                               std::abs(analytic2[o * n + j] - analytic[o * n + j])});
+        combined_diff = std::max(combined_diff, std::abs(c2 - c));
+        if (p < 8) fd_diff = std::max(fd_diff, std::abs(c - fd[o * n + j]));
       }
     }
   }
-  // Order-1 model against the exact chain: the difference is second order in the errors.
-  ok = coeff_diff <= 1e-6 * std::max(1.0, coeff_max) && dev_diff <= 1e-3 * dev_max;
+  // Exact sides to rounding; the order-1 model against the exact chain to O(e^2).
+  ok = eigen_diff <= 1e-12 * std::max(1.0, dev_max) && coeff_diff <= 1e-12 * coeff_max &&
+       combined_diff <= 1e-12 * std::max(coeff_max, dev_max) && gen_diff <= 1e-3 * dev_max &&
+       fd_diff <= 1e-6 * std::max(1.0, coeff_max);
   std::fprintf(stderr,
-               "check %-15s max|coeff - FD| = %.2e (max|coeff| %.3g), max|dev - chain| = %.2e "
-               "(max|dev| %.3g): %s\n",
-               M::kName, coeff_diff, coeff_max, dev_diff, dev_max, ok ? "ok" : "MISMATCH");
+               "check %-15s |eigen - NumericChain| %.1e, |analytic - Coefficients| %.1e (max "
+               "|coeff| %.3g), |combined - separate| %.1e, |Deviation - exact| %.1e (max |dev| "
+               "%.3g, O(e^2)), |Coefficients - FD| %.1e: %s\n",
+               M::kName, eigen_diff, coeff_diff, coeff_max, combined_diff, gen_diff, dev_max,
+               fd_diff, ok ? "ok" : "MISMATCH");
   return ok;
 }
 
@@ -261,13 +579,17 @@ void register_machine() {
   benchmark::RegisterBenchmark((m + "/generated_coeff").c_str(), BM_GeneratedCoefficients<M>);
   benchmark::RegisterBenchmark((m + "/generated_dev+coeff").c_str(),
                                BM_GeneratedDeviationCoefficients<M>);
-  benchmark::RegisterBenchmark((m + "/chain_dev+fd_coeff").c_str(),
+  benchmark::RegisterBenchmark((m + "/generated_combined").c_str(), BM_GeneratedCombined<M>);
+  benchmark::RegisterBenchmark((m + "/eigen_dev").c_str(), BM_EigenDeviation<M>);
+  benchmark::RegisterBenchmark((m + "/analytic_coeff").c_str(), BM_AnalyticCoefficients<M>);
+  benchmark::RegisterBenchmark((m + "/eigen_dev+analytic_coeff").c_str(),
+                               BM_EigenDeviationAnalyticCoefficients<M>);
+  benchmark::RegisterBenchmark((m + "/extra_chain_dev+fd_coeff").c_str(),
                                BM_ChainDeviationFdCoefficients<M>);
-  benchmark::RegisterBenchmark((m + "/chain_dev").c_str(), BM_ChainDeviation<M>);
 }
 
 // The console output, then a Markdown summary: CPU ns per pose (the median over repetitions
-// when --benchmark_repetitions is given) and the speed-ups of the generated code.
+// when --benchmark_repetitions is given) and the ratios baseline / generated.
 class SummaryReporter : public benchmark::ConsoleReporter {
  public:
   explicit SummaryReporter(bool color) : ConsoleReporter(color ? OO_ColorTabular : OO_Tabular) {}
@@ -291,26 +613,41 @@ class SummaryReporter : public benchmark::ConsoleReporter {
 
   void Finalize() override {
     ConsoleReporter::Finalize();
-    std::ostringstream rows;
+    std::ostringstream main, extra;
     for (const auto& [machine, n] : machines_) {
       const auto get = [&](const std::string& what) {
         const auto it = cpu_ns_.find(machine + "/" + what);
         return it == cpu_ns_.end() ? 0.0 : it->second;
       };
-      const double a = get("generated_dev+coeff"), b = get("chain_dev+fd_coeff");
-      const double dev = get("generated_dev"), c = get("chain_dev");
-      if (a == 0 || b == 0 || dev == 0 || c == 0) continue;  // filtered out
-      rows << std::fixed << "| " << machine << " | " << n << " | " << std::setprecision(1) << a
-           << " | " << std::setprecision(0) << b << " | " << b / a << "x | " << std::setprecision(1)
-           << dev << " | " << std::setprecision(0) << c << " | " << c / dev << "x |\n";
+      const double dev = get("generated_dev"), coeff = get("generated_coeff"),
+                   two = get("generated_dev+coeff"), one = get("generated_combined"),
+                   a = get("eigen_dev"), b = get("analytic_coeff"),
+                   ab = get("eigen_dev+analytic_coeff"), fd = get("extra_chain_dev+fd_coeff");
+      if (dev == 0 || coeff == 0 || two == 0 || one == 0 || a == 0 || b == 0 || ab == 0)
+        continue;  // filtered out
+      main << std::fixed << std::setprecision(1) << "| " << machine << " | " << n << " | " << dev
+           << " | " << a << " | **" << a / dev << "x** | " << coeff << " | " << b << " | **"
+           << b / coeff << "x** | " << one << " | " << two << " | " << ab << " | **" << ab / one
+           << "x** |\n";
+      if (fd != 0)
+        extra << std::fixed << "| " << machine << " | " << std::setprecision(1) << one << " | "
+              << std::setprecision(0) << fd << " | " << fd / one << "x |\n";
     }
-    if (rows.str().empty()) return;
+    if (main.str().empty()) return;
     std::ostream& out = GetOutputStream();
-    out << "\nCPU time per pose (ns); speed-up = chain / generated\n\n"
-        << "| machine | n errors | (a) generated dev+coeff | (b) chain dev+FD coeff | "
-           "speed-up (b)/(a) | generated dev | (c) chain dev | speed-up (c)/dev |\n"
-        << "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n"
-        << rows.str();
+    out << "\nCPU time per pose (ns); ratio = hand-written baseline / generated\n\n"
+        << "| machine | n | generated Deviation | (a) Eigen chain deviation | (a) / Deviation | "
+           "generated Coefficients | (b) analytic Jacobian | (b) / Coefficients | generated "
+           "DeviationAndCoefficients | generated Deviation + Coefficients (2 calls) | (a) + (b) "
+           "| (a + b) / DeviationAndCoefficients |\n"
+        << "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n"
+        << main.str();
+    if (!extra.str().empty())
+      out << "\nExtra (not a competent baseline): the numeric chain with finite-difference "
+             "coefficients\n\n"
+          << "| machine | generated DeviationAndCoefficients | NumericChain dev + FD coeff | "
+             "ratio |\n| --- | ---: | ---: | ---: |\n"
+          << extra.str();
     out.flush();
   }
 
@@ -337,6 +674,14 @@ class SummaryReporter : public benchmark::ConsoleReporter {
   std::set<std::string> median_;
 };
 
+template <typename M>
+bool add(SummaryReporter& reporter) {
+  if (!check_agreement<M>()) return false;
+  register_machine<M>();
+  reporter.add_machine(M::kName, M::kNumErrors);
+  return true;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -351,21 +696,13 @@ int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
 
-  bool ok = check_agreement<gantry_grinder_model>();
-  ok = check_agreement<vmc_3axis_model>() && ok;
-  ok = check_agreement<two_axis_model>() && ok;
-  ok = check_agreement<five_axis_ac_model>() && ok;
-  if (!ok) return 1;
-
   SummaryReporter reporter(color);
-  register_machine<gantry_grinder_model>();
-  reporter.add_machine(gantry_grinder_model::kName, gantry_grinder_model::kNumErrors);
-  register_machine<vmc_3axis_model>();
-  reporter.add_machine(vmc_3axis_model::kName, vmc_3axis_model::kNumErrors);
-  register_machine<two_axis_model>();
-  reporter.add_machine(two_axis_model::kName, two_axis_model::kNumErrors);
-  register_machine<five_axis_ac_model>();
-  reporter.add_machine(five_axis_ac_model::kName, five_axis_ac_model::kNumErrors);
+  bool ok = add<gantry_grinder_model>(reporter);
+  ok = add<vmc_3axis_model>(reporter) && ok;
+  ok = add<two_axis_model>(reporter) && ok;
+  ok = add<five_axis_ac_model>(reporter) && ok;
+  ok = add<head_head_bc_model>(reporter) && ok;
+  if (!ok) return 1;
 
   benchmark::RunSpecifiedBenchmarks(&reporter);
   benchmark::Shutdown();

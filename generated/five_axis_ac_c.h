@@ -114,6 +114,14 @@ int five_axis_ac_deviation(const double* axes, const double* errors, const doubl
 int five_axis_ac_coefficients(const double* axes, const double* params, double* position_coeff,
                          double* orientation_coeff) WEILGEN_C_API_NOEXCEPT;
 
+/* five_axis_ac_deviation and five_axis_ac_coefficients at one pose in one call, sharing the trigonometry
+ * and the terms common to both (the same results to rounding, at about the cost of the deviation
+ * alone). Any of the four outputs may be NULL (not computed). */
+int five_axis_ac_deviation_and_coefficients(const double* axes, const double* errors,
+                                       const double* params, double* position, double* orientation,
+                                       double* position_coeff,
+                                       double* orientation_coeff) WEILGEN_C_API_NOEXCEPT;
+
 /* The nominal pose (every error zero): position[3] in mm, rotation[9] row-major. Either may be
  * NULL. */
 int five_axis_ac_nominal_pose(const double* axes, const double* params, double* position,

@@ -6,6 +6,7 @@
 // Operation counts (after common-subexpression elimination):
 //   Deviation:    50 (adds 33, muls 17, divs 0, functions 0), 0 temporaries
 //   Coefficients: 2 (adds 2, muls 0, divs 0, functions 0), 0 temporaries
+//   DeviationAndCoefficients: 50 (adds 33, muls 17, divs 0, functions 0), 0 temporaries
 //   NominalPose:  1 (adds 1, muls 0, divs 0, functions 0), 0 temporaries
 //   NominalJacobian: 0 (adds 0, muls 0, divs 0, functions 0), 0 temporaries
 //   Compensate:   per iteration errors_at + Deviation + NominalPose + 3x3 least-squares step; once per call NominalJacobian + NominalPose + Cholesky
@@ -246,6 +247,199 @@ void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
     _position_coeff[22] = -Scalar(1);
     _position_coeff[23] = Scalar(0);
     _position_coeff[24] = Z - tool_length;
+    _position_coeff[25] = Scalar(0);
+    _position_coeff[26] = X;
+    _position_coeff[27] = X;
+    _position_coeff[28] = Scalar(0);
+    _position_coeff[29] = Scalar(1);
+    _position_coeff[30] = Scalar(0);
+    _position_coeff[31] = tool_length;
+    _position_coeff[32] = Scalar(0);
+    _position_coeff[33] = Scalar(0);
+    _position_coeff[34] = Scalar(0);
+    _position_coeff[35] = tool_length;
+    _position_coeff[36] = Scalar(0);
+    _position_coeff[37] = Scalar(1);
+    _position_coeff[38] = Scalar(0);
+    _position_coeff[39] = tool_length;
+    _position_coeff[40] = Scalar(0);
+    _position_coeff[41] = Scalar(0);
+    _position_coeff[42] = Scalar(0);
+    _position_coeff[43] = Scalar(0);
+    _position_coeff[44] = -Scalar(1);
+    _position_coeff[45] = -Y;
+    _position_coeff[46] = -X;
+    _position_coeff[47] = Scalar(0);
+    _position_coeff[48] = Scalar(0);
+    _position_coeff[49] = Scalar(0);
+    _position_coeff[50] = Scalar(0);
+    _position_coeff[51] = Scalar(1);
+    _position_coeff[52] = Y;
+    _position_coeff[53] = Scalar(0);
+    _position_coeff[54] = Scalar(0);
+    _position_coeff[55] = Scalar(0);
+    _position_coeff[56] = Y;
+    _position_coeff[57] = Scalar(0);
+    _position_coeff[58] = Scalar(0);
+    _position_coeff[59] = Scalar(1);
+    _position_coeff[60] = Scalar(0);
+    _position_coeff[61] = Scalar(0);
+    _position_coeff[62] = Scalar(0);
+  }
+  if (orientation_coeff != nullptr) {
+    auto& _orientation_coeff = *orientation_coeff;
+    _orientation_coeff[0] = Scalar(0);
+    _orientation_coeff[1] = Scalar(0);
+    _orientation_coeff[2] = Scalar(0);
+    _orientation_coeff[3] = -Scalar(1);
+    _orientation_coeff[4] = Scalar(0);
+    _orientation_coeff[5] = Scalar(0);
+    _orientation_coeff[6] = Scalar(0);
+    _orientation_coeff[7] = Scalar(0);
+    _orientation_coeff[8] = Scalar(0);
+    _orientation_coeff[9] = Scalar(0);
+    _orientation_coeff[10] = Scalar(1);
+    _orientation_coeff[11] = Scalar(0);
+    _orientation_coeff[12] = Scalar(0);
+    _orientation_coeff[13] = Scalar(0);
+    _orientation_coeff[14] = Scalar(1);
+    _orientation_coeff[15] = Scalar(0);
+    _orientation_coeff[16] = Scalar(0);
+    _orientation_coeff[17] = Scalar(0);
+    _orientation_coeff[18] = Scalar(1);
+    _orientation_coeff[19] = Scalar(0);
+    _orientation_coeff[20] = Scalar(0);
+    _orientation_coeff[21] = Scalar(0);
+    _orientation_coeff[22] = Scalar(0);
+    _orientation_coeff[23] = Scalar(0);
+    _orientation_coeff[24] = Scalar(0);
+    _orientation_coeff[25] = -Scalar(1);
+    _orientation_coeff[26] = Scalar(0);
+    _orientation_coeff[27] = Scalar(0);
+    _orientation_coeff[28] = Scalar(0);
+    _orientation_coeff[29] = Scalar(0);
+    _orientation_coeff[30] = Scalar(0);
+    _orientation_coeff[31] = Scalar(0);
+    _orientation_coeff[32] = Scalar(1);
+    _orientation_coeff[33] = Scalar(0);
+    _orientation_coeff[34] = Scalar(1);
+    _orientation_coeff[35] = Scalar(0);
+    _orientation_coeff[36] = Scalar(0);
+    _orientation_coeff[37] = Scalar(0);
+    _orientation_coeff[38] = Scalar(0);
+    _orientation_coeff[39] = Scalar(0);
+    _orientation_coeff[40] = Scalar(1);
+    _orientation_coeff[41] = Scalar(0);
+    _orientation_coeff[42] = Scalar(0);
+    _orientation_coeff[43] = Scalar(0);
+    _orientation_coeff[44] = Scalar(0);
+    _orientation_coeff[45] = Scalar(0);
+    _orientation_coeff[46] = Scalar(0);
+    _orientation_coeff[47] = -Scalar(1);
+    _orientation_coeff[48] = -Scalar(1);
+    _orientation_coeff[49] = Scalar(0);
+    _orientation_coeff[50] = Scalar(0);
+    _orientation_coeff[51] = Scalar(0);
+    _orientation_coeff[52] = Scalar(0);
+    _orientation_coeff[53] = Scalar(0);
+    _orientation_coeff[54] = Scalar(1);
+    _orientation_coeff[55] = Scalar(0);
+    _orientation_coeff[56] = Scalar(0);
+    _orientation_coeff[57] = Scalar(0);
+    _orientation_coeff[58] = Scalar(0);
+    _orientation_coeff[59] = Scalar(0);
+    _orientation_coeff[60] = Scalar(0);
+    _orientation_coeff[61] = Scalar(0);
+    _orientation_coeff[62] = Scalar(1);
+  }
+}
+
+// Deviation and Coefficients at one pose in one call, sharing the sin/cos of the axes and
+// the terms common to both (one common-subexpression pass over both). The same outputs
+// as the two functions, equal to rounding; null outputs are skipped.
+template <typename Scalar>
+void DeviationAndCoefficients(
+    [[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
+    [[maybe_unused]] const std::array<Scalar, kNumErrors>& errors,
+    [[maybe_unused]] const std::array<Scalar, kNumParams>& params,
+    std::array<Scalar, 3>* const position, std::array<Scalar, 3>* const orientation,
+    std::array<Scalar, 3 * kNumErrors>* const position_coeff,
+    std::array<Scalar, 3 * kNumErrors>* const orientation_coeff = nullptr) {
+  using std::cos;
+  using std::sin;
+  using std::sqrt;
+  // Inputs
+  const Scalar X = axes[0];
+  const Scalar Z = axes[1];
+  const Scalar Y = axes[2];
+  const Scalar E_XX = errors[0];
+  const Scalar E_YX = errors[1];
+  const Scalar E_ZX = errors[2];
+  const Scalar E_AX = errors[3];
+  const Scalar E_BX = errors[4];
+  const Scalar E_CX = errors[5];
+  const Scalar E_C0X = errors[6];
+  const Scalar E_XZ = errors[7];
+  const Scalar E_YZ = errors[8];
+  const Scalar E_ZZ = errors[9];
+  const Scalar E_AZ = errors[10];
+  const Scalar E_BZ = errors[11];
+  const Scalar E_CZ = errors[12];
+  const Scalar E_B0Z = errors[13];
+  const Scalar E_A0Z = errors[14];
+  const Scalar E_XY = errors[15];
+  const Scalar E_YY = errors[16];
+  const Scalar E_ZY = errors[17];
+  const Scalar E_AY = errors[18];
+  const Scalar E_BY = errors[19];
+  const Scalar E_CY = errors[20];
+  const Scalar tool_length = params[0];
+
+  // Intermediate terms (0)
+
+  // Coefficients of the error monomials (1)
+  const Scalar _coef0 = Z - tool_length;
+
+  // Outputs
+  if (position != nullptr) {
+    auto& _position = *position;
+    _position[0] = E_XY + E_XZ + E_C0X * Y + E_CX * Y - E_XX - E_B0Z * tool_length - E_BX * _coef0 - E_BY * tool_length - E_BZ * tool_length - E_CZ * Y;
+    _position[1] = E_YY + E_YZ + E_A0Z * tool_length + E_AX * _coef0 + E_AY * tool_length + E_AZ * tool_length + E_C0X * X + E_CX * X - E_YX;
+    _position[2] = E_ZY + E_ZZ + E_A0Z * Y + E_AZ * Y - E_ZX - E_AX * Y - E_BX * X;
+  }
+  if (orientation != nullptr) {
+    auto& _orientation = *orientation;
+    _orientation[0] = E_A0Z + E_AY + E_AZ - E_AX;
+    _orientation[1] = E_B0Z + E_BY + E_BZ - E_BX;
+    _orientation[2] = E_CY + E_CZ - E_C0X - E_CX;
+  }
+  if (position_coeff != nullptr) {
+    auto& _position_coeff = *position_coeff;
+    _position_coeff[0] = -Scalar(1);
+    _position_coeff[1] = Scalar(0);
+    _position_coeff[2] = Scalar(0);
+    _position_coeff[3] = Scalar(0);
+    _position_coeff[4] = -_coef0;
+    _position_coeff[5] = Y;
+    _position_coeff[6] = Y;
+    _position_coeff[7] = Scalar(1);
+    _position_coeff[8] = Scalar(0);
+    _position_coeff[9] = Scalar(0);
+    _position_coeff[10] = Scalar(0);
+    _position_coeff[11] = -tool_length;
+    _position_coeff[12] = -Y;
+    _position_coeff[13] = -tool_length;
+    _position_coeff[14] = Scalar(0);
+    _position_coeff[15] = Scalar(1);
+    _position_coeff[16] = Scalar(0);
+    _position_coeff[17] = Scalar(0);
+    _position_coeff[18] = Scalar(0);
+    _position_coeff[19] = -tool_length;
+    _position_coeff[20] = Scalar(0);
+    _position_coeff[21] = Scalar(0);
+    _position_coeff[22] = -Scalar(1);
+    _position_coeff[23] = Scalar(0);
+    _position_coeff[24] = _coef0;
     _position_coeff[25] = Scalar(0);
     _position_coeff[26] = X;
     _position_coeff[27] = X;

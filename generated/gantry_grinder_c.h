@@ -89,6 +89,14 @@ int gantry_grinder_deviation(const double* axes, const double* errors, const dou
 int gantry_grinder_coefficients(const double* axes, const double* params, double* position_coeff,
                          double* orientation_coeff) WEILGEN_C_API_NOEXCEPT;
 
+/* gantry_grinder_deviation and gantry_grinder_coefficients at one pose in one call, sharing the trigonometry
+ * and the terms common to both (the same results to rounding, at about the cost of the deviation
+ * alone). Any of the four outputs may be NULL (not computed). */
+int gantry_grinder_deviation_and_coefficients(const double* axes, const double* errors,
+                                       const double* params, double* position, double* orientation,
+                                       double* position_coeff,
+                                       double* orientation_coeff) WEILGEN_C_API_NOEXCEPT;
+
 /* The nominal pose (every error zero): position[3] in mm, rotation[9] row-major. Either may be
  * NULL. */
 int gantry_grinder_nominal_pose(const double* axes, const double* params, double* position,

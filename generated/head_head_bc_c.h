@@ -115,6 +115,14 @@ int head_head_bc_deviation(const double* axes, const double* errors, const doubl
 int head_head_bc_coefficients(const double* axes, const double* params, double* position_coeff,
                          double* orientation_coeff) WEILGEN_C_API_NOEXCEPT;
 
+/* head_head_bc_deviation and head_head_bc_coefficients at one pose in one call, sharing the trigonometry
+ * and the terms common to both (the same results to rounding, at about the cost of the deviation
+ * alone). Any of the four outputs may be NULL (not computed). */
+int head_head_bc_deviation_and_coefficients(const double* axes, const double* errors,
+                                       const double* params, double* position, double* orientation,
+                                       double* position_coeff,
+                                       double* orientation_coeff) WEILGEN_C_API_NOEXCEPT;
+
 /* The nominal pose (every error zero): position[3] in mm, rotation[9] row-major. Either may be
  * NULL. */
 int head_head_bc_nominal_pose(const double* axes, const double* params, double* position,

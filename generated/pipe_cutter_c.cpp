@@ -157,6 +157,24 @@ int pipe_cutter_coefficients(const double* axes, const double* params, double* p
   return PIPE_CUTTER_STATUS_OK;
 }
 
+int pipe_cutter_deviation_and_coefficients(const double* axes, const double* errors,
+                                       const double* params, double* position, double* orientation,
+                                       double* position_coeff, double* orientation_coeff) noexcept {
+  if (axes == nullptr || errors == nullptr || !params_ok(params)) return PIPE_CUTTER_STATUS_BAD_ARGUMENT;
+  std::array<double, 3> p{}, o{};
+  std::array<double, 3 * model::kNumErrors> pc{}, oc{};
+  model::DeviationAndCoefficients(load<model::kNumAxes>(axes), load<model::kNumErrors>(errors),
+                                  load<model::kNumParams>(params), position != nullptr ? &p : nullptr,
+                                  orientation != nullptr ? &o : nullptr,
+                                  position_coeff != nullptr ? &pc : nullptr,
+                                  orientation_coeff != nullptr ? &oc : nullptr);
+  if (position != nullptr) store(p, position);
+  if (orientation != nullptr) store(o, orientation);
+  if (position_coeff != nullptr) store(pc, position_coeff);
+  if (orientation_coeff != nullptr) store(oc, orientation_coeff);
+  return PIPE_CUTTER_STATUS_OK;
+}
+
 int pipe_cutter_nominal_pose(const double* axes, const double* params, double* position,
                          double* rotation) noexcept {
   if (axes == nullptr || !params_ok(params)) return PIPE_CUTTER_STATUS_BAD_ARGUMENT;

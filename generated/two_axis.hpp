@@ -6,6 +6,7 @@
 // Operation counts (after common-subexpression elimination):
 //   Deviation:    34 (adds 15, muls 17, divs 0, functions 2), 1 temporaries
 //   Coefficients: 6 (adds 0, muls 4, divs 0, functions 2), 2 temporaries
+//   DeviationAndCoefficients: 34 (adds 15, muls 17, divs 0, functions 2), 1 temporaries
 //   NominalPose:  7 (adds 1, muls 4, divs 0, functions 2), 0 temporaries
 //   NominalJacobian: 8 (adds 0, muls 6, divs 0, functions 2), 0 temporaries
 //   Compensate:   per iteration errors_at + Deviation + NominalPose + 6x2 least-squares step; once per call NominalJacobian + NominalPose + Cholesky
@@ -230,6 +231,138 @@ void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
     _position_coeff[31] = sin_A;
     _position_coeff[32] = cos_A;
     _position_coeff[33] = -_tmp1;
+    _position_coeff[34] = Scalar(0);
+    _position_coeff[35] = Scalar(0);
+  }
+  if (orientation_coeff != nullptr) {
+    auto& _orientation_coeff = *orientation_coeff;
+    _orientation_coeff[0] = Scalar(0);
+    _orientation_coeff[1] = Scalar(0);
+    _orientation_coeff[2] = Scalar(0);
+    _orientation_coeff[3] = Scalar(1);
+    _orientation_coeff[4] = Scalar(0);
+    _orientation_coeff[5] = Scalar(0);
+    _orientation_coeff[6] = Scalar(0);
+    _orientation_coeff[7] = Scalar(0);
+    _orientation_coeff[8] = Scalar(0);
+    _orientation_coeff[9] = Scalar(1);
+    _orientation_coeff[10] = Scalar(0);
+    _orientation_coeff[11] = Scalar(0);
+    _orientation_coeff[12] = Scalar(0);
+    _orientation_coeff[13] = Scalar(0);
+    _orientation_coeff[14] = Scalar(0);
+    _orientation_coeff[15] = Scalar(0);
+    _orientation_coeff[16] = Scalar(1);
+    _orientation_coeff[17] = Scalar(0);
+    _orientation_coeff[18] = Scalar(0);
+    _orientation_coeff[19] = Scalar(0);
+    _orientation_coeff[20] = Scalar(0);
+    _orientation_coeff[21] = Scalar(0);
+    _orientation_coeff[22] = cos_A;
+    _orientation_coeff[23] = -sin_A;
+    _orientation_coeff[24] = Scalar(0);
+    _orientation_coeff[25] = Scalar(0);
+    _orientation_coeff[26] = Scalar(0);
+    _orientation_coeff[27] = Scalar(0);
+    _orientation_coeff[28] = Scalar(0);
+    _orientation_coeff[29] = Scalar(1);
+    _orientation_coeff[30] = Scalar(0);
+    _orientation_coeff[31] = Scalar(0);
+    _orientation_coeff[32] = Scalar(0);
+    _orientation_coeff[33] = Scalar(0);
+    _orientation_coeff[34] = sin_A;
+    _orientation_coeff[35] = cos_A;
+  }
+}
+
+// Deviation and Coefficients at one pose in one call, sharing the sin/cos of the axes and
+// the terms common to both (one common-subexpression pass over both). The same outputs
+// as the two functions, equal to rounding; null outputs are skipped.
+template <typename Scalar>
+void DeviationAndCoefficients(
+    [[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
+    [[maybe_unused]] const std::array<Scalar, kNumErrors>& errors,
+    [[maybe_unused]] const std::array<Scalar, kNumParams>& params,
+    std::array<Scalar, 3>* const position, std::array<Scalar, 3>* const orientation,
+    std::array<Scalar, 3 * kNumErrors>* const position_coeff,
+    std::array<Scalar, 3 * kNumErrors>* const orientation_coeff = nullptr) {
+  using std::cos;
+  using std::sin;
+  using std::sqrt;
+  // Inputs
+  const Scalar A = axes[1];
+  const Scalar cos_A = cos(A * Scalar(0.017453292519943295));
+  const Scalar sin_A = sin(A * Scalar(0.017453292519943295));
+  const Scalar E_XY = errors[0];
+  const Scalar E_YY = errors[1];
+  const Scalar E_ZY = errors[2];
+  const Scalar E_AY = errors[3];
+  const Scalar E_BY = errors[4];
+  const Scalar E_CY = errors[5];
+  const Scalar E_XA = errors[6];
+  const Scalar E_YA = errors[7];
+  const Scalar E_ZA = errors[8];
+  const Scalar E_AA = errors[9];
+  const Scalar E_BA = errors[10];
+  const Scalar E_CA = errors[11];
+  const Scalar tool_length = params[0];
+
+  // Intermediate terms (1)
+  const Scalar _tmp0 = E_AA + E_AY;
+
+  // Coefficients of the error monomials (2)
+  const Scalar _coef0 = cos_A * tool_length;
+  const Scalar _coef1 = sin_A * tool_length;
+
+  // Outputs
+  if (position != nullptr) {
+    auto& _position = *position;
+    _position[0] = E_XA + E_XY + E_BA * tool_length + E_BY * _coef0 + E_CY * _coef1;
+    _position[1] = E_YY + E_YA * cos_A - E_ZA * sin_A - _coef0 * _tmp0;
+    _position[2] = E_ZY + E_YA * sin_A + E_ZA * cos_A - _coef1 * _tmp0;
+  }
+  if (orientation != nullptr) {
+    auto& _orientation = *orientation;
+    _orientation[0] = _tmp0;
+    _orientation[1] = E_BY + E_BA * cos_A - E_CA * sin_A;
+    _orientation[2] = E_CY + E_BA * sin_A + E_CA * cos_A;
+  }
+  if (position_coeff != nullptr) {
+    auto& _position_coeff = *position_coeff;
+    _position_coeff[0] = Scalar(1);
+    _position_coeff[1] = Scalar(0);
+    _position_coeff[2] = Scalar(0);
+    _position_coeff[3] = Scalar(0);
+    _position_coeff[4] = _coef0;
+    _position_coeff[5] = _coef1;
+    _position_coeff[6] = Scalar(1);
+    _position_coeff[7] = Scalar(0);
+    _position_coeff[8] = Scalar(0);
+    _position_coeff[9] = Scalar(0);
+    _position_coeff[10] = tool_length;
+    _position_coeff[11] = Scalar(0);
+    _position_coeff[12] = Scalar(0);
+    _position_coeff[13] = Scalar(1);
+    _position_coeff[14] = Scalar(0);
+    _position_coeff[15] = -_coef0;
+    _position_coeff[16] = Scalar(0);
+    _position_coeff[17] = Scalar(0);
+    _position_coeff[18] = Scalar(0);
+    _position_coeff[19] = cos_A;
+    _position_coeff[20] = -sin_A;
+    _position_coeff[21] = -_coef0;
+    _position_coeff[22] = Scalar(0);
+    _position_coeff[23] = Scalar(0);
+    _position_coeff[24] = Scalar(0);
+    _position_coeff[25] = Scalar(0);
+    _position_coeff[26] = Scalar(1);
+    _position_coeff[27] = -_coef1;
+    _position_coeff[28] = Scalar(0);
+    _position_coeff[29] = Scalar(0);
+    _position_coeff[30] = Scalar(0);
+    _position_coeff[31] = sin_A;
+    _position_coeff[32] = cos_A;
+    _position_coeff[33] = -_coef1;
     _position_coeff[34] = Scalar(0);
     _position_coeff[35] = Scalar(0);
   }

@@ -79,6 +79,14 @@ int two_axis_deviation(const double* axes, const double* errors, const double* p
 int two_axis_coefficients(const double* axes, const double* params, double* position_coeff,
                          double* orientation_coeff) WEILGEN_C_API_NOEXCEPT;
 
+/* two_axis_deviation and two_axis_coefficients at one pose in one call, sharing the trigonometry
+ * and the terms common to both (the same results to rounding, at about the cost of the deviation
+ * alone). Any of the four outputs may be NULL (not computed). */
+int two_axis_deviation_and_coefficients(const double* axes, const double* errors,
+                                       const double* params, double* position, double* orientation,
+                                       double* position_coeff,
+                                       double* orientation_coeff) WEILGEN_C_API_NOEXCEPT;
+
 /* The nominal pose (every error zero): position[3] in mm, rotation[9] row-major. Either may be
  * NULL. */
 int two_axis_nominal_pose(const double* axes, const double* params, double* position,

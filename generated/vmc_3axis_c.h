@@ -89,6 +89,14 @@ int vmc_3axis_deviation(const double* axes, const double* errors, const double* 
 int vmc_3axis_coefficients(const double* axes, const double* params, double* position_coeff,
                          double* orientation_coeff) WEILGEN_C_API_NOEXCEPT;
 
+/* vmc_3axis_deviation and vmc_3axis_coefficients at one pose in one call, sharing the trigonometry
+ * and the terms common to both (the same results to rounding, at about the cost of the deviation
+ * alone). Any of the four outputs may be NULL (not computed). */
+int vmc_3axis_deviation_and_coefficients(const double* axes, const double* errors,
+                                       const double* params, double* position, double* orientation,
+                                       double* position_coeff,
+                                       double* orientation_coeff) WEILGEN_C_API_NOEXCEPT;
+
 /* The nominal pose (every error zero): position[3] in mm, rotation[9] row-major. Either may be
  * NULL. */
 int vmc_3axis_nominal_pose(const double* axes, const double* params, double* position,

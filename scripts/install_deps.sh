@@ -14,8 +14,10 @@ packages=(
   chromium fonts-dejavu-core python3-pil
   python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest python3-matplotlib
 )
-# --bench: also the peer tools the benchmarks compare against (bench/openturns/run.sh).
+# --bench: also the peer tools the benchmarks compare against (bench/openturns/run.sh,
+# bench/sympy/run.sh).
 if [[ "${1:-}" == "--bench" ]]; then packages+=(python3-openturns python3-scipy); fi
+if [[ "${1:-}" == "--bench" ]]; then packages+=(python3-sympy python3-yaml); fi
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -58,6 +58,9 @@ void append(std::vector<double>& v, const double* p, std::size_t n) { v.insert(v
       const std::array<double, 2> status = {it < 0 ? -1.0 : 0.0, it < 0 ? 0.0 : double(it)}; \
       for (const auto* a : {&p, &o}) append(out, a->data(), 3);                              \
       for (const auto* a : {&pc, &oc}) append(out, a->data(), a->size());                    \
+      m::DeviationAndCoefficients(c.axes, c.errors, c.params, &p, &o, &pc, &oc);             \
+      for (const auto* a : {&p, &o}) append(out, a->data(), 3);                              \
+      for (const auto* a : {&pc, &oc}) append(out, a->data(), a->size());                    \
       append(out, pose.data(), 3);                                                           \
       append(out, r.data(), 9);                                                              \
       append(out, j.data(), j.size());                                                       \

@@ -83,6 +83,39 @@ bool batch_matches(const Model& m) {
   return true;
 }
 
+// Model::deviation_and_coefficients gives Model::deviation and Model::coefficients (to rounding:
+// largest difference relative to the output's magnitude below 1e-14), and with either output
+// null writes only the other.
+bool combined_matches(const Model& m) {
+  std::mt19937 rng(13);
+  ModelData data(m);
+  const std::size_t ne = m.num_errors();
+  for (int trial = 0; trial < 5; ++trial) {
+    const auto q = test::random_pose(m.description(), rng);
+    const auto e = test::scaled(test::random_direction(m.description(), rng), 1e-3);
+    std::vector<double> dev(6), coeff(6 * ne), dev2(6), coeff2(6 * ne), only(6 * ne, -7.0);
+    m.deviation(data, q.data(), e.data(), dev.data());
+    m.coefficients(data, q.data(), coeff.data());
+    m.deviation_and_coefficients(data, q.data(), e.data(), dev2.data(), coeff2.data());
+    for (std::size_t o = 0; o < 6; ++o) {
+      double scale = 0;
+      for (std::size_t j = 0; j < ne; ++j) scale = std::max(scale, std::abs(coeff[o * ne + j]));
+      for (std::size_t j = 0; j < ne; ++j)
+        if (std::abs(coeff[o * ne + j] - coeff2[o * ne + j]) > 1e-14 * scale) return false;
+    }
+    double dscale = 0;
+    for (std::size_t o = 0; o < 6; ++o) dscale = std::max(dscale, std::abs(dev[o]));
+    for (std::size_t o = 0; o < 6; ++o)
+      if (std::abs(dev[o] - dev2[o]) > 1e-14 * dscale) return false;
+    m.deviation_and_coefficients(data, q.data(), e.data(), nullptr, only.data());
+    if (only != coeff2) return false;
+    std::fill(dev.begin(), dev.end(), -7.0);
+    m.deviation_and_coefficients(data, q.data(), e.data(), dev.data(), nullptr);
+    if (dev != dev2) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 TEST_CASE("model loader: shipped machines are built in and match the exact chain") {
@@ -102,6 +135,8 @@ TEST_CASE("model loader: shipped machines are built in and match the exact chain
     CHECK(max_disagreement(*model, *chain, 1e-6) < 1e-8);
     CHECK(batch_matches(*model));
     CHECK(batch_matches(*chain));
+    CHECK(combined_matches(*model));
+    CHECK(combined_matches(*chain));
   }
 }
 
@@ -137,39 +172,47 @@ TEST_CASE("model loader: an edited machine is compiled once, then loaded from th
   CHECK(builtin->engine() == ModelEngine::BuiltIn);
   CHECK(max_disagreement(*compiled, *builtin, 1e-3) == 0.0);
   CHECK(batch_matches(*compiled));
+  CHECK(combined_matches(*compiled));
 }
 
 TEST_CASE("model loader: a cached model of an older ABI version is compiled again") {
-  const std::string dir = fresh_dir("loader_stale_abi");
-  const std::string cache = dir + "/cache";
-  fs::create_directories(cache);
-  std::string text = test::read_text(test::machine_path("two_axis"));
-  text += "\n# edited by test_model_loader (stale ABI)\n";
-  const Description d = load_machine_text(text, dir + "/two_axis_stale.yaml");
-  const std::string key = model_key(d.source_hash, d.algebra.order);
-  // An object from before the batch entry point: ABI version 1, the right key.
-  const std::string src = dir + "/old.cpp", so = cache + "/two_axis-" + key + ".so";
-  std::ofstream(src) << "#include <cstddef>\nstruct Abi1 { int v, order; const char *name, *key;"
-                        " std::size_t a, e, p; void *dev, *coeff; };\n"
-                        "static const Abi1 abi = {1, 1, \"two_axis\", \""
-                     << key
-                     << "\", 0, 0, 0, nullptr, nullptr};\n"
-                        "extern \"C\" const Abi1* weilgen_model_abi() { return &abi; }\n";
-  REQUIRE(std::system((std::string(WEILGEN_CXX) + " -shared -fPIC -o " + so + " " + src).c_str()) ==
-          0);
-  std::vector<std::string> log;
-  const auto model = load_model(d, options_in(cache, &log));
-  CHECK(model->engine() == ModelEngine::Compiled);
-  // Without the cache's integrity trailer the entry is first discarded as damaged (a note);
-  // either way it is compiled again.
-  REQUIRE_FALSE(log.empty());
-  CHECK(std::any_of(log.begin(), log.end(),
-                    [](const std::string& l) { return l.find("compiling model two_axis") == 0; }));
-  CHECK(batch_matches(*model));
-  // The new object replaced the stale one: the next load is a cache hit.
-  std::vector<std::string> log2;
-  CHECK(load_model(d, options_in(cache, &log2))->origin().find("cached (") == 0);
-  CHECK(log2.empty());
+  // Version 1 (before deviation_batch) and the one before the current one (before
+  // deviation_and_coefficients): reading past the end of their tables would crash.
+  for (const int old_version : {1, kWeilgenModelAbiVersion - 1}) {
+    CAPTURE(old_version);
+    const std::string dir = fresh_dir("loader_stale_abi" + std::to_string(old_version));
+    const std::string cache = dir + "/cache";
+    fs::create_directories(cache);
+    std::string text = test::read_text(test::machine_path("two_axis"));
+    text += "\n# edited by test_model_loader (stale ABI)\n";
+    const Description d = load_machine_text(text, dir + "/two_axis_stale.yaml");
+    const std::string key = model_key(d.source_hash, d.algebra.order);
+    // An object of an older ABI version (its table is shorter), with the right key.
+    const std::string src = dir + "/old.cpp", so = cache + "/two_axis-" + key + ".so";
+    std::ofstream(src) << "#include <cstddef>\nstruct Abi1 { int v, order; const char *name, *key;"
+                          " std::size_t a, e, p; void *dev, *coeff; };\n"
+                          "static const Abi1 abi = {"
+                       << old_version << ", 1, \"two_axis\", \"" << key
+                       << "\", 0, 0, 0, nullptr, nullptr};\n"
+                          "extern \"C\" const Abi1* weilgen_model_abi() { return &abi; }\n";
+    REQUIRE(std::system(
+                (std::string(WEILGEN_CXX) + " -shared -fPIC -o " + so + " " + src).c_str()) == 0);
+    std::vector<std::string> log;
+    const auto model = load_model(d, options_in(cache, &log));
+    CHECK(model->engine() == ModelEngine::Compiled);
+    // Without the cache's integrity trailer the entry is first discarded as damaged (a note);
+    // either way it is compiled again.
+    REQUIRE_FALSE(log.empty());
+    CHECK(std::any_of(log.begin(), log.end(), [](const std::string& l) {
+      return l.find("compiling model two_axis") == 0;
+    }));
+    CHECK(batch_matches(*model));
+    CHECK(combined_matches(*model));
+    // The new object replaced the stale one: the next load is a cache hit.
+    std::vector<std::string> log2;
+    CHECK(load_model(d, options_in(cache, &log2))->origin().find("cached (") == 0);
+    CHECK(log2.empty());
+  }
 }
 
 TEST_CASE("model loader: order override compiles an order-2 model that converges as s^3") {

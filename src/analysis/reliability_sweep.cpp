@@ -84,10 +84,10 @@ std::vector<SweepCase> ReliabilitySweep::run(
     ModelData data(model);
     const std::vector<double> zero(ne, 0.0);
     for (std::size_t p = 0; p < np; ++p) {
-      model.coefficients(data, st.poses.poses[p].data(), data.coeff.data());
-      coeff.push_back(data.coeff);
       base.emplace_back(6);
-      model.deviation(data, st.poses.poses[p].data(), zero.data(), base.back().data());
+      model.deviation_and_coefficients(data, st.poses.poses[p].data(), zero.data(),
+                                       base.back().data(), data.coeff.data());
+      coeff.push_back(data.coeff);
     }
   }
   std::vector<SweepCase> cases;

@@ -288,6 +288,25 @@ std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_la
   const FunctionCode coef =
       function_body(inputs, {{"position_coeff", cpos}, {"orientation_coeff", crot}});
 
+  // Both at once: one CSE over the deviation and the coefficients, so that the sin/cos of the
+  // axes and the nominal terms they share are computed once. A coefficient that is a named
+  // coefficient of Deviation is written as factor·_coefN (the same canonical sign), so that the
+  // two are not computed twice under different signs.
+  Coefficients shared = coefs;
+  std::vector<ex> spos, srot;
+  for (int o = 0; o < 6; ++o)
+    for (std::size_t i = 0; i < ne; ++i) {
+      const ex c = m.coefficient(o, {static_cast<std::uint16_t>(i)});
+      const auto s = shared.split(c);
+      (o < 3 ? spos : srot).push_back(s ? s->first * s->second : c);
+    }
+  const FunctionCode dev_coef = function_body(inputs,
+                                              {{"position", pos},
+                                               {"orientation", rot},
+                                               {"position_coeff", spos},
+                                               {"orientation_coeff", srot}},
+                                              &shared);
+
   FunctionCode high;
   if (!higher.empty()) {
     std::vector<ex> h;
@@ -344,6 +363,8 @@ std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_la
   os << "// Operation counts (after common-subexpression elimination):\n";
   os << "//   Deviation:    " << dev.ops.str() << ", " << dev.temps << " temporaries\n";
   os << "//   Coefficients: " << coef.ops.str() << ", " << coef.temps << " temporaries\n";
+  os << "//   DeviationAndCoefficients: " << dev_coef.ops.str() << ", " << dev_coef.temps
+     << " temporaries\n";
   if (!higher.empty())
     os << "//   HigherOrder:  " << high.ops.str() << ", " << high.temps << " temporaries\n";
   os << "//   NominalPose:  " << pose.ops.str() << ", " << pose.temps << " temporaries\n";
@@ -469,6 +490,19 @@ std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_la
         "{\n"
         "  using std::cos;\n  using std::sin;\n  using std::sqrt;\n"
      << coef.body << "}\n";
+  os << "\n// Deviation and Coefficients at one pose in one call, sharing the sin/cos of the axes "
+        "and\n"
+        "// the terms common to both (one common-subexpression pass over both). The same outputs\n"
+        "// as the two functions, equal to rounding; null outputs are skipped.\n";
+  os << "template <typename Scalar>\nvoid DeviationAndCoefficients(\n"
+        "    [[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,\n"
+        "    [[maybe_unused]] const std::array<Scalar, kNumErrors>& errors,\n"
+        "    [[maybe_unused]] const std::array<Scalar, kNumParams>& params,\n"
+        "    std::array<Scalar, 3>* const position, std::array<Scalar, 3>* const orientation,\n"
+        "    std::array<Scalar, 3 * kNumErrors>* const position_coeff,\n"
+        "    std::array<Scalar, 3 * kNumErrors>* const orientation_coeff = nullptr) {\n"
+        "  using std::cos;\n  using std::sin;\n  using std::sqrt;\n"
+     << dev_coef.body << "}\n";
   if (!higher.empty()) {
     os << "\n// Coefficients of the monomials kHigherTerms in each output, row-major\n"
           "// [output][term]: output = Coefficients·errors + Σ terms[o][k]·Π "

@@ -112,6 +112,18 @@ void Model::coefficients(ModelData& data, const double* axes, double* coeff) con
   }
 }
 
+void Model::deviation_and_coefficients(ModelData& data, const double* axes, const double* errors,
+                                       double* out6, double* coeff) const {
+  if (abi_) {
+    const std::size_t ne = num_errors();
+    abi_->deviation_and_coefficients(axes, errors, params_.data(), out6, out6 ? out6 + 3 : nullptr,
+                                     coeff, coeff ? coeff + 3 * ne : nullptr);
+    return;
+  }
+  if (out6) deviation(data, axes, errors, out6);
+  if (coeff) coefficients(data, axes, coeff);
+}
+
 ModelData::ModelData(const Model& model)
     : axes(model.num_axes(), 0.0),
       errors(model.num_errors(), 0.0),

@@ -6,9 +6,10 @@
  *   c_api_run_<model> IN OUT
  *
  * IN: cases of axes[NUM_AXES], errors[NUM_ERRORS], params[NUM_PARAMS] (native doubles). OUT: per
- * case the results of deviation, coefficients, nominal_pose, nominal_jacobian and compensate
- * (10 iterations, 1e-9 mm), then status and iterations as doubles. tests/test_c_api.cpp compares
- * them with the C++ header bit for bit. Exits 1 when an argument check fails. */
+ * case the results of deviation, coefficients, deviation_and_coefficients, nominal_pose,
+ * nominal_jacobian and compensate (10 iterations, 1e-9 mm), then status and iterations as doubles.
+ * tests/test_c_api.cpp compares them with the C++ header bit for bit. Exits 1 when an argument
+ * check fails. */
 #include <stdio.h>
 #include <string.h>
 
@@ -30,6 +31,7 @@ static int read_all(FILE* f, double* v, size_t n) {
 int main(int argc, char** argv) {
   double axes[NA], errors[NE], params[NP + 1], position[3], orientation[3];
   double position_coeff[3 * NE], orientation_coeff[3 * NE], pose[3], rotation[9], jacobian[6 * NA];
+  double both[6 + 6 * NE];
   double command[NA], status_iterations[2];
   int status = 0, iterations = 0;
   long cases = 0;
@@ -48,6 +50,9 @@ int main(int argc, char** argv) {
          "deviation: NULL errors");
   expect(M(coefficients)(NULL, params, position_coeff, NULL) == MU(STATUS_BAD_ARGUMENT),
          "coefficients: NULL axes");
+  expect(M(deviation_and_coefficients)(axes, NULL, params, position, NULL, NULL, NULL) ==
+             MU(STATUS_BAD_ARGUMENT),
+         "deviation_and_coefficients: NULL errors");
   expect(M(nominal_jacobian)(axes, params, NULL) == MU(STATUS_BAD_ARGUMENT),
          "nominal_jacobian: NULL output");
   command[0] = 12345.0;
@@ -74,6 +79,9 @@ int main(int argc, char** argv) {
     expect(M(deviation)(axes, errors, params, position, orientation) == MU(STATUS_OK), "deviation");
     expect(M(coefficients)(axes, params, position_coeff, orientation_coeff) == MU(STATUS_OK),
            "coefficients");
+    expect(M(deviation_and_coefficients)(axes, errors, params, both, both + 3, both + 6,
+                                         both + 6 + 3 * NE) == MU(STATUS_OK),
+           "deviation_and_coefficients");
     expect(M(nominal_pose)(axes, params, pose, rotation) == MU(STATUS_OK), "nominal_pose");
     expect(M(nominal_jacobian)(axes, params, jacobian) == MU(STATUS_OK), "nominal_jacobian");
     status = M(compensate)(axes, errors, params, command, 10, 1e-9, &iterations);
@@ -83,6 +91,7 @@ int main(int argc, char** argv) {
     fwrite(orientation, sizeof(double), 3, out);
     fwrite(position_coeff, sizeof(double), 3 * NE, out);
     fwrite(orientation_coeff, sizeof(double), 3 * NE, out);
+    fwrite(both, sizeof(double), 6 + 6 * NE, out);
     fwrite(pose, sizeof(double), 3, out);
     fwrite(rotation, sizeof(double), 9, out);
     fwrite(jacobian, sizeof(double), 6 * NA, out);

@@ -49,6 +49,19 @@ int main(void) {
   status = standin_coefficients(axes, params, coeff, NULL);
   expect(status == STANDIN_STATUS_OK && coeff[0] == 1.0 && coeff[1] == 250.0, "coefficients");
 
+  memset(position, 0, sizeof position);
+  memset(coeff, 0, sizeof coeff);
+  status = standin_deviation_and_coefficients(axes, errors, params, position, NULL, coeff, NULL);
+  expect(status == STANDIN_STATUS_OK && position[0] == 0.012 + 2e-5 * 250.0 && coeff[0] == 1.0 &&
+             coeff[1] == 250.0,
+         "deviation and coefficients");
+  expect(standin_deviation_and_coefficients(axes, errors, params, NULL, NULL, NULL, NULL) ==
+             STANDIN_STATUS_OK,
+         "deviation and coefficients: every output NULL");
+  expect(standin_deviation_and_coefficients(axes, NULL, params, position, NULL, coeff, NULL) ==
+             STANDIN_STATUS_BAD_ARGUMENT,
+         "deviation and coefficients: NULL errors");
+
   status = standin_nominal_pose(axes, params, pose, rotation);
   expect(status == STANDIN_STATUS_OK && pose[0] == 250.0 && rotation[8] == 1.0, "nominal pose");
   status = standin_nominal_jacobian(axes, params, jacobian);

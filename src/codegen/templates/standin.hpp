@@ -66,6 +66,17 @@ void Coefficients(const std::array<Scalar, kNumAxes>& q, const std::array<Scalar
 }
 
 template <typename Scalar>
+void DeviationAndCoefficients(
+    const std::array<Scalar, kNumAxes>& q, const std::array<Scalar, kNumErrors>& e,
+    const std::array<Scalar, kNumParams>& p, std::array<Scalar, 3>* const position,
+    std::array<Scalar, 3>* const orientation,
+    std::array<Scalar, 3 * kNumErrors>* const position_coeff,
+    std::array<Scalar, 3 * kNumErrors>* const orientation_coeff = nullptr) {
+  Deviation(q, e, p, position, orientation);
+  Coefficients(q, p, position_coeff, orientation_coeff);
+}
+
+template <typename Scalar>
 void NominalPose(const std::array<Scalar, kNumAxes>& q, const std::array<Scalar, kNumParams>&,
                  std::array<Scalar, 3>* const position,
                  std::array<Scalar, 9>* const rotation = nullptr) {

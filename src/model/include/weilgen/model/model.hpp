@@ -62,6 +62,11 @@ class Model {
                        double* position, double* orientation) const;
   // d(output)/d(error) at zero error, row-major [6][num_errors] (mm or rad per base unit).
   void coefficients(ModelData& data, const double* axes, double* coeff) const;
+  // deviation(errors) into out6 and coefficients into coeff at one pose in one call: compiled
+  // models share the sin/cos and common terms (the generated DeviationAndCoefficients), at about
+  // the cost of the deviation alone. Either output may be null (not computed).
+  void deviation_and_coefficients(ModelData& data, const double* axes, const double* errors,
+                                  double* out6, double* coeff) const;
 
  private:
   friend class ModelData;

@@ -30,10 +30,16 @@ struct WeilgenModelAbi {
   // either may be null. One call per batch instead of one per point (Sobol' designs).
   void (*deviation_batch)(const double* axes, const double* params, std::size_t count,
                           const double* errors, double* position, double* orientation);
+  // deviation and coefficients at one pose in one call (ABI version 3), sharing the sin/cos and
+  // the terms common to both (the generated DeviationAndCoefficients); any output may be null.
+  void (*deviation_and_coefficients)(const double* axes, const double* errors, const double* params,
+                                     double* position, double* orientation, double* position_coeff,
+                                     double* orientation_coeff);
 };
 }
 
-inline constexpr int kWeilgenModelAbiVersion = 2;
+// 3: deviation_and_coefficients. A cached model built for an older version is compiled again.
+inline constexpr int kWeilgenModelAbiVersion = 3;
 
 #define WEILGEN_DEFINE_MODEL_ABI(ns, var)                                                        \
   namespace var##_impl {                                                                         \
@@ -77,6 +83,25 @@ inline constexpr int kWeilgenModelAbiVersion = 2;
         if (orientation) std::copy_n(ori.begin(), 3, orientation + 3 * j);                       \
       }                                                                                          \
     }                                                                                            \
+    inline void deviation_and_coefficients(                                                      \
+        const double* axes, const double* errors, const double* params, double* position,        \
+        double* orientation, double* position_coeff, double* orientation_coeff) {                \
+      std::array<double, ns::kNumAxes> a{};                                                      \
+      std::array<double, ns::kNumErrors> e{};                                                    \
+      std::array<double, ns::kNumParams> p{};                                                    \
+      std::copy_n(axes, ns::kNumAxes, a.begin());                                                \
+      std::copy_n(errors, ns::kNumErrors, e.begin());                                            \
+      std::copy_n(params, ns::kNumParams, p.begin());                                            \
+      std::array<double, 3> pos{}, ori{};                                                        \
+      std::array<double, 3 * ns::kNumErrors> pc{}, oc{};                                         \
+      ns::DeviationAndCoefficients<double>(                                                      \
+          a, e, p, position ? &pos : nullptr, orientation ? &ori : nullptr,                      \
+          position_coeff ? &pc : nullptr, orientation_coeff ? &oc : nullptr);                    \
+      if (position) std::copy_n(pos.begin(), 3, position);                                       \
+      if (orientation) std::copy_n(ori.begin(), 3, orientation);                                 \
+      if (position_coeff) std::copy_n(pc.begin(), pc.size(), position_coeff);                    \
+      if (orientation_coeff) std::copy_n(oc.begin(), oc.size(), orientation_coeff);              \
+    }                                                                                            \
   }                                                                                              \
   const WeilgenModelAbi var = {kWeilgenModelAbiVersion,                                          \
                                ns::kOrder,                                                       \
@@ -87,4 +112,5 @@ inline constexpr int kWeilgenModelAbiVersion = 2;
                                ns::kNumParams,                                                   \
                                &var##_impl::deviation,                                           \
                                &var##_impl::coefficients,                                        \
-                               &var##_impl::deviation_batch};
+                               &var##_impl::deviation_batch,                                     \
+                               &var##_impl::deviation_and_coefficients};
