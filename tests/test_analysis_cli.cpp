@@ -109,11 +109,11 @@ TEST_CASE("sensitivity CLI: replicate intervals by default, the bootstrap on req
       out;
   const Run r = run(cli(common));
   REQUIRE(r.status == 0);
-  CHECK(r.out.find("Sobol' intervals: 95 % Student t over 8 independent randomised replicates") !=
+  CHECK(r.out.find("Sobol' intervals: 95 % Student t over 4 independent randomised replicates") !=
         std::string::npos);
   json j = read_json(out);
   CHECK(j["settings"]["intervals"] == "replicates");
-  CHECK(j["settings"]["replicates"] == 8);
+  CHECK(j["settings"]["replicates"] == 4);
   CHECK(j["settings"]["bootstrap"] == 0);
   CHECK(j["settings"]["evaluations"] == 4096 * 23);
   // The grinder is linear at order 1: the replicate intervals are narrow and hold S_exact
@@ -248,7 +248,7 @@ TEST_CASE("analysis CLI: bad arguments give one clear line, exit 2 and leave out
       {"sensitivity gantry_grinder --at X=0,Y=0,Z=600 --bootstrap -1",
        "--bootstrap: '-1' is out of range"},
       {"sensitivity gantry_grinder --at X=0,Y=0,Z=600 --samples 1001",
-       "--samples 1001 must be a multiple of --replicates 8"},
+       "--samples 1001 must be a multiple of --replicates 4"},
       {"sensitivity gantry_grinder --at X=0,Y=0,Z=600 --seed 0", "--seed 0"},
       {"reliability gantry_grinder --at X=0,Y=0,Z=600 --tolerance dx=0mm", "dx"},
       {"reliability gantry_grinder --at X=0,Y=0,Z=600 --tolerance dx=-1um", "dx"},

@@ -130,11 +130,36 @@ ESTIMATORS = {
 }
 
 
-def openturns_sobol(estimator, n, sigma, cdx):
-    """Design (QMC Sobol' sequence), evaluation, first and total indices (no intervals)."""
-    ot.ResourceMap.SetAsString("SobolIndicesExperiment-SamplingMethod", "QMC")
-    dist = ot.ComposedDistribution([ot.Normal(0.0, float(s)) for s in sigma])
-    x = ot.SobolIndicesExperiment(dist, n).generate()
+def openturns_design(n, sigma, seed):
+    """OpenTURNS's Sobol' design [A; B; A_B^1; ...] of N base rows. seed None: its default QMC
+    design (SobolIndicesExperiment on the 2d-dimensional plain Sobol' sequence,
+    deterministic). Otherwise the same design from the same sequence with OpenTURNS's only QMC
+    randomisation, a random shift modulo 1 (LowDiscrepancyExperiment.setRandomize), seeded
+    through RandomGenerator: SobolIndicesExperiment itself offers no randomised QMC, so the
+    design is assembled here in its row order (checked to reproduce it exactly without the
+    shift)."""
+    d = len(sigma)
+    if seed is None:
+        ot.ResourceMap.SetAsString("SobolIndicesExperiment-SamplingMethod", "QMC")
+        dist = ot.ComposedDistribution([ot.Normal(0.0, float(s)) for s in sigma])
+        return ot.SobolIndicesExperiment(dist, n).generate()
+    ot.RandomGenerator.SetSeed(seed)
+    twice = ot.ComposedDistribution([ot.Normal(0.0, float(s)) for s in sigma] * 2)
+    exp = ot.LowDiscrepancyExperiment(ot.SobolSequence(2 * d), twice, n, True)
+    exp.setRandomize(True)
+    u = np.asarray(exp.generate())
+    a, b = u[:, :d], u[:, d:]
+    rows = [a, b]
+    for i in range(d):
+        e = a.copy()
+        e[:, i] = b[:, i]
+        rows.append(e)
+    return ot.Sample(np.vstack(rows))
+
+
+def openturns_sobol(estimator, n, sigma, cdx, seed=None):
+    """Design, evaluation, first and total indices (no intervals)."""
+    x = openturns_design(n, sigma, seed)
     y = ot.Sample((np.asarray(x) @ cdx).reshape(-1, 1))
     algo = ESTIMATORS[estimator](x, y, n)
     return np.array(algo.getFirstOrderIndices()), np.array(algo.getTotalOrderIndices())
@@ -158,79 +183,108 @@ def median_timing(runs):
     return statistics.median(walls), statistics.median(cpus)
 
 
-def sobol_section(wg, errors, sigma, coeff, s_exact, repeats, out):
+def log2s(n):
+    return "2^%d" % int(math.log2(n)) if n else "> max"
+
+
+def sobol_section(wg, errors, sigma, coeff, s_exact, repeats, seeds, out):
+    """For every seed, the smallest N = 2^j reaching the accuracy, for weilgen (its default
+    randomised replicates) and for OpenTURNS (randomised QMC, seeded; plus its deterministic
+    default design). Then the run at every N some seed needed is timed `repeats` times,
+    alternating tools (OpenTURNS through its own SobolIndicesExperiment, the default design:
+    the same work as the shifted one), and each seed is charged the median time of its N: the
+    report gives the median over seeds of those times and their ratio."""
     cdx = coeff[0]
     out.append("## Sobol' indices: dx at %s, max |S - S_exact| <= %g\n" % (POSE, SOBOL_TOL))
-    n_wg, seen = doubling(1 << 10, 1 << 22,
-                          lambda n: weilgen_sobol_error(weilgen_sobol(wg, n)[0], errors, s_exact),
-                          SOBOL_TOL)
-    out.append("weilgen (seed 1, defaults: 8 scrambled replicates, Student-t intervals), max "
-               "error by N: " + ", ".join("2^%d: %.2e" % (int(math.log2(n)), e) for n, e in seen))
-    if n_wg is None:
-        sys.exit("weilgen did not reach the accuracy")
-    # Seed robustness at that N.
-    errs = [weilgen_sobol_error(weilgen_sobol(wg, n_wg, seed)[0], errors, s_exact)
-            for seed in range(1, 11)]
-    out.append("weilgen at N = 2^%d over seeds 1-10: %d of 10 within %g, max error %.2e, median "
-               "%.2e" % (int(math.log2(n_wg)), sum(e <= SOBOL_TOL for e in errs), SOBOL_TOL,
-                         max(errs), statistics.median(errs)))
-    # One design per N serves the four estimators while N doubles (timing comes later).
-    ot_n, seen = {}, {name: [] for name in ESTIMATORS}
-    ot.ResourceMap.SetAsString("SobolIndicesExperiment-SamplingMethod", "QMC")
-    dist = ot.ComposedDistribution([ot.Normal(0.0, float(s)) for s in sigma])
-    n = 1 << 10
-    while n <= (1 << 19) and len(ot_n) < len(ESTIMATORS):
-        x = ot.SobolIndicesExperiment(dist, n).generate()
-        y = ot.Sample((np.asarray(x) @ cdx).reshape(-1, 1))
-        for name, algo in ESTIMATORS.items():
-            if name in ot_n:
-                continue
-            a = algo(x, y, n)
-            err = max(np.max(np.abs(np.array(a.getFirstOrderIndices()) - s_exact)),
-                      np.max(np.abs(np.array(a.getTotalOrderIndices()) - s_exact)))
-            seen[name].append((n, err))
-            if err <= SOBOL_TOL:
-                ot_n[name] = n
-        n *= 2
-    for name in ESTIMATORS:
-        ot_n.setdefault(name, None)
-        out.append("OpenTURNS %s (QMC), max error by N: %s%s" % (
-            name, ", ".join("2^%d: %.2e" % (int(math.log2(m)), e) for m, e in seen[name]),
-            "" if ot_n[name] else " (not reached by 2^19)"))
-    # Timing, alternating tools.
-    runs = {"weilgen": []}
-    runs.update({name: [] for name, n in ot_n.items() if n})
+    wg_last, ot_last = 1 << 20, 1 << 19
+    wg_n, ot_n = {}, {name: {} for name in ESTIMATORS}
+    out.append("weilgen defaults (randomised QMC replicates, Student-t intervals), seeds 1-%d, "
+               "max error by N:\n" % seeds)
+    for seed in range(1, seeds + 1):
+        n, seen = doubling(1 << 14, wg_last, lambda m: weilgen_sobol_error(
+            weilgen_sobol(wg, m, seed)[0], errors, s_exact), SOBOL_TOL)
+        wg_n[seed] = n
+        out.append("- seed %d: %s -> N = %s" % (seed, ", ".join(
+            "2^%d: %.2e" % (int(math.log2(m)), e) for m, e in seen), log2s(n)))
+    # One OpenTURNS design per (seed, N) serves the four estimators while N doubles.
+    out.append("\nOpenTURNS %s, N reaching the accuracy per design (seed None: the default "
+               "deterministic QMC design; seeds 1-%d: randomised QMC, random shift):\n" % (
+                   ot.__version__, seeds))
+    for seed in [None] + list(range(1, seeds + 1)):
+        # All four estimators on the default design; the seeds follow Jansen, the best one.
+        names = list(ESTIMATORS) if seed is None else ["Jansen"]
+        n, seen = 1 << 14, {name: [] for name in ESTIMATORS}
+        while n <= ot_last and any(seed not in ot_n[name] for name in names):
+            x = openturns_design(n, sigma, seed)
+            y = ot.Sample((np.asarray(x) @ cdx).reshape(-1, 1))
+            for name, algo in ESTIMATORS.items():
+                if seed in ot_n[name] or name not in names:
+                    continue
+                a = algo(x, y, n)
+                err = max(np.max(np.abs(np.array(a.getFirstOrderIndices()) - s_exact)),
+                          np.max(np.abs(np.array(a.getTotalOrderIndices()) - s_exact)))
+                seen[name].append((n, err))
+                if err <= SOBOL_TOL:
+                    ot_n[name][seed] = n
+            if seed in ot_n["Jansen"] and n >= (1 << 17):
+                break  # the others are not followed beyond 2^17 (Saltelli, Martinez: 2^19)
+            n *= 2
+        for name in ESTIMATORS:
+            ot_n[name].setdefault(seed, None)
+        out.append("- seed %s: %s" % (seed, "; ".join(
+            "%s %s" % (name, log2s(ot_n[name][seed]) if ot_n[name][seed] else "> " + log2s(
+                seen[name][-1][0])) for name in names)))
+        out.append("  Jansen max error by N: " + ", ".join(
+            "2^%d: %.2e" % (int(math.log2(m)), e) for m, e in seen["Jansen"]))
+    # Timing: every N some seed needed, alternating tools.
+    wg_sizes = sorted({n for n in wg_n.values() if n})
+    ot_sizes = sorted({n for n in ot_n["Jansen"].values() if n})
+    runs = {("weilgen", n): [] for n in wg_sizes}
+    runs.update({("Jansen", n): [] for n in ot_sizes})
     loads = [load()]
     for _ in range(repeats):
-        _, w, c = weilgen_sobol(wg, n_wg)
-        runs["weilgen"].append((w, c))
-        for name in ot_n:
-            if ot_n[name]:
-                _, w, c = timed(lambda: openturns_sobol(name, ot_n[name], sigma, cdx))
-                runs[name].append((w, c))
+        for n in wg_sizes:
+            _, w, c = weilgen_sobol(wg, n)
+            runs[("weilgen", n)].append((w, c))
+        for n in ot_sizes:
+            _, w, c = timed(lambda: openturns_sobol("Jansen", n, sigma, cdx))
+            runs[("Jansen", n)].append((w, c))
         loads.append(load())
+    med = {key: median_timing(v) for key, v in runs.items()}
+    out.append("\nTimes: median of %d runs per N; load average (1, 5, 15 min) before and after "
+               "each round: %s\n" % (repeats, " | ".join(loads)))
     nv = len(errors)
-    wg_wall, wg_cpu = median_timing(runs["weilgen"])
-    out.append("\nMedian of %d runs; load average (1, 5, 15 min) before and after each round: %s\n"
-               % (repeats, " | ".join(loads)))
-    out.append("| tool | N | evaluations | wall s | CPU s | wall ratio to weilgen |")
+    out.append("| tool | N | evaluations | seeds needing it | wall s | CPU s |")
     out.append("| --- | ---: | ---: | ---: | ---: | ---: |")
-    out.append("| weilgen (whole process, %d threads) | 2^%d | %d | %.3f | %.3f | 1 |" % (
-        wg.threads, int(math.log2(n_wg)), n_wg * (nv + 2), wg_wall, wg_cpu))
-    best = None
-    for name in ot_n:
-        if not ot_n[name]:
-            continue
-        w, c = median_timing(runs[name])
-        out.append("| OpenTURNS %s (computation) | 2^%d | %d | %.3f | %.3f | %.1f |" % (
-            name, int(math.log2(ot_n[name])), ot_n[name] * (nv + 2), w, c, w / wg_wall))
-        if best is None or w < best[1]:
-            best = (name, w, c)
-    out.append("\nSpeed-up over the best OpenTURNS estimator (%s): **%.1fx** wall, %.1fx CPU "
-               "(target >= 20x wall).\n" % (best[0], best[1] / wg_wall, best[2] / wg_cpu))
-    out.append("weilgen command: `%s --json FILE`\n" % " ".join(
+    for n in wg_sizes:
+        out.append("| weilgen (whole process, %d threads) | 2^%d | %d | %d | %.3f | %.3f |" % (
+            wg.threads, int(math.log2(n)), n * (nv + 2), sum(m == n for m in wg_n.values()),
+            *med[("weilgen", n)]))
+    for n in ot_sizes:
+        out.append("| OpenTURNS Jansen (computation, 1 thread) | 2^%d | %d | %d | %.3f | %.3f |"
+                   % (int(math.log2(n)), n * (nv + 2),
+                      sum(m == n for s, m in ot_n["Jansen"].items() if s is not None),
+                      *med[("Jansen", n)]))
+    failed_wg = [s for s, n in wg_n.items() if not n]
+    failed_ot = [s for s, n in ot_n["Jansen"].items() if s is not None and not n]
+    wg_t = [med[("weilgen", wg_n[s])] for s in wg_n if wg_n[s]]
+    ot_t = [med[("Jansen", ot_n["Jansen"][s])] for s in range(1, seeds + 1)
+            if ot_n["Jansen"][s]]
+    mw = statistics.median(t[0] for t in wg_t), statistics.median(t[1] for t in wg_t)
+    mo = statistics.median(t[0] for t in ot_t), statistics.median(t[1] for t in ot_t)
+    out.append("\nMedian over seeds of the time at each seed's N: weilgen %.3f s wall, %.3f s "
+               "CPU (median N %s); OpenTURNS Jansen %.3f s wall, %.3f s CPU (median N %s)%s.\n"
+               % (mw[0], mw[1], log2s(statistics.median_high([n or 1 << 40 for n in
+                                                             wg_n.values()])),
+                  mo[0], mo[1], log2s(statistics.median_high(
+                      [ot_n["Jansen"][s] or 1 << 40 for s in range(1, seeds + 1)])),
+                  "; not reached: weilgen seeds %s, OpenTURNS seeds %s" % (failed_wg, failed_ot)
+                  if failed_wg or failed_ot else ""))
+    out.append("**Ratio of the median times: %.1fx wall, %.1fx CPU** (target >= 20x).\n" % (
+        mo[0] / mw[0], mo[1] / mw[1]))
+    out.append("weilgen command: `%s --seed S --json FILE`\n" % " ".join(
         wg.command(["sensitivity", MACHINE, "--at", POSE, "--outputs", "dx", "--method", "sobol",
-                    "--samples", str(n_wg)])))
+                    "--samples", "N"])))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -447,6 +501,7 @@ def main():
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--threads", type=int, default=0, help="weilgen --threads (0 = all cores)")
     ap.add_argument("--only", choices=["sobol", "reliability"], default=None)
+    ap.add_argument("--seeds", type=int, default=10, help="Sobol' seeds per tool (default 10)")
     args = ap.parse_args()
     wg = Weilgen(os.path.abspath(args.weilgen), args.threads)
     out = ["# weilgen vs OpenTURNS %s (%s)\n" % (ot.__version__, time.strftime("%Y-%m-%d %H:%M")),
@@ -456,7 +511,7 @@ def main():
            "Command: `%s`\n" % " ".join([sys.executable] + sys.argv)]
     errors, sigma, coeff, s_exact = read_model(wg)
     if args.only in (None, "sobol"):
-        sobol_section(wg, errors, sigma, coeff, s_exact, args.repeats, out)
+        sobol_section(wg, errors, sigma, coeff, s_exact, args.repeats, args.seeds, out)
     if args.only in (None, "reliability"):
         reliability_section(wg, errors, sigma, coeff, args.repeats, out)
     out.append("`uptime` at end: %s" % subprocess.run(["uptime"], capture_output=True,

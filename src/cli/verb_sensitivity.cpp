@@ -29,7 +29,7 @@ int verb_sensitivity(const Args& args) {
   StudyFlags f;
   std::string method = "all", outputs_text = "dx,dy,dz,da,db,dc,dp", sampling = "qmc";
   std::size_t samples = 1u << 14, top = 10;
-  long long replicates = 8, bootstrap = 200;
+  long long replicates = static_cast<long long>(SobolOptions{}.replicates), bootstrap = 200;
   double confidence = 0.95;
   opts.add_options()("help,h", "show this help")(
       "method", po::value<std::string>(&method)->default_value("all"),
@@ -43,7 +43,7 @@ int verb_sensitivity(const Args& args) {
       "sampling", po::value<std::string>(&sampling)->default_value("qmc"),
       "qmc (Sobol' points with a seeded digital shift) | mc (pseudo-random)")(
       "replicates", ranged(&replicates, NumberRange::whole_numbers(2, 1024)),
-      "R independent randomised replicates of N/R rows each (default 8): each index is their "
+      "R independent randomised replicates of N/R rows each (default 4): each index is their "
       "mean, its interval mean +- t sd/sqrt(R); N must be a multiple of R")(
       "bootstrap", ranged(&bootstrap, NumberRange::whole_numbers(0, 1e5)),
       "percentile bootstrap with B resamples instead of replicates (0 = no intervals); on QMC a "

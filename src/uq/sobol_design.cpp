@@ -192,11 +192,13 @@ void SobolDesign::make_block(std::size_t block, double* a, double* b, std::vecto
     for (std::size_t j = 0; j < rows; ++j)
       for (std::size_t d = 0; d < dims; ++d) u[d * rows + j] = open_unit(rng);
   }
+  // Interleaved: dimensions 2v and 2v + 1 give varying input v's columns of A and B (see
+  // docs/sensitivity.md, "The sampling design", for why not A in the first k' dimensions).
   for (std::size_t d = 0; d < dims; ++d) {
-    const std::size_t i = varying_[d % kv];
+    const std::size_t i = varying_[d / 2];
     double* col = u.data() + d * rows;
     inputs_[i].quantiles(col, col, rows);
-    double* dst = (d < kv ? a : b) + i;
+    double* dst = (d % 2 == 0 ? a : b) + i;
     for (std::size_t j = 0; j < rows; ++j) dst[j * k] = col[j];
   }
 }

@@ -34,7 +34,8 @@ struct SobolOptions {
   Sampling sampling = Sampling::Qmc;
   std::uint64_t seed = 1;  // 0 with Qmc: unrandomised Sobol' points (not with Replicates)
   SobolIntervals intervals = SobolIntervals::Replicates;
-  std::size_t replicates = 8;   // R, with Replicates: 2 <= R <= 1024, N a multiple of R, N/R >= 2
+  std::size_t replicates = 4;   // R, with Replicates: 2 <= R <= 1024, N a multiple of R, N/R >= 2
+                                // (4: docs/sensitivity.md, "Confidence intervals")
   std::size_t bootstrap = 200;  // resamples, with Bootstrap (0: no intervals, like None)
   double confidence = 0.95;     // in (0, 1)
   unsigned threads = 0;         // 0 = all cores
