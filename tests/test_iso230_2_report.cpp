@@ -2,11 +2,6 @@
 // inline SVG charts (weilgen/report/svg_chart.hpp), the HTML report's structure and numbers
 // (weilgen/report/iso230_2_html.hpp) against the JSON, and `iso230-2 --report` end to end. The
 // rendering in a real browser is the CTest iso230_2_report_browser (tests/report/).
-// GCC 12 reports a false -Wmaybe-uninitialized inside std::regex's automaton when built with
-// -O3 and -fsanitize=address (scripts/sanitize.sh); the standard library's code, not ours.
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#endif
 #include <doctest/doctest.h>
 
 #include <algorithm>
