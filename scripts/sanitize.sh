@@ -15,7 +15,11 @@ export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1:exitcode=87"
 flags="-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer -g"
 launcher=()
 command -v ccache >/dev/null 2>&1 && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
-cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=Release -DWEILGEN_BUILD_BENCH=OFF "${launcher[@]}" \
+# Warnings are not errors here: GCC 12's flow warnings at -O3 with ASan report false positives
+# inside libstdc++ (-Wmaybe-uninitialized in std::regex and in a moved std::optional<vector>);
+# the normal build, which CI runs, keeps -Werror.
+cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=Release -DWEILGEN_BUILD_BENCH=OFF -DWEILGEN_WERROR=OFF \
+  "${launcher[@]}" \
   -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" \
   -DCMAKE_SHARED_LINKER_FLAGS="-fsanitize=address,undefined" >/dev/null
 cmake --build "$dir" -j"$jobs"
