@@ -81,7 +81,7 @@ std::string pct(double fraction) {
 // The verdict and its reason from the greedy explanation (docs/gap.md, "Verdict"). `shape` holds
 // each accepted effect's (coordinate, output) when it is a shape along a coordinate.
 void decide_verdict(GapResult& R, const GapOptions& opt, const std::vector<std::string>& axes,
-                    bool gap_significant, bool by_evidence, double explained,
+                    bool gap_significant, double explained,
                     const std::vector<std::pair<int, int>>& shape) {
   auto unexplained = [&](std::string why) {
     R.verdict = "unexplained";
@@ -123,6 +123,8 @@ void decide_verdict(GapResult& R, const GapOptions& opt, const std::vector<std::
   // Accepted on overwhelming evidence while the gap over all held-out data is at the floor: the
   // excess over the floor is mostly noise, so the share of it an effect removes says nothing.
   // The effect stands if nothing significant remains.
+  // (gap_significant with a baseline p at or above alpha: the exception in GapDiagnosis::run.)
+  const bool by_evidence = R.baseline_p_value >= opt.alpha;
   if (by_evidence && R.final_p_value >= opt.alpha) {
     R.verdict = first.name;
     R.verdict_reason = first.name +
@@ -296,7 +298,6 @@ GapResult GapDiagnosis::run(const Model& model, const ErrorParameterisation& par
   const double n_candidates = static_cast<double>(std::max<std::size_t>(1, candidates.size()));
 
   bool gap_significant = R.baseline_p_value < options_.alpha;
-  bool by_evidence = false;  // the gap stands on one effect's evidence, not on the floor test
   VectorXd cur_r = r, cur_h = h;
   std::vector<bool> used(candidates.size(), false);
   // Shape effects: free shape dof per (coordinate, output), and the dof the accepted ones use.
@@ -366,7 +367,7 @@ GapResult GapDiagnosis::run(const Model& model, const ErrorParameterisation& par
     // show, e.g. a small shape along one axis among many observations.
     if (step == 0 && pick && !gap_significant &&
         pick->fit.p_value < options_.alpha * options_.alpha * options_.alpha)
-      gap_significant = by_evidence = true;
+      gap_significant = true;
     if (!pick || !gap_significant) break;
     // Accept: its columns join the model.
     EffectFit fit = pick->fit;
@@ -407,7 +408,7 @@ GapResult GapDiagnosis::run(const Model& model, const ErrorParameterisation& par
   const double excess_ss = std::max(0.0, base.ss - base.expected);
   const double explained =
       excess_ss > 0 ? explained_ss / excess_ss : (base.ss > 0 ? explained_ss / base.ss : 0);
-  decide_verdict(R, options_, data.axes, gap_significant, by_evidence, explained, accepted_shape);
+  decide_verdict(R, options_, data.axes, gap_significant, explained, accepted_shape);
   // The accepted effects' own regions lead the list: where the named cause acts, in the output
   // where it removed the most held-out sum of squares (what the data show of it; the output an
   // error moves most before the model absorbs part of it can be another on a rotary layout).
