@@ -85,8 +85,8 @@ inline std::string load_error(const std::string& yaml, const std::string& filena
 }
 
 inline const std::vector<std::string>& shipped_machines() {
-  static const std::vector<std::string> m = {"gantry_grinder", "vmc_3axis", "two_axis",
-                                             "five_axis_ac", "pipe_cutter"};
+  static const std::vector<std::string> m = {"gantry_grinder", "vmc_3axis",   "two_axis",
+                                             "five_axis_ac",   "pipe_cutter", "head_head_bc"};
   return m;
 }
 
