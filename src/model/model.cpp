@@ -77,31 +77,6 @@ void Model::deviation(ModelData& data, const double* axes, const double* errors,
 
 void Model::deviation_batch(ModelData& data, const double* axes, std::size_t count,
                             const double* errors, double* position, double* orientation) const {
-  if (abi_ && order_ == 1) {
-    // At order 1 the model is linear in the errors at a fixed pose, without a constant term
-    // (zero error, zero deviation): the batch is one product with the pose's coefficients,
-    // equal to the closed forms point by point up to rounding and several times cheaper.
-    const std::size_t ne = num_errors();
-    const double* c = data.batch_coeff_.data();
-    abi_->coefficients(axes, params_.data(), data.batch_coeff_.data(),
-                       data.batch_coeff_.data() + 3 * ne);
-    // Three dot products of length n per point and output half, over contiguous rows.
-    const auto rows = [&](const double* cr, double* out) {
-      for (std::size_t j = 0; j < count; ++j) {
-        const double* e = errors + j * ne;
-        double r0 = 0, r1 = 0, r2 = 0;
-        for (std::size_t k = 0; k < ne; ++k) {
-          r0 += cr[k] * e[k];
-          r1 += cr[ne + k] * e[k];
-          r2 += cr[2 * ne + k] * e[k];
-        }
-        out[3 * j] = r0, out[3 * j + 1] = r1, out[3 * j + 2] = r2;
-      }
-    };
-    if (position) rows(c, position);
-    if (orientation) rows(c + 3 * ne, orientation);
-    return;
-  }
   if (abi_) {
     abi_->deviation_batch(axes, params_.data(), count, errors, position, orientation);
     return;
@@ -154,7 +129,6 @@ ModelData::ModelData(const Model& model)
       errors(model.num_errors(), 0.0),
       out(6, 0.0),
       coeff(6 * model.num_errors(), 0.0),
-      batch_coeff_(6 * model.num_errors(), 0.0),
       chain_axes_(model.num_axes(), 0.0),
       chain_errors_(model.num_errors(), 0.0) {}
 

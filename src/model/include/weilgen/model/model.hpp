@@ -57,9 +57,7 @@ class Model {
   void deviation(ModelData& data, const double* axes, const double* errors, double* out6) const;
   // `count` deviations at one pose in one call: errors row-major [count][num_errors()],
   // position [count][3] (mm) and orientation [count][3] (rad), either may be null (not
-  // computed, where the engine allows). Compiled models loop inside the compiled code; at
-  // order 1 the batch is the product of the pose's coefficients with the errors (the model is
-  // linear in them), equal to deviation() point by point up to rounding.
+  // computed, where the engine allows). Compiled models loop inside the compiled code.
   void deviation_batch(ModelData& data, const double* axes, std::size_t count, const double* errors,
                        double* position, double* orientation) const;
   // d(output)/d(error) at zero error, row-major [6][num_errors] (mm or rad per base unit).
@@ -92,7 +90,6 @@ class ModelData {
 
  private:
   friend class Model;
-  std::vector<double> batch_coeff_;  // deviation_batch at order 1: the pose's coefficients
   std::vector<double> chain_axes_, chain_errors_;
 };
 
