@@ -68,44 +68,44 @@ Scalar FourierSum(const std::array<double, N>& c, Scalar w) {
 }
 
 // E_XY(Y): poly:3 on [-400.0, 0.0], mm
-inline constexpr std::array<double, 4> kE_XY = {{0.0028541741934906251, -0.00098231688317304599, 0.00068202026208982248, 0.0020326556287312081}};
+inline constexpr std::array<double, 4> kE_XY = {{0.0028541741934906256, -0.00098231688317303428, 0.00068202026208979028, 0.0020326556287311929}};
 // E_YY(Y): poly:3 on [-400.0, 0.0], mm
-inline constexpr std::array<double, 4> kE_YY = {{0.0010027930533516595, 1.9984444444526757e-06, -0.012371078095238099, -0.0075014679738562226}};
+inline constexpr std::array<double, 4> kE_YY = {{0.0010027930533516543, 1.9984444444887025e-06, -0.012371078095238104, -0.007501467973856272}};
 // E_ZY(Y): poly:3 on [-400.0, 0.0], mm
-inline constexpr std::array<double, 4> kE_ZY = {{-0.0017230076092742597, -0.001125714001928848, -0.00096181440896360329, 0.00021728690787424431}};
+inline constexpr std::array<double, 4> kE_ZY = {{-0.0017230076092742553, -0.0011257140019288053, -0.00096181440896359559, 0.00021728690787418546}};
 // E_AY(Y): poly:3 on [-400.0, 0.0], rad
-inline constexpr std::array<double, 4> kE_AY = {{3.1358856451066032e-06, 8.4552048148147558e-06, -1.8463761904761535e-06, 1.4071198257081435e-06}};
+inline constexpr std::array<double, 4> kE_AY = {{3.1358856451065574e-06, 8.4552048148145203e-06, -1.8463761904761867e-06, 1.4071198257083602e-06}};
 // E_BY(Y): poly:3 on [-400.0, 0.0], rad
-inline constexpr std::array<double, 4> kE_BY = {{-6.0430782371838743e-06, -1.5867649999999909e-05, -5.5399571428570771e-06, -8.9930666666667059e-06}};
+inline constexpr std::array<double, 4> kE_BY = {{-6.0430782371838827e-06, -1.5867650000000031e-05, -5.5399571428571966e-06, -8.9930666666664924e-06}};
 // E_CY(Y): poly:3 on [-400.0, 0.0], rad
-inline constexpr std::array<double, 4> kE_CY = {{-1.1151108783590494e-05, 4.2217137998631718e-06, 3.2235051896775084e-06, -3.8629444444442838e-06}};
-inline constexpr double kE_C0Y = 1.1151108783590506e-05;  // rad
+inline constexpr std::array<double, 4> kE_CY = {{-1.1151108783590465e-05, 4.2217137998631269e-06, 3.2235051896774974e-06, -3.8629444444442618e-06}};
+inline constexpr double kE_C0Y = 1.1151108783590467e-05;  // rad
 // E_XX(X): poly:3 on [0.0, 500.0], mm
-inline constexpr std::array<double, 4> kE_XX = {{0.0028541741934906225, 0.0043708883596682785, -0.00018179531249997634, -0.0074431976693207181}};
+inline constexpr std::array<double, 4> kE_XX = {{0.0028541741934906264, 0.0043708883596683661, -0.00018179531249998981, -0.007443197669320837}};
 // E_YX(X): poly:3 on [0.0, 500.0], mm
-inline constexpr std::array<double, 4> kE_YX = {{0.0010027930533516483, 0.00075623994238351142, 0.0012214037246696123, 0.00035524914354413114}};
+inline constexpr std::array<double, 4> kE_YX = {{0.0010027930533516552, 0.00075623994238355923, 0.0012214037246695601, 0.00035524914354403969}};
 // E_ZX(X): poly:3 on [0.0, 500.0], mm
-inline constexpr std::array<double, 4> kE_ZX = {{-0.0017230076092742534, -0.0034680094002281477, 0.0017414589142402859, 0.0026330836668253072}};
+inline constexpr std::array<double, 4> kE_ZX = {{-0.0017230076092742534, -0.0034680094002281507, 0.0017414589142402909, 0.0026330836668253055}};
 // E_AX(X): poly:3 on [0.0, 500.0], rad
-inline constexpr std::array<double, 4> kE_AX = {{3.135885645106593e-06, 1.1438350681725696e-05, 6.0081524725274837e-06, 3.8035345441595201e-06}};
+inline constexpr std::array<double, 4> kE_AX = {{3.135885645106557e-06, 1.1438350681725681e-05, 6.0081524725275168e-06, 3.8035345441596484e-06}};
 // E_BX(X): poly:3 on [0.0, 500.0], rad
-inline constexpr std::array<double, 4> kE_BX = {{-8.264690031420655e-06, -5.0101768548462943e-06, -9.3007299107142445e-06, -1.9714925770997404e-06}};
+inline constexpr std::array<double, 4> kE_BX = {{-8.264690031420638e-06, -5.0101768548462096e-06, -9.3007299107142716e-06, -1.9714925770998154e-06}};
 // E_CX(X): poly:3 on [0.0, 500.0], rad
-inline constexpr std::array<double, 4> kE_CX = {{-6.646106265701666e-06, 8.7849817022076379e-06, -4.8302176339285063e-06, -4.6822727042880955e-06}};
+inline constexpr std::array<double, 4> kE_CX = {{-6.6461062657016905e-06, 8.7849817022078581e-06, -4.8302176339285919e-06, -4.6822727042883937e-06}};
 // E_XZ(Z): poly:3 on [-300.0, 0.0], mm
-inline constexpr std::array<double, 4> kE_XZ = {{-0.0028541741934906225, -0.0025994206886658781, -0.00039805125000000373, -0.0013625475000000071}};
+inline constexpr std::array<double, 4> kE_XZ = {{-0.0028541741934906256, -0.0025994206886659063, -0.00039805125000000639, -0.0013625474999999782}};
 // E_YZ(Z): poly:3 on [-300.0, 0.0], mm
-inline constexpr std::array<double, 4> kE_YZ = {{-0.0010027930533516517, 0.0045542435993321364, -0.0020793787499999942, -0.0022329900000000059}};
+inline constexpr std::array<double, 4> kE_YZ = {{-0.0010027930533516548, 0.0045542435993321398, -0.0020793787500000007, -0.0022329900000000015}};
 // E_ZZ(Z): poly:3 on [-300.0, 0.0], mm
-inline constexpr std::array<double, 4> kE_ZZ = {{0.0017230076092742529, 0.0054494737500000038, -0.000428325000000003, -0.0037410637500000028}};
+inline constexpr std::array<double, 4> kE_ZZ = {{0.001723007609274254, 0.0054494737500000012, -0.00042832499999998505, -0.0037410637500000028}};
 // E_AZ(Z): poly:3 on [-300.0, 0.0], rad
 inline constexpr std::array<double, 4> kE_AZ = {{0.0, 0.0, 0.0, 0.0}};
 // E_BZ(Z): poly:3 on [-300.0, 0.0], rad
 inline constexpr std::array<double, 4> kE_BZ = {{0.0, 0.0, 0.0, 0.0}};
 // E_CZ(Z): poly:3 on [-300.0, 0.0], rad
 inline constexpr std::array<double, 4> kE_CZ = {{0.0, 0.0, 0.0, 0.0}};
-inline constexpr double kE_B0Z = 6.0430782371839005e-06;  // rad
-inline constexpr double kE_A0Z = -1.5141121655631193e-05;  // rad
+inline constexpr double kE_B0Z = 6.0430782371838836e-06;  // rad
+inline constexpr double kE_A0Z = -1.5141121655631215e-05;  // rad
 
 // Every error at a pose (axes in kAxes order of the model header: mm, deg).
 template <typename Scalar>

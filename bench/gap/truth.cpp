@@ -729,7 +729,8 @@ void Synthesiser::build_regressors() {
 // condition numbers are ~40), so any cut between 1e-12 and 1e-3 gives the same space;
 // `smallest_kept` and `largest_dropped` record the gap.
 Synthesiser::Span::Span(const Eigen::MatrixXd& A) {
-  const Eigen::BDCSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeThinU);
+  // Jacobi, not Eigen 3.4.0's BDCSVD (out-of-bounds read on rank-deficient input: src/uq/lsq.cpp).
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeThinU);
   const Eigen::VectorXd& sv = svd.singularValues();
   Eigen::Index k = 0;
   while (k < sv.size() && sv[k] > 1e-7 * sv[0]) ++k;

@@ -23,21 +23,18 @@ EquilibratedSvd::EquilibratedSvd(const MatrixXd& A, double rank_tolerance, bool 
     if (zero_column_[static_cast<std::size_t>(p)]) As.col(p).setZero();
   const unsigned options =
       Eigen::ComputeThinU | (full_v ? Eigen::ComputeFullV : Eigen::ComputeThinV);
-  Eigen::BDCSVD<MatrixXd> svd(As, options);
+  // One-sided Jacobi (after a QR), not Eigen 3.4.0's divide-and-conquer BDCSVD: its
+  // perturbCol0 reads perm(-1) when the first undeflated index lies below a deflated one, which
+  // happens on rank-deficient designs (fixed upstream after 3.4.0; Debian 12 ships 3.4.0). In a
+  // normal build that read returned garbage, seen as NaN singular vectors (a 1010 x 75 design of
+  // rank 4: tests/test_lsq.cpp); under AddressSanitizer it crashed the gap diagnosis. Jacobi is
+  // 1.2-2x slower on the small triangles the callers pass (gap, identify) and always exact to
+  // rounding.
+  Eigen::JacobiSVD<MatrixXd> svd(As, options);
   sigma_ = VectorXd::Zero(n);
-  if (svd.singularValues().allFinite() && svd.matrixU().allFinite() && svd.matrixV().allFinite()) {
-    sigma_.head(svd.singularValues().size()) = svd.singularValues();
-    U_ = svd.matrixU();
-    V_ = svd.matrixV();
-  } else {
-    // Eigen 3.4's divide-and-conquer SVD returns NaN for some strongly rank-deficient matrices
-    // (a 1010 × 75 design of rank 4, one linear axis measured: tests/test_lsq.cpp); the
-    // one-sided Jacobi SVD is slower but does not.
-    Eigen::JacobiSVD<MatrixXd> jacobi(As, options);
-    sigma_.head(jacobi.singularValues().size()) = jacobi.singularValues();
-    U_ = jacobi.matrixU();
-    V_ = jacobi.matrixV();
-  }
+  sigma_.head(svd.singularValues().size()) = svd.singularValues();
+  U_ = svd.matrixU();
+  V_ = svd.matrixV();
   const double smax = sigma_.size() ? sigma_[0] : 0;
   while (rank_ < static_cast<std::size_t>(std::min(n, U_.cols())) &&
          sigma_[static_cast<Index>(rank_)] > rank_tolerance * smax && smax > 0)
