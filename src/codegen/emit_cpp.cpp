@@ -6,6 +6,7 @@
 #include <set>
 #include <sstream>
 #include <stdexcept>
+#include <tuple>
 
 #include "weilgen/base/format.hpp"
 #include "weilgen/base/text.hpp"
@@ -180,11 +181,13 @@ struct Coefficients {
 
   // Σ c_m · monomial_m of one output, grouped by placeholder, each group's monomials (and those
   // with an inline coefficient) in nested form (factored_sum).
-  ex output(const Poly& p, const std::vector<GiNaC::symbol>& errors) {
+  // With max_degree > 0, only the monomials up to that degree.
+  ex output(const Poly& p, const std::vector<GiNaC::symbol>& errors, int max_degree = 0) {
     using Terms = std::vector<std::pair<Monomial, ex>>;
     Terms direct;
     std::map<std::string, std::pair<GiNaC::symbol, Terms>> grouped;
     for (const auto& [mono, c] : p.terms()) {
+      if (max_degree > 0 && static_cast<int>(mono.size()) > max_degree) continue;
       if (auto s = split(c)) {
         auto& g = grouped[s->second.get_name()];
         g.first = s->second;
@@ -285,6 +288,13 @@ std::string packed_lines(const std::vector<std::string>& items) {
   return out;
 }
 
+// Above this many non-zero coefficients of degree >= 2 (all outputs), Deviation sums the higher
+// terms by a loop over kHigherTable instead of writing them in nested form: the nested form
+// costs about 8 bytes of header per coefficient (0.7 MB of the pipe cutter's order-3 header),
+// the loop 3-4 times the time per call (measured at order 2). Every shipped machine up to order
+// 3 stays nested except the pipe cutter at order 3 (91 791).
+constexpr std::size_t kMaxNestedHigherTerms = 20000;
+
 // A model with terms of degree >= 2: every coefficient that is not a number is defined once, as
 // `_c[N]` of MonomialCoefficients, and the functions use them: DeviationAndCoefficients (the
 // monomials in nested form, the first-order coefficients as factor·_c[N]), Deviation (which
@@ -303,37 +313,45 @@ HigherTable higher_table(const SymbolicModel& m, const std::vector<Monomial>& hi
   shared.everything = true;
   shared.prefix = "_c[";
   shared.suffix = "]";
+  // Deviation writes every monomial in nested form, or (many higher terms) the first-order part
+  // nested plus _h[o], the higher terms summed by a loop over the table.
+  std::size_t entries = 0;
+  for (const Poly& p : m.outputs)
+    for (const auto& [mono, c] : p.terms()) entries += mono.size() >= 2;
+  const bool nested = entries <= kMaxNestedHigherTerms;
   std::vector<ex> pos, rot, spos, srot;
-  for (int o = 0; o < 6; ++o) (o < 3 ? pos : rot).push_back(shared.output(m.outputs[o], m.errors));
+  for (int o = 0; o < 6; ++o) {
+    ex out = shared.output(m.outputs[o], m.errors, nested ? 0 : 1);
+    if (!nested) out += GiNaC::symbol("_h[" + std::to_string(o) + "]");
+    (o < 3 ? pos : rot).push_back(out);
+  }
   for (int o = 0; o < 6; ++o)
     for (std::size_t i = 0; i < ne; ++i) {
       const ex c = m.coefficient(o, {static_cast<std::uint16_t>(i)});
       const auto s = shared.split(c);
       (o < 3 ? spos : srot).push_back(s ? s->first * s->second : c);
     }
-  // The table: per non-zero coefficient in [output][term] order, the step from the previous
-  // entry's index in `terms`, the coefficient (count: the number 1) and the numeric factor.
-  std::map<std::string, std::size_t> index;
-  for (std::size_t k = 0; k < shared.defs.size(); ++k) index[shared.defs[k].first.get_name()] = k;
-  std::vector<std::array<std::size_t, 3>> rows;
+  // The table, term by term (each monomial is formed once): per non-zero coefficient, the step
+  // from the previous entry's index term * kNumOutputs + output, its placeholder (none: the
+  // number 1) and its numeric factor.
+  std::vector<std::tuple<std::size_t, std::string, std::size_t>> rows;
   std::vector<GiNaC::numeric> factors;
   std::size_t at = 0, last = 0;
-  for (int o = 0; o < 6; ++o)
-    for (const Monomial& mono : higher) {
+  for (const Monomial& mono : higher)
+    for (int o = 0; o < 6; ++o, ++at) {
       const ex c = m.coefficient(o, mono);
-      if (!c.is_zero()) {
-        const auto s = shared.split(c);
-        const ex f = s ? s->first : c;
-        const std::size_t k = s ? index.at(s->second.get_name()) : shared.defs.size();
-        const GiNaC::numeric fn = GiNaC::ex_to<GiNaC::numeric>(f);
-        auto it = std::find_if(factors.begin(), factors.end(),
-                               [&](const GiNaC::numeric& x) { return x.is_equal(fn); });
-        if (it == factors.end()) it = factors.insert(factors.end(), fn);
-        rows.push_back({at - last, k, static_cast<std::size_t>(it - factors.begin())});
-        last = at;
-      }
-      ++at;
+      if (c.is_zero()) continue;
+      const auto s = shared.split(c);
+      const GiNaC::numeric f = GiNaC::ex_to<GiNaC::numeric>(s ? s->first : c);
+      auto it = std::find_if(factors.begin(), factors.end(),
+                             [&](const GiNaC::numeric& x) { return x.is_equal(f); });
+      if (it == factors.end()) it = factors.insert(factors.end(), f);
+      rows.emplace_back(at - last, s ? s->second.get_name() : std::string(),
+                        static_cast<std::size_t>(it - factors.begin()));
+      last = at;
     }
+  std::map<std::string, std::size_t> index;
+  for (std::size_t k = 0; k < shared.defs.size(); ++k) index[shared.defs[k].first.get_name()] = k;
 
   HigherTable t;
   t.count = shared.defs.size();
@@ -343,17 +361,50 @@ HigherTable higher_table(const SymbolicModel& m, const std::vector<Monomial>& hi
   t.monomial = function_body(inputs, {{"coefficients", values, false, "_k"}});
   const std::string call =
       "  std::array<Scalar, kNumMonomialCoefficients> _c{};\n"
-      "  MonomialCoefficients(axes, params, &_c);\n\n";
+      "  MonomialCoefficients(axes, params, &_c);\n";
+  const std::string coefficient =
+      "(c < kNumMonomialCoefficients ? _c[c] : Scalar(1)) * "
+      "Scalar(kHigherFactors[kHigherTable[k + 2]])";
+  const std::string higher_sum =
+      "  // The terms of degree >= 2, monomial by monomial (kHigherTable).\n"
+      "  std::array<Scalar, kNumOutputs> _h{};\n"
+      "  if (position != nullptr || orientation != nullptr) {\n"
+      "    std::size_t at = 0, term = kNumHigherTerms;\n"
+      "    Scalar monomial(1);\n"
+      "    for (std::size_t k = 0; k < kHigherTable.size(); k += 3) {\n"
+      "      at += kHigherTable[k];\n"
+      "      if (at / kNumOutputs != term) {\n"
+      "        term = at / kNumOutputs;\n"
+      "        monomial = Scalar(1);\n"
+      "        for (const int i : kHigherTerms[term])\n"
+      "          if (i >= 0) monomial = monomial * errors[static_cast<std::size_t>(i)];\n"
+      "      }\n"
+      "      const std::uint32_t c = kHigherTable[k + 1];\n"
+      "      _h[at % kNumOutputs] = _h[at % kNumOutputs] + " +
+      coefficient +
+      " * monomial;\n"
+      "    }\n"
+      "  }\n\n";
+  // The loop: per entry three multiplications (coefficient, factor, monomial) and an addition;
+  // per monomial of degree d, d multiplications.
+  OpCount loop;
+  loop.muls = 3 * static_cast<long>(rows.size());
+  loop.adds = static_cast<long>(rows.size());
+  for (const Monomial& mono : higher) loop.muls += static_cast<long>(mono.size());
   t.deviation_and_coefficients = function_body(inputs, {{"position", pos},
                                                         {"orientation", rot},
                                                         {"position_coeff", spos},
                                                         {"orientation_coeff", srot}});
-  t.deviation_and_coefficients.body = call + t.deviation_and_coefficients.body;
+  t.deviation_and_coefficients.body =
+      call + (nested ? "\n" : higher_sum) + t.deviation_and_coefficients.body;
+  if (nested) loop = {};
   t.deviation_and_coefficients.ops += t.monomial.ops;
+  t.deviation_and_coefficients.ops += loop;
   t.deviation_and_coefficients.temps += t.monomial.temps;
-  // Deviation's cost: the coefficients and the outputs (the body only forwards).
+  // Deviation's cost: the coefficients, the loop and the outputs (its body only forwards).
   t.deviation = function_body(inputs, {{"position", pos}, {"orientation", rot}});
   t.deviation.ops += t.monomial.ops;
+  t.deviation.ops += loop;
   t.deviation.temps += t.monomial.temps;
   t.deviation.body =
       "  DeviationAndCoefficients<Scalar>(axes, errors, params, position, orientation, nullptr,\n"
@@ -368,26 +419,32 @@ HigherTable higher_table(const SymbolicModel& m, const std::vector<Monomial>& hi
                         "  for (std::size_t k = 0; k < kHigherTable.size(); k += 3) {\n"
                         "    at += kHigherTable[k];\n"
                         "    const std::uint32_t c = kHigherTable[k + 1];\n"
-                        "    _terms[at] = Scalar(kHigherFactors[kHigherTable[k + 2]]) *\n"
-                        "                 (c < kNumMonomialCoefficients ? _c[c] : Scalar(1));\n"
+                        "    _terms[at % kNumOutputs * kNumHigherTerms + at / kNumOutputs] =\n"
+                        "        " +
+                        coefficient +
+                        ";\n"
                         "  }\n";
 
   std::ostringstream os;
-  os << "// HigherOrder's numeric factors, and its table: per non-zero coefficient of a higher "
-        "term, in\n"
-        "// [output][term] order, the step from the previous entry's index in `terms`, the "
-        "index of its\n"
-        "// MonomialCoefficients value (kNumMonomialCoefficients: the number 1) and of its "
-        "factor.\n";
+  os << "// The terms of degree >= 2 as a table, read by HigherOrder (and by "
+        "DeviationAndCoefficients\n"
+        "// when it sums them by a loop): per non-zero coefficient, term by term, the step from "
+        "the\n"
+        "// previous entry's index term * kNumOutputs + output, the index of its "
+        "MonomialCoefficients\n"
+        "// value (kNumMonomialCoefficients: the number 1) and of its numeric factor in "
+        "kHigherFactors.\n";
   os << "inline constexpr std::array<double, " << factors.size() << "> kHigherFactors = {{";
   for (std::size_t i = 0; i < factors.size(); ++i)
     os << (i ? ", " : "") << format_literal(factors[i].to_double());
   os << "}};\n";
   os << "inline constexpr std::array<std::uint32_t, " << 3 * rows.size() << "> kHigherTable = {{\n";
   std::vector<std::string> items;
-  for (const auto& r : rows)
-    items.push_back(std::to_string(r[0]) + "," + std::to_string(r[1]) + "," + std::to_string(r[2]) +
+  for (const auto& [step, name, factor] : rows) {
+    const std::size_t k = name.empty() ? t.count : index.at(name);
+    items.push_back(std::to_string(step) + "," + std::to_string(k) + "," + std::to_string(factor) +
                     ",");
+  }
   os << packed_lines(items);
   os << "}};\n\n";
   t.tables = os.str();
