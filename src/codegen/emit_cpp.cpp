@@ -288,12 +288,10 @@ std::string packed_lines(const std::vector<std::string>& items) {
   return out;
 }
 
-// Above this many non-zero coefficients of degree >= 2 (all outputs), Deviation sums the higher
-// terms by a loop over kHigherTable instead of writing them in nested form: the nested form
-// costs about 8 bytes of header per coefficient (0.7 MB of the pipe cutter's order-3 header),
-// the loop 3-4 times the time per call (measured at order 2). Every shipped machine up to order
-// 3 stays nested except the pipe cutter at order 3 (91 791).
-constexpr std::size_t kMaxNestedHigherTerms = 20000;
+// kMaxNestedHigherTerms (emit_cpp.hpp): the nested form costs about 8 bytes of header per
+// coefficient (0.7 MB of the pipe cutter's order-3 header), the loop 3-4 times the time per call
+// (measured at order 2). Every shipped machine up to order 3 stays nested except the pipe cutter
+// at order 3 (91 791).
 
 // A model with terms of degree >= 2: every coefficient that is not a number is defined once, as
 // `_c[N]` of MonomialCoefficients, and the functions use them: DeviationAndCoefficients (the
@@ -307,7 +305,7 @@ struct HigherTable {
 };
 
 HigherTable higher_table(const SymbolicModel& m, const std::vector<Monomial>& higher,
-                         const InputTable& inputs) {
+                         const InputTable& inputs, std::size_t max_nested) {
   const std::size_t ne = m.errors.size();
   Coefficients shared;
   shared.everything = true;
@@ -318,7 +316,7 @@ HigherTable higher_table(const SymbolicModel& m, const std::vector<Monomial>& hi
   std::size_t entries = 0;
   for (const Poly& p : m.outputs)
     for (const auto& [mono, c] : p.terms()) entries += mono.size() >= 2;
-  const bool nested = entries <= kMaxNestedHigherTerms;
+  const bool nested = entries <= max_nested;
   std::vector<ex> pos, rot, spos, srot;
   for (int o = 0; o < 6; ++o) {
     ex out = shared.output(m.outputs[o], m.errors, nested ? 0 : 1);
@@ -459,7 +457,8 @@ std::string doc_list(const std::vector<std::string>& names) {
 
 }  // namespace
 
-std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_label) {
+std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_label,
+                            std::size_t max_nested_higher_terms) {
   const Description& d = m.desc;
   const InputTable inputs = inputs_of(m);
   const std::size_t ne = m.errors.size();
@@ -501,7 +500,7 @@ std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_la
                               {"orientation_coeff", srot}},
                              &shared);
   } else {
-    table = higher_table(m, higher, inputs);
+    table = higher_table(m, higher, inputs, max_nested_higher_terms);
     dev = table.deviation;
     dev_coef = table.deviation_and_coefficients;
     high = table.higher_order;
