@@ -2,13 +2,17 @@
 // run, and the CLI's handling of bad input.
 #include <doctest/doctest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include "test_support.hpp"
 #include "weilgen/base/atomic_file.hpp"
+#include "weilgen/base/format.hpp"
+#include "weilgen/codegen/emit_cpp.hpp"
 #include "weilgen/codegen/emit_report.hpp"
 #include "weilgen/codegen/generate.hpp"
 #include "weilgen/codegen/model_eval.hpp"
@@ -127,6 +131,7 @@ TEST_CASE("order-2 header compiles standalone (C++20, no exceptions) and matches
   REQUIRE_MESSAGE(g.status == 0, g.out);
   // A driver that evaluates Deviation, and rebuilds it from Coefficients and HigherOrder.
   const std::string driver = R"(#include "five_axis_ac_o2.hpp"
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 namespace m = weilgen_models::five_axis_ac_o2;
@@ -157,38 +162,116 @@ int main(int argc, char** argv) {
   }
   return 0;
 })";
-  write_file_atomically((dir / "driver.cpp").string(), driver);
-  const std::string exe = (dir / "driver").string();
-  const Run c = run(std::string(WEILGEN_CXX) +
-                    " -std=c++20 -O1 -Wall -Wextra -Werror -fno-exceptions -fno-rtti -I" +
-                    dir.string() + " " + (dir / "driver.cpp").string() + " -o " + exe);
-  REQUIRE_MESSAGE(c.status == 0, c.out);
-
   const Description d = load_machine_file(test::machine_path("five_axis_ac"));
-  const NumericChain chain(d);
-  std::mt19937 rng(9);
-  const auto q = test::random_pose(d, rng);
-  const auto u = test::random_direction(d, rng);
-  std::vector<double> residual;
-  for (double s : {0.4, 0.2}) {
-    const auto e = test::scaled(u, s);
-    std::ostringstream args;
-    args.precision(17);
-    for (double v : q) args << " " << v;
-    for (double v : e) args << " " << v;
-    const Run r = run(exe + args.str());
-    REQUIRE_MESSAGE(r.status == 0, r.out);
-    std::istringstream in(r.out);
-    std::array<double, 6> dev{};
-    for (int o = 0; o < 6; ++o) {
-      double rebuilt = 0;
-      in >> dev[o] >> rebuilt;
-      CHECK(rebuilt == doctest::Approx(dev[o]).epsilon(1e-9).scale(1e-9));
+  // The same model with Deviation summing the higher terms by its loop over kHigherTable (the
+  // form of models with many higher terms, emit_cpp.hpp).
+  const fs::path loop_dir = dir / "loop";
+  fs::create_directories(loop_dir);
+  gen::SymbolicModel o2 = gen::build_model(d, 2);
+  o2.desc.name += "_o2";
+  const std::string loop_header = gen::emit_cpp_header(o2, "machines/five_axis_ac.yaml", 0);
+  REQUIRE(loop_header.find("kHigherTable.size(); k += 3) {\n      at +=") != std::string::npos);
+  write_file_atomically((loop_dir / "five_axis_ac_o2.hpp").string(), loop_header);
+  for (const fs::path& include : {dir, loop_dir}) {
+    CAPTURE(include.string());
+    // Beside the header: a quoted include looks in the driver's directory first.
+    write_file_atomically((include / "driver.cpp").string(), driver);
+    const std::string exe = (include / "driver").string();
+    const Run c = run(std::string(WEILGEN_CXX) +
+                      " -std=c++20 -O1 -Wall -Wextra -Werror -fno-exceptions -fno-rtti -I" +
+                      include.string() + " " + (include / "driver.cpp").string() + " -o " + exe);
+    REQUIRE_MESSAGE(c.status == 0, c.out);
+
+    const NumericChain chain(d);
+    std::mt19937 rng(9);
+    const auto q = test::random_pose(d, rng);
+    const auto u = test::random_direction(d, rng);
+    std::vector<double> residual;
+    for (double s : {0.4, 0.2}) {
+      const auto e = test::scaled(u, s);
+      std::ostringstream args;
+      args.precision(17);
+      for (double v : q) args << " " << v;
+      for (double v : e) args << " " << v;
+      const Run r = run(exe + args.str());
+      REQUIRE_MESSAGE(r.status == 0, r.out);
+      std::istringstream in(r.out);
+      std::array<double, 6> dev{};
+      for (int o = 0; o < 6; ++o) {
+        double rebuilt = 0;
+        in >> dev[o] >> rebuilt;
+        CHECK(rebuilt == doctest::Approx(dev[o]).epsilon(1e-9).scale(1e-9));
+      }
+      residual.push_back(test::max_abs_diff(dev, chain.deviation(q, e)));
     }
-    residual.push_back(test::max_abs_diff(dev, chain.deviation(q, e)));
+    // Third-order residual: halving s divides it by about 8.
+    CHECK(residual[0] / residual[1] == doctest::Approx(8).epsilon(0.15));
   }
-  // Third-order residual: halving s divides it by about 8.
-  CHECK(residual[0] / residual[1] == doctest::Approx(8).epsilon(0.15));
+}
+
+TEST_CASE("order-3 report: closed forms to degree 2, higher terms counted, the largest listed") {
+  const Description d = load_machine_file(test::machine_path("five_axis_ac"));
+  const gen::SymbolicModel m = gen::build_model(d, 3);
+  const std::string md = gen::emit_report_markdown(m, "machines/five_axis_ac.yaml");
+  REQUIRE(md.find("## Terms of degree 3 and higher") != std::string::npos);
+  CHECK(md.find("weilgen show machines/five_axis_ac.yaml --order 3") != std::string::npos);
+  for (int o = 0; o < 6; ++o) {
+    // The report's closed form is the full one without its degree-3 terms.
+    const std::string shown = gen::closed_form(m, o, gen::FormStyle::Text, gen::Notation::Iso, 2);
+    const std::string full = gen::closed_form(m, o, gen::FormStyle::Text, gen::Notation::Iso);
+    CHECK(md.find(shown + "\n") != std::string::npos);
+    CHECK(full.size() > shown.size());
+    CHECK(full.compare(0, shown.size(), shown) == 0);
+    // The count table: terms of each degree in the model.
+    std::array<int, 4> count{};
+    for (const auto& [mono, c] : m.outputs[o].terms()) ++count[mono.size()];
+    const std::string row = "| " + std::string(output_name(static_cast<std::size_t>(o))) + " | " +
+                            std::to_string(count[1]) + " | " + std::to_string(count[2]) + " | " +
+                            std::to_string(count[3]) + " |";
+    CHECK_MESSAGE(md.find(row) != std::string::npos, row);
+  }
+  // The largest degree-3 term of dx at the mid-range pose, found here by GiNaC's own numeric
+  // evaluation (subs + evalf), is the first row listed for dx, with its coefficient.
+  GiNaC::exmap at;
+  for (const auto& a : m.axes) {
+    const Joint& j = d.bodies[a.body].joint;
+    const double q = (j.min + j.max) / 2;
+    at[a.coordinate] = q;
+    if (a.revolute) {
+      at[a.cos] = std::cos(q * j.to_base);
+      at[a.sin] = std::sin(q * j.to_base);
+    }
+  }
+  const auto defaults = d.parameter_defaults();
+  for (std::size_t i = 0; i < m.params.size(); ++i)
+    at[m.params[i]] = defaults.at(d.parameters[i].name);
+  double best = -1;
+  std::map<std::string, std::pair<double, double>> dx_terms;  // name -> (coefficient, size)
+  for (const auto& [mono, c] : m.outputs[0].terms()) {
+    if (mono.size() != 3) continue;
+    const double v = GiNaC::ex_to<GiNaC::numeric>(m.with_divisors(c).subs(at).evalf()).to_double();
+    double size = std::abs(v);
+    for (auto i : mono) {
+      const Distribution& dist = d.errors[i].distribution;
+      REQUIRE(dist.kind == Distribution::Kind::Normal);
+      size *= std::sqrt(dist.a * dist.a + dist.b * dist.b) * d.errors[i].to_base;
+    }
+    dx_terms[m.monomial_name(mono)] = {v, size};
+    best = std::max(best, size);
+  }
+  // The first dx row of the table of the largest terms (ties may list either of equal terms).
+  const auto table = md.find("| output | monomial | coefficient at the pose | size |");
+  REQUIRE(table != std::string::npos);
+  const auto row = md.find("\n| dx | ", table);
+  REQUIRE(row != std::string::npos);
+  std::vector<std::string> cells;
+  std::istringstream line(md.substr(row + 1, md.find('\n', row + 1) - row - 1));
+  for (std::string cell; std::getline(line, cell, '|');)
+    if (cell.size() > 2) cells.push_back(cell.substr(1, cell.size() - 2));
+  REQUIRE(cells.size() == 4);
+  REQUIRE(dx_terms.count(cells[1]) == 1);
+  CHECK(cells[2] == format_significant(dx_terms[cells[1]].first, 4));
+  CHECK(cells[3] == format_significant(best, 3));
 }
 
 TEST_CASE("CLI: bad input exits non-zero with file:line:column and writes nothing") {

@@ -1,9 +1,12 @@
 #include "weilgen/codegen/emit_cpp.hpp"
 
+#include <algorithm>
+#include <array>
 #include <optional>
 #include <set>
 #include <sstream>
 #include <stdexcept>
+#include <tuple>
 
 #include "weilgen/base/format.hpp"
 #include "weilgen/base/text.hpp"
@@ -119,6 +122,7 @@ struct OutputGroup {
   std::string pointer;  // argument name
   std::vector<ex> values;
   bool fill_zeros = false;  // one fill() instead of an assignment per zero (sparse outputs)
+  std::string alias = {};   // the reference the assignments use; empty: "_" + pointer
 };
 
 // Named coefficient polynomials of a Deviation-style function: every coefficient that is a sum
@@ -131,8 +135,13 @@ struct Coefficients {
   std::vector<std::pair<GiNaC::symbol, ex>> defs;
   std::map<std::string, GiNaC::symbol> by_text;
   CanonicalText canon;
+  // Every coefficient but a number gets a placeholder (single symbols too), named
+  // `<prefix>N<suffix>`: the shared MonomialCoefficients of models with higher terms use `_c[N]`.
+  bool everything = false;
+  std::string prefix = "_coef", suffix;
 
-  // c = factor · placeholder, or nullopt when c is a number or a single symbol (used inline).
+  // c = factor · placeholder, or nullopt when c is a number or (unless `everything`) a single
+  // symbol (used inline).
   std::optional<std::pair<ex, GiNaC::symbol>> split(const ex& c) {
     ex factor = 1, rest = c;
     if (GiNaC::is_a<GiNaC::mul>(c)) {
@@ -150,9 +159,11 @@ struct Coefficients {
           rest *= op;
         }
       }
-      if (!GiNaC::is_a<GiNaC::mul>(rest) && !GiNaC::is_a<GiNaC::power>(rest)) return std::nullopt;
+      if (everything ? GiNaC::is_a<GiNaC::numeric>(rest)
+                     : !GiNaC::is_a<GiNaC::mul>(rest) && !GiNaC::is_a<GiNaC::power>(rest))
+        return std::nullopt;
     } else if (!GiNaC::is_a<GiNaC::add>(c)) {
-      return std::nullopt;
+      if (!everything || GiNaC::is_a<GiNaC::numeric>(c)) return std::nullopt;
     } else {
       const CanonicalText::Signed r = canon.canonical_sign(c);
       rest = r.value;
@@ -161,7 +172,7 @@ struct Coefficients {
     const std::string& key = canon.of(rest);
     auto it = by_text.find(key);
     if (it == by_text.end()) {
-      GiNaC::symbol sym("_coef" + std::to_string(defs.size()));
+      GiNaC::symbol sym(prefix + std::to_string(defs.size()) + suffix);
       defs.emplace_back(sym, rest);
       it = by_text.emplace(key, sym).first;
     }
@@ -170,11 +181,13 @@ struct Coefficients {
 
   // Σ c_m · monomial_m of one output, grouped by placeholder, each group's monomials (and those
   // with an inline coefficient) in nested form (factored_sum).
-  ex output(const Poly& p, const std::vector<GiNaC::symbol>& errors) {
+  // With max_degree > 0, only the monomials up to that degree.
+  ex output(const Poly& p, const std::vector<GiNaC::symbol>& errors, int max_degree = 0) {
     using Terms = std::vector<std::pair<Monomial, ex>>;
     Terms direct;
     std::map<std::string, std::pair<GiNaC::symbol, Terms>> grouped;
     for (const auto& [mono, c] : p.terms()) {
+      if (max_degree > 0 && static_cast<int>(mono.size()) > max_degree) continue;
       if (auto s = split(c)) {
         auto& g = grouped[s->second.get_name()];
         g.first = s->second;
@@ -246,18 +259,194 @@ FunctionCode function_body(const InputTable& inputs, const std::vector<OutputGro
   os << "\n  // Outputs\n";
   std::size_t k = ncoef;
   for (const auto& g : groups) {
+    const std::string alias = g.alias.empty() ? "_" + g.pointer : g.alias;
     os << "  if (" << g.pointer << " != nullptr) {\n";
-    os << "    auto& _" << g.pointer << " = *" << g.pointer << ";\n";
-    if (g.fill_zeros) os << "    _" << g.pointer << ".fill(Scalar(0));\n";
+    os << "    auto& " << alias << " = *" << g.pointer << ";\n";
+    if (g.fill_zeros) os << "    " << alias << ".fill(Scalar(0));\n";
     for (std::size_t i = 0; i < g.values.size(); ++i, ++k) {
       if (g.fill_zeros && cse.outputs[k].is_zero()) continue;
-      os << "    _" << g.pointer << "[" << i << "] = " << printer.print(cse.outputs[k]) << ";\n";
+      os << "    " << alias << "[" << i << "] = " << printer.print(cse.outputs[k]) << ";\n";
     }
     os << "  }\n";
   }
   FunctionCode fc{os.str(), printer.ops(), cse.temps.size()};
   fc.ops += trig;
   return fc;
+}
+
+// Items of a long initializer list, several to a line of at most 98 characters.
+std::string packed_lines(const std::vector<std::string>& items) {
+  std::string out, line;
+  for (const auto& item : items) {
+    if (line.size() + item.size() > 98) {
+      out += line + "\n";
+      line.clear();
+    }
+    line += item;
+  }
+  if (!line.empty()) out += line + "\n";
+  return out;
+}
+
+// kMaxNestedHigherTerms (emit_cpp.hpp): the nested form costs about 8 bytes of header per
+// coefficient (0.7 MB of the pipe cutter's order-3 header), the loop 3-4 times the time per call
+// (measured at order 2). Every shipped machine up to order 3 stays nested except the pipe cutter
+// at order 3 (91 791).
+
+// A model with terms of degree >= 2: every coefficient that is not a number is defined once, as
+// `_c[N]` of MonomialCoefficients, and the functions use them: DeviationAndCoefficients (the
+// monomials in nested form, the first-order coefficients as factor·_c[N]), Deviation (which
+// calls it without the coefficients) and HigherOrder, a loop over a table (output, term) →
+// (coefficient, numeric factor) instead of one assignment per term.
+struct HigherTable {
+  FunctionCode monomial, deviation, deviation_and_coefficients, higher_order;
+  std::size_t count = 0;  // kNumMonomialCoefficients
+  std::string tables;     // kHigherFactors and kHigherTable
+};
+
+HigherTable higher_table(const SymbolicModel& m, const std::vector<Monomial>& higher,
+                         const InputTable& inputs, std::size_t max_nested) {
+  const std::size_t ne = m.errors.size();
+  Coefficients shared;
+  shared.everything = true;
+  shared.prefix = "_c[";
+  shared.suffix = "]";
+  // Deviation writes every monomial in nested form, or (many higher terms) the first-order part
+  // nested plus _h[o], the higher terms summed by a loop over the table.
+  std::size_t entries = 0;
+  for (const Poly& p : m.outputs)
+    for (const auto& [mono, c] : p.terms()) entries += mono.size() >= 2;
+  const bool nested = entries <= max_nested;
+  std::vector<ex> pos, rot, spos, srot;
+  for (int o = 0; o < 6; ++o) {
+    ex out = shared.output(m.outputs[o], m.errors, nested ? 0 : 1);
+    if (!nested) out += GiNaC::symbol("_h[" + std::to_string(o) + "]");
+    (o < 3 ? pos : rot).push_back(out);
+  }
+  for (int o = 0; o < 6; ++o)
+    for (std::size_t i = 0; i < ne; ++i) {
+      const ex c = m.coefficient(o, {static_cast<std::uint16_t>(i)});
+      const auto s = shared.split(c);
+      (o < 3 ? spos : srot).push_back(s ? s->first * s->second : c);
+    }
+  // The table, term by term (each monomial is formed once): per non-zero coefficient, the step
+  // from the previous entry's index term * kNumOutputs + output, its placeholder (none: the
+  // number 1) and its numeric factor.
+  std::vector<std::tuple<std::size_t, std::string, std::size_t>> rows;
+  std::vector<GiNaC::numeric> factors;
+  std::size_t at = 0, last = 0;
+  for (const Monomial& mono : higher)
+    for (int o = 0; o < 6; ++o, ++at) {
+      const ex c = m.coefficient(o, mono);
+      if (c.is_zero()) continue;
+      const auto s = shared.split(c);
+      const GiNaC::numeric f = GiNaC::ex_to<GiNaC::numeric>(s ? s->first : c);
+      auto it = std::find_if(factors.begin(), factors.end(),
+                             [&](const GiNaC::numeric& x) { return x.is_equal(f); });
+      if (it == factors.end()) it = factors.insert(factors.end(), f);
+      rows.emplace_back(at - last, s ? s->second.get_name() : std::string(),
+                        static_cast<std::size_t>(it - factors.begin()));
+      last = at;
+    }
+  std::map<std::string, std::size_t> index;
+  for (std::size_t k = 0; k < shared.defs.size(); ++k) index[shared.defs[k].first.get_name()] = k;
+
+  HigherTable t;
+  t.count = shared.defs.size();
+  std::vector<ex> values;
+  for (const auto& def : shared.defs) values.push_back(def.second);
+  // A short name for the ~10 000 assignments (`_k[N] = ...`).
+  t.monomial = function_body(inputs, {{"coefficients", values, false, "_k"}});
+  const std::string call =
+      "  std::array<Scalar, kNumMonomialCoefficients> _c{};\n"
+      "  MonomialCoefficients(axes, params, &_c);\n";
+  const std::string coefficient =
+      "(c < kNumMonomialCoefficients ? _c[c] : Scalar(1)) * "
+      "Scalar(kHigherFactors[kHigherTable[k + 2]])";
+  const std::string higher_sum =
+      "  // The terms of degree >= 2, monomial by monomial (kHigherTable).\n"
+      "  std::array<Scalar, kNumOutputs> _h{};\n"
+      "  if (position != nullptr || orientation != nullptr) {\n"
+      "    std::size_t at = 0, term = kNumHigherTerms;\n"
+      "    Scalar monomial(1);\n"
+      "    for (std::size_t k = 0; k < kHigherTable.size(); k += 3) {\n"
+      "      at += kHigherTable[k];\n"
+      "      if (at / kNumOutputs != term) {\n"
+      "        term = at / kNumOutputs;\n"
+      "        monomial = Scalar(1);\n"
+      "        for (const int i : kHigherTerms[term])\n"
+      "          if (i >= 0) monomial = monomial * errors[static_cast<std::size_t>(i)];\n"
+      "      }\n"
+      "      const std::uint32_t c = kHigherTable[k + 1];\n"
+      "      _h[at % kNumOutputs] = _h[at % kNumOutputs] + " +
+      coefficient +
+      " * monomial;\n"
+      "    }\n"
+      "  }\n\n";
+  // The loop: per entry three multiplications (coefficient, factor, monomial) and an addition;
+  // per monomial of degree d, d multiplications.
+  OpCount loop;
+  loop.muls = 3 * static_cast<long>(rows.size());
+  loop.adds = static_cast<long>(rows.size());
+  for (const Monomial& mono : higher) loop.muls += static_cast<long>(mono.size());
+  t.deviation_and_coefficients = function_body(inputs, {{"position", pos},
+                                                        {"orientation", rot},
+                                                        {"position_coeff", spos},
+                                                        {"orientation_coeff", srot}});
+  t.deviation_and_coefficients.body =
+      call + (nested ? "\n" : higher_sum) + t.deviation_and_coefficients.body;
+  if (nested) loop = {};
+  t.deviation_and_coefficients.ops += t.monomial.ops;
+  t.deviation_and_coefficients.ops += loop;
+  t.deviation_and_coefficients.temps += t.monomial.temps;
+  // Deviation's cost: the coefficients, the loop and the outputs (its body only forwards).
+  t.deviation = function_body(inputs, {{"position", pos}, {"orientation", rot}});
+  t.deviation.ops += t.monomial.ops;
+  t.deviation.ops += loop;
+  t.deviation.temps += t.monomial.temps;
+  t.deviation.body =
+      "  DeviationAndCoefficients<Scalar>(axes, errors, params, position, orientation, nullptr,\n"
+      "                                   nullptr);\n";
+  t.higher_order.ops = t.monomial.ops;
+  t.higher_order.ops.muls += static_cast<long>(rows.size());
+  t.higher_order.temps = t.monomial.temps;
+  t.higher_order.body = "  if (terms == nullptr) return;\n" + call +
+                        "  auto& _terms = *terms;\n"
+                        "  _terms.fill(Scalar(0));\n"
+                        "  std::size_t at = 0;\n"
+                        "  for (std::size_t k = 0; k < kHigherTable.size(); k += 3) {\n"
+                        "    at += kHigherTable[k];\n"
+                        "    const std::uint32_t c = kHigherTable[k + 1];\n"
+                        "    _terms[at % kNumOutputs * kNumHigherTerms + at / kNumOutputs] =\n"
+                        "        " +
+                        coefficient +
+                        ";\n"
+                        "  }\n";
+
+  std::ostringstream os;
+  os << "// The terms of degree >= 2 as a table, read by HigherOrder (and by "
+        "DeviationAndCoefficients\n"
+        "// when it sums them by a loop): per non-zero coefficient, term by term, the step from "
+        "the\n"
+        "// previous entry's index term * kNumOutputs + output, the index of its "
+        "MonomialCoefficients\n"
+        "// value (kNumMonomialCoefficients: the number 1) and of its numeric factor in "
+        "kHigherFactors.\n";
+  os << "inline constexpr std::array<double, " << factors.size() << "> kHigherFactors = {{";
+  for (std::size_t i = 0; i < factors.size(); ++i)
+    os << (i ? ", " : "") << format_literal(factors[i].to_double());
+  os << "}};\n";
+  os << "inline constexpr std::array<std::uint32_t, " << 3 * rows.size() << "> kHigherTable = {{\n";
+  std::vector<std::string> items;
+  for (const auto& [step, name, factor] : rows) {
+    const std::size_t k = name.empty() ? t.count : index.at(name);
+    items.push_back(std::to_string(step) + "," + std::to_string(k) + "," + std::to_string(factor) +
+                    ",");
+  }
+  os << packed_lines(items);
+  os << "}};\n\n";
+  t.tables = os.str();
+  return t;
 }
 
 std::string doc_list(const std::vector<std::string>& names) {
@@ -268,17 +457,12 @@ std::string doc_list(const std::vector<std::string>& names) {
 
 }  // namespace
 
-std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_label) {
+std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_label,
+                            std::size_t max_nested_higher_terms) {
   const Description& d = m.desc;
   const InputTable inputs = inputs_of(m);
   const std::size_t ne = m.errors.size();
   const std::vector<Monomial> higher = m.higher_monomials();
-
-  // Deviation: the full algebra element of each output.
-  Coefficients coefs;
-  std::vector<ex> pos, rot;
-  for (int o = 0; o < 6; ++o) (o < 3 ? pos : rot).push_back(coefs.output(m.outputs[o], m.errors));
-  const FunctionCode dev = function_body(inputs, {{"position", pos}, {"orientation", rot}}, &coefs);
 
   // Coefficients: ∂output/∂error at zero error, row-major [output][error].
   std::vector<ex> cpos, crot;
@@ -288,33 +472,39 @@ std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_la
   const FunctionCode coef =
       function_body(inputs, {{"position_coeff", cpos}, {"orientation_coeff", crot}});
 
-  // Both at once: one CSE over the deviation and the coefficients, so that the sin/cos of the
-  // axes and the nominal terms they share are computed once. A coefficient that is a named
-  // coefficient of Deviation is written as factor·_coefN (the same canonical sign), so that the
-  // two are not computed twice under different signs.
-  Coefficients shared = coefs;
-  std::vector<ex> spos, srot;
-  for (int o = 0; o < 6; ++o)
-    for (std::size_t i = 0; i < ne; ++i) {
-      const ex c = m.coefficient(o, {static_cast<std::uint16_t>(i)});
-      const auto s = shared.split(c);
-      (o < 3 ? spos : srot).push_back(s ? s->first * s->second : c);
-    }
-  const FunctionCode dev_coef = function_body(inputs,
-                                              {{"position", pos},
-                                               {"orientation", rot},
-                                               {"position_coeff", spos},
-                                               {"orientation_coeff", srot}},
-                                              &shared);
+  FunctionCode dev, dev_coef, high;
+  HigherTable table;
+  if (higher.empty()) {
+    // Deviation: the full algebra element of each output.
+    Coefficients coefs;
+    std::vector<ex> pos, rot;
+    for (int o = 0; o < 6; ++o) (o < 3 ? pos : rot).push_back(coefs.output(m.outputs[o], m.errors));
+    dev = function_body(inputs, {{"position", pos}, {"orientation", rot}}, &coefs);
 
-  FunctionCode high;
-  if (!higher.empty()) {
-    std::vector<ex> h;
+    // Both at once: one CSE over the deviation and the coefficients, so that the sin/cos of the
+    // axes and the nominal terms they share are computed once. A coefficient that is a named
+    // coefficient of Deviation is written as factor·_coefN (the same canonical sign), so that
+    // the two are not computed twice under different signs.
+    Coefficients shared = coefs;
+    std::vector<ex> spos, srot;
     for (int o = 0; o < 6; ++o)
-      for (const auto& mono : higher) h.push_back(m.coefficient(o, mono));
-    high = function_body(inputs, {{"terms", h, true}});
+      for (std::size_t i = 0; i < ne; ++i) {
+        const ex c = m.coefficient(o, {static_cast<std::uint16_t>(i)});
+        const auto s = shared.split(c);
+        (o < 3 ? spos : srot).push_back(s ? s->first * s->second : c);
+      }
+    dev_coef = function_body(inputs,
+                             {{"position", pos},
+                              {"orientation", rot},
+                              {"position_coeff", spos},
+                              {"orientation_coeff", srot}},
+                             &shared);
+  } else {
+    table = higher_table(m, higher, inputs, max_nested_higher_terms);
+    dev = table.deviation;
+    dev_coef = table.deviation_and_coefficients;
+    high = table.higher_order;
   }
-
   // Nominal kinematics: the pose at zero errors and its Jacobian in the axes' units (a revolute
   // column per deg is the per-rad derivative times to_base).
   std::vector<ex> npos, nrot;
@@ -361,6 +551,10 @@ std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_la
         "mm/deg;\n"
      << "//        position outputs dx, dy, dz in mm, orientation outputs da, db, dc in rad.\n";
   os << "// Operation counts (after common-subexpression elimination):\n";
+  if (!higher.empty())
+    os << "//   MonomialCoefficients: " << table.monomial.ops.str() << ", " << table.monomial.temps
+       << " temporaries (" << table.count
+       << " coefficients; included in each function below that uses them)\n";
   os << "//   Deviation:    " << dev.ops.str() << ", " << dev.temps << " temporaries\n";
   os << "//   Coefficients: " << coef.ops.str() << ", " << coef.temps << " temporaries\n";
   os << "//   DeviationAndCoefficients: " << dev_coef.ops.str() << ", " << dev_coef.temps
@@ -373,7 +567,8 @@ std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_la
   os << "//   Compensate:   per iteration errors_at + Deviation + NominalPose + "
      << (m.axes_turn_output() ? 6 : 3) << "x" << na
      << " least-squares step; once per call NominalJacobian + NominalPose + Cholesky\n";
-  os << "#pragma once\n\n#include <array>\n#include <cmath>\n#include <cstddef>\n\n";
+  os << "#pragma once\n\n#include <array>\n#include <cmath>\n#include <cstddef>\n"
+     << (higher.empty() ? "" : "#include <cstdint>\n") << "\n";
   os << "namespace weilgen_models {\nnamespace " << d.name << " {\n\n";
 
   os << "inline constexpr const char* kMachineName = " << string_literal(d.name) << ";\n";
@@ -450,59 +645,93 @@ std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_la
   const std::size_t width = higher.empty() ? 1 : higher.back().size();
   os << "inline constexpr std::array<std::array<int, " << width
      << ">, kNumHigherTerms> kHigherTerms = {{\n";
+  std::vector<std::string> rows;  // several monomials per line: tens of thousands at order 3
   for (const auto& mono : higher) {
-    os << "    {{";
+    std::string item = "{{";
     for (std::size_t i = 0; i < width; ++i)
-      os << (i ? ", " : "") << (i < mono.size() ? std::to_string(mono[i]) : "-1");
-    os << "}},  // " << m.monomial_name(mono) << "\n";
+      item += (i ? "," : "") + (i < mono.size() ? std::to_string(mono[i]) : std::string("-1"));
+    rows.push_back(item + "}},");
   }
+  os << packed_lines(rows);
   os << "}};\n\n";
+  if (!higher.empty()) {
+    os << "// Coefficient polynomials shared by DeviationAndCoefficients, Deviation and "
+          "HigherOrder.\n"
+       << "inline constexpr std::size_t kNumMonomialCoefficients = " << table.count << ";\n";
+    os << table.tables;
+  }
 
   const std::string in_doc = "//   axes:   " + doc_list(axis_names) +
                              "\n//   errors: " + doc_list(error_names) +
                              "\n//   params: " + doc_list(param_names) + "\n";
-  os << (d.output ? "// Deviation of the output point (" +
-                        (d.output->description.empty() ? std::string("the output transform")
-                                                       : d.output->description) +
-                        "):\n"
-                  : std::string("// Deviation of the tool point relative to the workpiece, in the "
-                                "workpiece frame:\n"))
-     << "// position = (dx, dy, dz) in mm, orientation = (da, db, dc) in rad. Null outputs are\n"
-        "// skipped. Exact in the algebra of order kOrder.\n"
-     << in_doc;
-  os << "template <typename Scalar>\nvoid Deviation([[maybe_unused]] const std::array<Scalar, "
-        "kNumAxes>& axes,\n"
-        "               [[maybe_unused]] const std::array<Scalar, kNumErrors>& errors,\n"
-        "               [[maybe_unused]] const std::array<Scalar, kNumParams>& params,\n"
-        "               std::array<Scalar, 3>* const position,\n"
-        "               std::array<Scalar, 3>* const orientation = nullptr) {\n"
-        "  using std::cos;\n  using std::sin;\n  using std::sqrt;\n"
-     << dev.body << "}\n\n";
-  os << "// First-order coefficients d(output)/d(error) at zero error, row-major [output][error]:\n"
-        "// position_coeff rows dx, dy, dz (mm per base unit of the error), orientation_coeff "
-        "rows\n"
-        "// da, db, dc (rad per base unit).\n";
-  os << "template <typename Scalar>\nvoid Coefficients([[maybe_unused]] const std::array<Scalar, "
-        "kNumAxes>& axes,\n"
-        "                  [[maybe_unused]] const std::array<Scalar, kNumParams>& params,\n"
-        "                  std::array<Scalar, 3 * kNumErrors>* const position_coeff,\n"
-        "                  std::array<Scalar, 3 * kNumErrors>* const orientation_coeff = nullptr) "
-        "{\n"
-        "  using std::cos;\n  using std::sin;\n  using std::sqrt;\n"
-     << coef.body << "}\n";
-  os << "\n// Deviation and Coefficients at one pose in one call, sharing the sin/cos of the axes "
-        "and\n"
-        "// the terms common to both (one common-subexpression pass over both). The same outputs\n"
-        "// as the two functions, equal to rounding; null outputs are skipped.\n";
-  os << "template <typename Scalar>\nvoid DeviationAndCoefficients(\n"
-        "    [[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,\n"
-        "    [[maybe_unused]] const std::array<Scalar, kNumErrors>& errors,\n"
-        "    [[maybe_unused]] const std::array<Scalar, kNumParams>& params,\n"
-        "    std::array<Scalar, 3>* const position, std::array<Scalar, 3>* const orientation,\n"
-        "    std::array<Scalar, 3 * kNumErrors>* const position_coeff,\n"
-        "    std::array<Scalar, 3 * kNumErrors>* const orientation_coeff = nullptr) {\n"
-        "  using std::cos;\n  using std::sin;\n  using std::sqrt;\n"
-     << dev_coef.body << "}\n";
+  std::ostringstream dev_text, coef_text, dev_coef_text;
+  dev_text
+      << (d.output ? "// Deviation of the output point (" +
+                         (d.output->description.empty() ? std::string("the output transform")
+                                                        : d.output->description) +
+                         "):\n"
+                   : std::string("// Deviation of the tool point relative to the workpiece, in the "
+                                 "workpiece frame:\n"))
+      << "// position = (dx, dy, dz) in mm, orientation = (da, db, dc) in rad. Null outputs are\n"
+         "// skipped. Exact in the algebra of order kOrder.\n"
+      << in_doc;
+  dev_text
+      << "template <typename Scalar>\nvoid Deviation([[maybe_unused]] const std::array<Scalar, "
+         "kNumAxes>& axes,\n"
+         "               [[maybe_unused]] const std::array<Scalar, kNumErrors>& errors,\n"
+         "               [[maybe_unused]] const std::array<Scalar, kNumParams>& params,\n"
+         "               std::array<Scalar, 3>* const position,\n"
+         "               std::array<Scalar, 3>* const orientation = nullptr) {\n"
+         "  using std::cos;\n  using std::sin;\n  using std::sqrt;\n"
+      << dev.body << "}\n";
+  coef_text
+      << "\n// First-order coefficients d(output)/d(error) at zero error, row-major "
+         "[output][error]:\n"
+         "// position_coeff rows dx, dy, dz (mm per base unit of the error), orientation_coeff "
+         "rows\n"
+         "// da, db, dc (rad per base unit).\n";
+  coef_text
+      << "template <typename Scalar>\nvoid Coefficients([[maybe_unused]] const std::array<Scalar, "
+         "kNumAxes>& axes,\n"
+         "                  [[maybe_unused]] const std::array<Scalar, kNumParams>& params,\n"
+         "                  std::array<Scalar, 3 * kNumErrors>* const position_coeff,\n"
+         "                  std::array<Scalar, 3 * kNumErrors>* const orientation_coeff = nullptr) "
+         "{\n"
+         "  using std::cos;\n  using std::sin;\n  using std::sqrt;\n"
+      << coef.body << "}\n";
+  dev_coef_text
+      << "\n// Deviation and Coefficients at one pose in one call, sharing the sin/cos of the axes "
+         "and\n"
+         "// the terms common to both (one common-subexpression pass over both). The same outputs\n"
+         "// as the two functions, equal to rounding; null outputs are skipped.\n";
+  dev_coef_text
+      << "template <typename Scalar>\nvoid DeviationAndCoefficients(\n"
+         "    [[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,\n"
+         "    [[maybe_unused]] const std::array<Scalar, kNumErrors>& errors,\n"
+         "    [[maybe_unused]] const std::array<Scalar, kNumParams>& params,\n"
+         "    std::array<Scalar, 3>* const position, std::array<Scalar, 3>* const orientation,\n"
+         "    std::array<Scalar, 3 * kNumErrors>* const position_coeff,\n"
+         "    std::array<Scalar, 3 * kNumErrors>* const orientation_coeff = nullptr) {\n"
+         "  using std::cos;\n  using std::sin;\n  using std::sqrt;\n"
+      << dev_coef.body << "}\n";
+  if (higher.empty()) {
+    os << dev_text.str() << coef_text.str() << dev_coef_text.str();
+  } else {
+    // Deviation calls DeviationAndCoefficients, which comes first.
+    os << "// The coefficient polynomials of the error monomials, each once (every coefficient of "
+          "an\n"
+          "// output's monomial is a numeric factor times one of them or a number).\n"
+          "template <typename Scalar>\n"
+          "void MonomialCoefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,\n"
+          "                          [[maybe_unused]] const std::array<Scalar, kNumParams>& "
+          "params,\n"
+          "                          std::array<Scalar, kNumMonomialCoefficients>* const "
+          "coefficients) {\n"
+          "  using std::cos;\n  using std::sin;\n  using std::sqrt;\n"
+       << table.monomial.body << "}\n"
+       << dev_coef_text.str() << "\n"
+       << dev_text.str() << coef_text.str();
+  }
   if (!higher.empty()) {
     os << "\n// Coefficients of the monomials kHigherTerms in each output, row-major\n"
           "// [output][term]: output = Coefficients·errors + Σ terms[o][k]·Π "

@@ -1,9 +1,12 @@
 #include "weilgen/codegen/emit_report.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <sstream>
 
 #include "weilgen/base/format.hpp"
 #include "weilgen/base/version.hpp"
+#include "weilgen/codegen/model_eval.hpp"
 #include "weilgen/codegen/printer.hpp"
 
 namespace weilgen::gen {
@@ -33,39 +36,48 @@ std::pair<std::string, int> display(const SymbolicModel& m, std::size_t i, Notat
   return {style == FormStyle::Latex ? latex_name(e.name) : e.name, 1};
 }
 
-// Appends " + c·name" (or the first term) to acc in place: a closed form at order 3 has tens of
-// thousands of terms, and building a new string per term would copy it each time.
-void append_term(std::string& acc, ex coeff, const std::string& name, ExprPrinter& pr,
-                 FormStyle style) {
-  const std::string times = style == FormStyle::Latex ? "\\," : "·";
+// A coefficient as printed before its error name: its sign (a leading '-') split off.
+struct CoefficientText {
   bool negative = false;
-  std::string c;
+  std::string text;
+};
+
+CoefficientText coefficient_text(ex coeff, ExprPrinter& pr, FormStyle style) {
+  CoefficientText out;
   if (GiNaC::is_a<GiNaC::add>(coeff)) {
     // -(a + b)·E reads better than (-a - b)·E: factor out the sign of a mostly negative sum.
     std::size_t negatives = 0;
     for (std::size_t i = 0; i < coeff.nops(); ++i) negatives += pr.prints_negative(coeff.op(i));
     if (2 * negatives > coeff.nops()) {
-      negative = true;
+      out.negative = true;
       coeff = (-coeff).expand();
     } else if (2 * negatives == coeff.nops()) {
       // As many negative terms as positive: GiNaC's sign of the sum varies between runs; take
       // the canonical one.
       CanonicalText canon;
       const CanonicalText::Signed r = canon.canonical_sign(coeff);
-      negative = r.negated;
+      out.negative = r.negated;
       coeff = r.value;
     }
-    c = (style == FormStyle::Latex ? "\\left(" : "(") + pr.print(coeff) +
-        (style == FormStyle::Latex ? "\\right)" : ")");
+    out.text = (style == FormStyle::Latex ? "\\left(" : "(") + pr.print(coeff) +
+               (style == FormStyle::Latex ? "\\right)" : ")");
   } else {
-    c = pr.print(coeff);
-    if (!c.empty() && c[0] == '-') {
-      negative = true;
-      c.erase(0, 1);
+    out.text = pr.print(coeff);
+    if (!out.text.empty() && out.text[0] == '-') {
+      out.negative = true;
+      out.text.erase(0, 1);
     }
   }
-  acc += acc.empty() ? (negative ? "-" : "") : (negative ? " - " : " + ");
-  if (c != "1") acc.append(c).append(times);
+  return out;
+}
+
+// Appends " + c·name" (or the first term) to acc in place: a closed form at order 3 has tens of
+// thousands of terms, and building a new string per term would copy it each time.
+void append_term(std::string& acc, const CoefficientText& c, const std::string& name,
+                 FormStyle style) {
+  const char* times = style == FormStyle::Latex ? "\\," : "·";
+  acc += acc.empty() ? (c.negative ? "-" : "") : (c.negative ? " - " : " + ");
+  if (c.text != "1") acc.append(c.text).append(times);
   acc += name;
 }
 
@@ -84,20 +96,52 @@ std::map<std::string, std::string> symbol_names(const SymbolicModel& m, FormStyl
 // Common factors pulled out for reading: cos(c)·z - cos(c)·L -> cos(c)·(z - L).
 ex readable(const ex& c) { return GiNaC::collect_common_factors(c); }
 
-}  // namespace
+// Printed coefficients of one style, memoised by (coefficient, sign): at order 3 a coefficient
+// recurs in many monomials and outputs, and both notations print it again.
+class TermPrinter {
+ public:
+  TermPrinter(const SymbolicModel& m, FormStyle style)
+      : m_(m),
+        style_(style),
+        pr_(style == FormStyle::Latex ? ExprPrinter::Style::Latex : ExprPrinter::Style::Text,
+            symbol_names(m, style)) {}
+  FormStyle style() const { return style_; }
+  const CoefficientText& operator()(const ex& coefficient, int sign) {
+    const auto key = std::make_pair(coefficient, sign);
+    auto it = memo_.find(key);
+    if (it == memo_.end()) {
+      const ex c = readable((m_.with_divisors(coefficient) * sign).expand());
+      it = memo_.emplace(key, coefficient_text(c, pr_, style_)).first;
+    }
+    return it->second;
+  }
 
-std::string closed_form(const SymbolicModel& m, int o, FormStyle style, Notation notation) {
-  ExprPrinter pr(style == FormStyle::Latex ? ExprPrinter::Style::Latex : ExprPrinter::Style::Text,
-                 symbol_names(m, style));
+ private:
+  struct Less {
+    bool operator()(const std::pair<ex, int>& a, const std::pair<ex, int>& b) const {
+      if (a.second != b.second) return a.second < b.second;
+      return a.first.compare(b.first) < 0;
+    }
+  };
+  const SymbolicModel& m_;
+  FormStyle style_;
+  ExprPrinter pr_;
+  std::map<std::pair<ex, int>, CoefficientText, Less> memo_;
+};
+
+std::string closed_form(const SymbolicModel& m, int o, Notation notation, int max_degree,
+                        TermPrinter& tp) {
+  const FormStyle style = tp.style();
   std::string s;
   for (std::size_t i = 0; i < m.errors.size(); ++i) {
-    const ex c = m.with_divisors(m.coefficient(o, {static_cast<std::uint16_t>(i)}));
+    const ex c = m.coefficient(o, {static_cast<std::uint16_t>(i)});
     if (c.is_zero()) continue;
     const auto [name, sign] = display(m, i, notation, style);
-    append_term(s, readable((c * sign).expand()), name, pr, style);
+    append_term(s, tp(c, sign), name, style);
   }
   for (const auto& mono : m.higher_monomials()) {
-    const ex c = m.with_divisors(m.coefficient(o, mono));
+    if (max_degree > 0 && static_cast<int>(mono.size()) > max_degree) break;  // sorted by degree
+    const ex c = m.coefficient(o, mono);
     if (c.is_zero()) continue;
     std::string name;
     int sign = 1;
@@ -106,7 +150,7 @@ std::string closed_form(const SymbolicModel& m, int o, FormStyle style, Notation
       name += (name.empty() ? "" : (style == FormStyle::Latex ? "\\," : "·")) + n;
       sign *= sg;
     }
-    append_term(s, readable((c * sign).expand()), name, pr, style);
+    append_term(s, tp(c, sign), name, style);
   }
   const std::string lhs =
       style == FormStyle::Latex
@@ -115,17 +159,129 @@ std::string closed_form(const SymbolicModel& m, int o, FormStyle style, Notation
   return lhs + " = " + (s.empty() ? "0" : s);
 }
 
+// Root mean square of error i's distribution in base units (mm, rad): the size of the error a
+// term is weighed with; 1 µm or 1 µrad when the file gives no distribution.
+double error_scale(const ErrorDef& e) {
+  const Distribution& d = e.distribution;
+  double rms = 0;
+  switch (d.kind) {
+    case Distribution::Kind::Normal:
+    case Distribution::Kind::TruncatedNormal:
+      rms = std::sqrt(d.a * d.a + d.b * d.b);
+      break;
+    case Distribution::Kind::Uniform:
+      rms = std::sqrt((d.a * d.a + d.a * d.b + d.b * d.b) / 3);
+      break;
+    case Distribution::Kind::None:
+      return 1e-3 * (e.effect == ErrorEffect::Rotation ? 1e-3 : 1);
+  }
+  return rms * e.to_base;
+}
+
+// The part of the report for terms above `shown` degrees: counts per output and degree, and the
+// largest terms at the mid-range pose (a reader's question: which products of errors matter).
+std::string higher_terms_summary(const SymbolicModel& m, const std::vector<Monomial>& higher,
+                                 int shown, const std::string& source_label) {
+  const Description& d = m.desc;
+  const int top_degree = static_cast<int>(higher.back().size());
+  std::vector<double> axes;
+  std::string pose;
+  for (const auto& a : m.axes) {
+    const Joint& j = d.bodies[a.body].joint;
+    axes.push_back((j.min + j.max) / 2);
+    pose += (pose.empty() ? "" : ", ") + j.coordinate + " = " + format_short(axes.back()) + " " +
+            j.unit;
+  }
+  std::vector<double> scale;
+  for (const auto& e : d.errors) scale.push_back(error_scale(e));
+  CoefficientEvaluator at_pose(m, axes);
+
+  struct Term {
+    double size, coefficient;
+    int output;
+    std::size_t monomial;
+  };
+  constexpr std::size_t kListed = 5;  // per output
+  std::vector<Term> largest;
+  std::vector<std::vector<std::size_t>> count(kNumDeviationOutputs,
+                                              std::vector<std::size_t>(top_degree + 1, 0));
+  std::size_t above = 0;
+  for (int o = 0; o < kNumDeviationOutputs; ++o) {
+    std::vector<Term> terms;
+    for (const auto& [mono, c] : m.outputs[o].terms()) {
+      ++count[o][mono.size()];
+      if (static_cast<int>(mono.size()) <= shown) continue;
+      ++above;
+      const double v = at_pose(c);
+      double size = std::abs(v);
+      for (auto i : mono) size *= scale[i];
+      const auto k = static_cast<std::size_t>(
+          std::lower_bound(higher.begin(), higher.end(), mono,
+                           [](const Monomial& a, const Monomial& b) {
+                             return a.size() != b.size() ? a.size() < b.size() : a < b;
+                           }) -
+          higher.begin());
+      terms.push_back({size, v, o, k});
+    }
+    const std::size_t n = std::min(kListed, terms.size());
+    // Ties (equal sizes) by the monomial's place in kHigherTerms: the same order on every run.
+    std::partial_sort(terms.begin(), terms.begin() + static_cast<std::ptrdiff_t>(n), terms.end(),
+                      [](const Term& a, const Term& b) {
+                        return a.size != b.size ? a.size > b.size : a.monomial < b.monomial;
+                      });
+    largest.insert(largest.end(), terms.begin(), terms.begin() + static_cast<std::ptrdiff_t>(n));
+  }
+
+  std::ostringstream os;
+  os << "## Terms of degree " << shown + 1 << " and higher\n\n";
+  os << "Order " << m.order << " has " << above << " terms (output, monomial) of degree "
+     << shown + 1 << (top_degree > shown + 1 ? " to " + std::to_string(top_degree) : std::string())
+     << ", too many to read here. `weilgen show " << source_label << " --order " << m.order
+     << "` prints every term (`--format latex` or `--format json` too); the header's "
+        "`HigherOrder` evaluates their coefficients (monomials in `kHigherTerms`).\n\n";
+  os << "| output";
+  for (int g = 1; g <= top_degree; ++g) os << " | degree " << g;
+  os << " |\n| ---";
+  for (int g = 1; g <= top_degree; ++g) os << " | ---:";
+  os << " |\n";
+  for (int o = 0; o < kNumDeviationOutputs; ++o) {
+    os << "| " << output_name(static_cast<std::size_t>(o));
+    for (int g = 1; g <= top_degree; ++g) os << " | " << count[o][g];
+    os << " |\n";
+  }
+  os << "\nThe " << kListed << " largest of them per output at the mid-range pose (" << pose
+     << "; parameters at their defaults), each error at the root mean square of its "
+        "distribution (1 µm or 1 µrad without one): the coefficient there, and the term's size "
+        "|coefficient · Π errors| in the output's unit (mm, rad).\n\n"
+        "| output | monomial | coefficient at the pose | size |\n| --- | --- | ---: | ---: |\n";
+  for (const Term& t : largest)
+    os << "| " << output_name(static_cast<std::size_t>(t.output)) << " | "
+       << m.monomial_name(higher[t.monomial]) << " | " << format_significant(t.coefficient, 4)
+       << " | " << format_significant(t.size, 3) << " |\n";
+  os << "\n";
+  return os.str();
+}
+
+}  // namespace
+
+std::string closed_form(const SymbolicModel& m, int o, FormStyle style, Notation notation,
+                        int max_degree) {
+  TermPrinter tp(m, style);
+  return closed_form(m, o, notation, max_degree, tp);
+}
+
 nlohmann::json closed_forms_json(const SymbolicModel& m, Notation notation) {
   nlohmann::json j;
   j["machine"] = m.desc.name;
   j["order"] = m.order;
   j["notation"] = notation == Notation::Iso ? "iso" : "alias";
   ExprPrinter pr(ExprPrinter::Style::Text);
+  TermPrinter text(m, FormStyle::Text), latex(m, FormStyle::Latex);
   for (int o = 0; o < kNumDeviationOutputs; ++o) {
     nlohmann::json out;
     out["unit"] = output_unit(static_cast<std::size_t>(o));
-    out["closed_form"] = closed_form(m, o, FormStyle::Text, notation);
-    out["latex"] = closed_form(m, o, FormStyle::Latex, notation);
+    out["closed_form"] = closed_form(m, o, notation, 0, text);
+    out["latex"] = closed_form(m, o, notation, 0, latex);
     nlohmann::json lin = nlohmann::json::object();
     for (std::size_t i = 0; i < m.errors.size(); ++i) {
       const ex c = m.with_divisors(m.coefficient(o, {static_cast<std::uint16_t>(i)}));
@@ -181,18 +337,29 @@ std::string emit_report_markdown(const SymbolicModel& m, const std::string& sour
   os << "- Coordinates print in lower case (`X` → `x`); revolute coordinates appear as "
         "`cos(c)`, `sin(c)` of the angle.\n\n";
 
-  os << "## Closed forms\n\n```text\n";
+  const std::vector<Monomial> higher = m.higher_monomials();
+  const int shown = !higher.empty() && static_cast<int>(higher.back().size()) > kReportMaxDegree
+                        ? kReportMaxDegree
+                        : 0;
+  os << "## Closed forms\n\n";
+  if (shown > 0)
+    os << "Terms up to degree " << shown << "; the terms of degree " << shown + 1
+       << " and higher are summarised in \"Terms of degree " << shown + 1
+       << " and higher\" below.\n\n";
+  os << "```text\n";
+  TermPrinter tp(m, FormStyle::Text);
   for (int o = 0; o < kNumDeviationOutputs; ++o)
-    os << closed_form(m, o, FormStyle::Text, Notation::Iso) << "\n";
+    os << closed_form(m, o, Notation::Iso, shown, tp) << "\n";
   os << "```\n\n";
   bool has_alias = false;
   for (const auto& e : d.errors) has_alias |= !e.aliases.empty();
   if (has_alias) {
     os << "### In the source's notation (first alias of each error)\n\n```text\n";
     for (int o = 0; o < kNumDeviationOutputs; ++o)
-      os << closed_form(m, o, FormStyle::Text, Notation::Alias) << "\n";
+      os << closed_form(m, o, Notation::Alias, shown, tp) << "\n";
     os << "```\n\n";
   }
+  if (shown > 0) os << higher_terms_summary(m, higher, shown, source_label);
 
   os << "## First-order coefficients ∂output/∂error\n\n| error | dx | dy | dz | da | db | dc |\n"
         "| --- | --- | --- | --- | --- | --- | --- |\n";

@@ -381,7 +381,10 @@ struct Builder {
       Mat4 r = rotation_small(w, amount - Poly(a0), alg);
       if (!a0.is_zero()) r = rotation_cs(w, GiNaC::cos(a0), GiNaC::sin(a0), alg).mul(r, alg);
       const ex pitch = (w[0] * v[0] + w[1] * v[1] + w[2] * v[2]).expand();
-      m = m.mul(translation(q), alg).mul(r, alg).mul(translation(minus_q), alg);
+      // A twist through the origin (q = 0): no translations, whose products would only copy m.
+      const bool through_origin = q[0].is_zero() && q[1].is_zero() && q[2].is_zero();
+      m = through_origin ? m.mul(r, alg)
+                         : m.mul(translation(q), alg).mul(r, alg).mul(translation(minus_q), alg);
       if (!pitch.is_zero()) m = m.mul(translation_by(amount.scaled(pitch, alg), w, alg), alg);
     }
     ex t[3];  // nominal (checked by the loader)

@@ -63,23 +63,65 @@ std::string ExprPrinter::symbol(const ex& e) {
   return it == names_.end() ? n : it->second;
 }
 
+namespace {
+// Terms (negative, text without the sign) joined in canonical order, positive terms first:
+// "(tool_length - z)" rather than "(-z + tool_length)". Counts the additions.
+std::string joined(std::vector<std::pair<bool, std::string>> terms, long& adds) {
+  std::stable_partition(terms.begin(), terms.end(), [](const auto& t) { return !t.first; });
+  std::string s = terms.front().first ? "-" + terms.front().second : terms.front().second;
+  for (std::size_t i = 1; i < terms.size(); ++i) {
+    s += terms[i].first ? " - " : " + ";
+    s += terms[i].second;
+    ++adds;
+  }
+  return s;
+}
+}  // namespace
+
 std::string ExprPrinter::print(const ex& e) {
   if (GiNaC::is_a<GiNaC::add>(e)) {
-    // Canonical order, positive terms first: "(tool_length - z)" rather than "(-z + tool_length)".
     std::vector<std::pair<bool, std::string>> terms;  // (negative, text without the sign)
+    // C++: products with the same numeric factor are grouped, Scalar(0.25) * (a + b - c), one
+    // multiplication instead of one per term (at order 3 most coefficients are such sums).
+    // Groups in order of their first term: the order stays canonical.
+    std::vector<std::string> factor_of;  // per term: its printed factor when groupable, else ""
+    std::map<std::string, std::vector<std::size_t>> members;
     for (const ex& op : canon_.sorted_ops(e)) {
       bool neg = false;
       std::string t = term(op, neg);
+      std::string f;
+      if (style_ == Style::Cpp && GiNaC::is_a<GiNaC::mul>(op)) {
+        GiNaC::numeric c = printed_coefficient(op);
+        if (c.is_negative()) c = -c;
+        const std::string prefix = number(c) + " * ";
+        if (!c.is_equal(1) && t.compare(0, prefix.size(), prefix) == 0) {
+          f = number(c);
+          members[f].push_back(terms.size());
+        }
+      }
+      factor_of.push_back(f);
       terms.emplace_back(neg, std::move(t));
     }
-    std::stable_partition(terms.begin(), terms.end(), [](const auto& t) { return !t.first; });
-    std::string s = terms.front().first ? "-" + terms.front().second : terms.front().second;
-    for (std::size_t i = 1; i < terms.size(); ++i) {
-      s += terms[i].first ? " - " : " + ";
-      s += terms[i].second;
-      ++ops_.adds;
+    std::vector<std::pair<bool, std::string>> out;
+    for (std::size_t i = 0; i < terms.size(); ++i) {
+      const std::string& f = factor_of[i];
+      if (f.empty() || members.at(f).size() < 2) {
+        out.push_back(std::move(terms[i]));
+        continue;
+      }
+      if (members.at(f).front() != i) continue;  // printed with its group's first term
+      std::vector<std::pair<bool, std::string>> inner;
+      bool all_negative = true;
+      for (std::size_t k : members.at(f)) {
+        inner.emplace_back(terms[k].first, terms[k].second.substr(f.size() + 3));
+        all_negative &= terms[k].first;
+      }
+      if (all_negative)
+        for (auto& t : inner) t.first = false;
+      ops_.muls -= static_cast<long>(inner.size()) - 1;  // one product for the group
+      out.emplace_back(all_negative, f + " * (" + joined(std::move(inner), ops_.adds) + ")");
     }
-    return s;
+    return joined(std::move(out), ops_.adds);
   }
   bool neg = false;
   std::string t = term(e, neg);

@@ -11,9 +11,14 @@ namespace weilgen::gen {
 enum class Notation { Iso, Alias };  // error names as in ISO 230-1 or as the file's first alias
 enum class FormStyle { Text, Latex };
 
-// "dx = -E_XX - z·E_BX + y·E_CX + ..." grouped by error in declaration order, then higher terms.
-std::string closed_form(const SymbolicModel& m, int output, FormStyle style, Notation notation);
+// "dx = -E_XX - z·E_BX + y·E_CX + ..." grouped by error in declaration order, then higher terms;
+// with max_degree > 0 only the terms up to that degree.
+std::string closed_form(const SymbolicModel& m, int output, FormStyle style, Notation notation,
+                        int max_degree = 0);
 nlohmann::json closed_forms_json(const SymbolicModel& m, Notation notation);
+// The report prints the closed forms in full up to this degree; higher terms (order 3 and up)
+// are counted and the largest listed (`weilgen show` prints every term).
+inline constexpr int kReportMaxDegree = 2;
 std::string emit_report_markdown(const SymbolicModel& m, const std::string& source_label);
 
 }  // namespace weilgen::gen

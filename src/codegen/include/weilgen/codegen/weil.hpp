@@ -38,7 +38,9 @@ class Algebra {
   int order_;
   std::vector<Monomial> relations_;  // minimal generators besides the degree bound
   GiNaC::exmap trig_rules_;
-  GiNaC::exvector trig_bases_;  // x of every rule x^2 -> ...
+  GiNaC::exvector trig_bases_;                                // x of every rule x^2 -> ...
+  std::vector<std::pair<GiNaC::ex, GiNaC::ex>> squares_;      // (x, r) when every rule is x^2 -> r
+  GiNaC::ex reduce_squares(const GiNaC::ex& expanded) const;  // one substitution pass
 };
 
 // An algebra element: Σ coefficient · monomial. Zero coefficients are never stored.
