@@ -436,6 +436,14 @@ VectorXd determined_part(const BlockFactors& F, const FoldFit& full, const Matri
   const Eigen::SelfAdjointEigenSolver<MatrixXd> bb(Linv.transpose() * perp * Linv);
   const MatrixXd W = bb.eigenvectors();
   VectorXd z = W.transpose() * (L * c);
+  // The nearly absorbed part is left out only when it is absurd: more than kAbsurd times the
+  // determined part (RMS over the observations, |z|). A smaller one is the minimum-norm value the
+  // rank cut gives an exactly absorbed term (a missing roll's constant shared with the other
+  // errors' constants), and the shape is reported whole.
+  double under = 0, det = 0;
+  for (Index j = 0; j < q; ++j)
+    (bb.eigenvalues()[j] < kDeterminedFraction * kDeterminedFraction ? under : det) += z[j] * z[j];
+  if (!(under > kAbsurd * kAbsurd * det)) return c;
   for (Index j = 0; j < q; ++j)
     if (bb.eigenvalues()[j] < kDeterminedFraction * kDeterminedFraction) z[j] = 0, ++absorbed;
   return Linv * (W * z);

@@ -211,10 +211,11 @@ JointFit joint_fit(const BlockFactors& F, const MatrixXd& A, const VectorXd& y, 
 // The part of a fitted combination E c of shape terms that the data determine. In the metric of
 // the shapes (z = L c, LᵀL = EᵀE) the eigen-directions of the Gram matrix of E's part outside
 // A's span (from the fit on all data, `full`) are shapes with a fraction λ of their squared norm
-// outside it; those with λ < kDeterminedFraction² are absorbed by the model (their coefficient
-// is traded against the model's errors and can be anything). Returns c with those left out and
-// their number in `absorbed`.
-inline constexpr double kDeterminedFraction = 0.1;
+// outside it; those with λ < kDeterminedFraction² are nearly absorbed by the model (their
+// coefficient is traded against the model's errors and can be anything). When the fitted shape's
+// part along them is more than kAbsurd times the rest (RMS over the observations), returns c
+// with them left out and their number in `absorbed`; else c whole (absorbed 0).
+inline constexpr double kDeterminedFraction = 0.1, kAbsurd = 10;
 VectorXd determined_part(const BlockFactors& F, const FoldFit& full, const MatrixXd& E,
                          const VectorXd& c, std::size_t& absorbed);
 // The rank of [A E] alone (the same cut).
