@@ -505,6 +505,22 @@ TEST_CASE("gap: ballbar traces are dr observations, and reversal on X is read fr
   REQUIRE(e);
   CHECK(std::abs(e->params.at("reversal_um")) == doctest::Approx(5.0).epsilon(0.1));
   CHECK(res.final_rms[kRadialOutput] < 1.2 * 0.4);
+  // "where" along the trace's angle is in deg, the unit the measurement reader gives the
+  // column (classify_column); the feed (ccw +1, cw -1) has none.
+  CHECK(d.covariate_unit.at("angle_deg") == "deg");
+  int angle = 0, feed = 0;
+  for (const GapRegion& g : res.where) {
+    if (g.by == "angle_deg") {
+      CHECK(g.unit == "deg");
+      ++angle;
+    }
+    if (g.by == "feed") {
+      CHECK(g.unit.empty());
+      ++feed;
+    }
+  }
+  CHECK(angle >= 1);
+  CHECK(feed >= 1);
 }
 
 TEST_CASE(
@@ -1059,12 +1075,24 @@ TEST_CASE(
   INFO(e->summary);
   CHECK(e->variant == "E_ZC");
   CHECK(e->summary.find("fourier:3") != std::string::npos);
-  // Recovered in the data: a held-out gap many times the noise is brought to the noise. (The
-  // reported peak over the travel is not checked: parts of the shape are nearly absorbed by the
-  // model's other errors here, and their minimum-norm joint coefficients are not the truth's;
-  // docs/experiments/gap-benchmark.md, "Issue 14".)
+  // Recovered in the data: a held-out gap many times the noise is brought to the noise.
   CHECK(r.baseline_rms_um > 5 * noise);
   CHECK(r.final_rms_um < 1.3 * noise);
+  // Parts of the shape are nearly absorbed by the model's other errors here: their minimum-norm
+  // joint coefficients are anything (the peak read 8.97e3 µm for a true 3.3 µm). Only the part
+  // the data determine is reported, over the measured C, and says what it left out.
+  double truth_peak = 0;
+  for (int deg = 0; deg <= 330; ++deg) {
+    const double c = deg * M_PI / 180;
+    truth_peak = std::max(truth_peak, std::abs(2 * std::cos(c) + 1.5 * std::sin(3 * c)));
+  }
+  CHECK(e->terms == 7);
+  CHECK(e->terms_absorbed >= 1);
+  CHECK(e->terms_absorbed < e->terms);
+  CHECK(e->summary.find("absorbed by the model's errors") != std::string::npos);
+  REQUIRE(e->params.count("E_ZC_peak"));
+  CHECK(e->params.at("E_ZC_peak") > 0.3 * truth_peak);
+  CHECK(e->params.at("E_ZC_peak") < 1.5 * truth_peak);
   // The top where entry is the effect's own region, along C, in the output E_ZC moves most
   // (from the exact chain with E_ZC alone: the model cannot absorb an error it lacks).
   NumericChain chain(full->description());
@@ -1118,4 +1146,41 @@ TEST_CASE("gap: effect-free data whose noise grows 4x across the layout are none
   CHECK(named <= 1);
   // The floor reads the RMS of σ_i (0.99 over these seeds), not the median's 0.85 of it.
   CHECK(ratio == doctest::Approx(1).epsilon(0.04));
+}
+
+TEST_CASE(
+    "gap: on a small rotary set without repeats the floor reads the noise, and a step is seen") {
+  // head_head_bc, one pass of 60 R-test poses (no pose repeated), time:5 folds, poly:3 PDGEs:
+  // the held-out residual carries each fold's prediction error (held-out leverage up to several),
+  // which neighbours in time far apart in B and C do not share. Taken as noise (Var(d) = 2σ²),
+  // the floor read up to 2.8x σ on the benchmark's effect-free sets of this layout and steps
+  // were `none`; with the differences' exact variance from the folds' factors it reads σ.
+  const auto model = test::builtin_model("head_head_bc");
+  std::vector<ChainRow> rows;
+  for (const ChainRow& r : head_rtest(*model))
+    if (r.cycle == 1) rows.push_back(r);
+  REQUIRE(rows.size() == 60);
+  PdgeBasisChoice poly3;
+  poly3.all = "poly:3";
+  const double noise = 0.5;
+  for (std::uint32_t seed : {41u, 42u, 43u, 44u}) {
+    const GapResult r = diagnose(chain_csv(*model, rows, noise, seed, {}), model, "time:5", poly3);
+    INFO("seed " << seed << ": floor " << r.noise.sigma_um << " µm, " << r.noise.detail);
+    CHECK(r.noise.source == "small-scale");
+    CHECK(r.noise.sigma_um == doctest::Approx(noise).epsilon(0.25));
+    // (The verdict is not checked: with the floor at the noise some such sets show a held-out
+    // excess from what a fold's poses do not determine; docs/experiments/gap-benchmark.md.)
+  }
+  // A step of 4 µm in dz from the middle of the run on (outside the library).
+  const std::string csv = chain_csv(
+      *model, rows, noise, 45,
+      [&](const ChainRow& r, std::vector<double>&, std::vector<double>&, Eigen::Vector3d& x) {
+        x = Eigen::Vector3d(0, 0, r.t_s >= 30 * 20 ? 4.0 : 0.0);
+      });
+  const GapResult r = diagnose(csv, model, "time:5", poly3);
+  INFO(r.verdict_reason);
+  CHECK(r.noise.sigma_um < 1.25 * noise);
+  // Seen: not `none`. (Which name it gets is the step's own problem, outside the library: the
+  // model's errors absorb most of a step on 60 poses and thermal_drift fits the rest.)
+  CHECK(r.verdict != "none");
 }

@@ -212,3 +212,57 @@ TEST_CASE("gap: the diagnosis is the same for any number of threads (JSON byte-i
   CHECK(docs[0] == docs[1]);
   CHECK(docs[0] == docs[2]);
 }
+
+TEST_CASE("gap engine: the held-out residuals' covariance is M Mᵀ, M from each fold's fit") {
+  // r = M e under the null hypothesis: row k of M is e_kᵀ − a_kᵀ A_f⁺ S_f for k held out by
+  // split f (S_f selects its training rows). Build M from dense fits of the training rows and
+  // compare every entry, the prepared columns and the centred differences' variances.
+  const std::size_t n = 60;
+  const MatrixXd A = design(n, 11);
+  const VectorXd y = values(A, 12);
+  GapData d;
+  Engine e(d, A, y, 1);
+  e.splits = three_folds(n);
+  e.fit_folds();
+  MatrixXd M = MatrixXd::Zero(static_cast<Index>(n), static_cast<Index>(n));
+  for (const Split& s : e.splits) {
+    const EquilibratedSvd svd(rows_of(A, s.train), 1e-9, false);
+    MatrixXd P(A.cols(), static_cast<Index>(s.train.size()));  // θ = P y_train
+    for (Index j = 0; j < P.cols(); ++j)
+      P.col(j) = svd.solve(VectorXd::Unit(static_cast<Index>(s.train.size()), j));
+    for (std::size_t k : s.test) {
+      const VectorXd w = P.transpose() * A.row(static_cast<Index>(k)).transpose();
+      M(static_cast<Index>(k), static_cast<Index>(k)) = 1;
+      for (std::size_t j = 0; j < s.train.size(); ++j)
+        M(static_cast<Index>(k), static_cast<Index>(s.train[j])) -= w[static_cast<Index>(j)];
+    }
+  }
+  const MatrixXd S = M * M.transpose();
+  const HeldoutCovariance cov(e);
+  double worst = 0, worst_column = 0;
+  for (std::size_t l = 0; l < n; ++l) {
+    const HeldoutCovariance::Column c = cov.column(l);
+    for (std::size_t k = 0; k < n; ++k) {
+      const double want = S(static_cast<Index>(k), static_cast<Index>(l));
+      worst = std::max(worst, std::abs(cov(k, l) - want));
+      worst_column = std::max(worst_column, std::abs(cov(k, c) - want));
+    }
+  }
+  CHECK(worst < 1e-9 * S.cwiseAbs().maxCoeff());
+  CHECK(worst_column < 1e-9 * S.cwiseAbs().maxCoeff());
+  // Leverage on the diagonal: c(k, k) = 1 + h_k, h_k well above 0 for a 60-row design.
+  CHECK(S.diagonal().maxCoeff() > 1.2);
+  // Centred successive differences of a sequence crossing the folds.
+  std::vector<std::size_t> seq;
+  for (std::size_t i = 0; i < n; i += 2) seq.push_back(i);
+  const std::vector<double> v = cov.difference_variances(seq);
+  REQUIRE(v.size() == seq.size() - 1);
+  const std::size_t k = v.size();
+  for (std::size_t i = 0; i < k; ++i) {
+    VectorXd c = VectorXd::Zero(static_cast<Index>(n));
+    c[static_cast<Index>(seq[i + 1])] += 1, c[static_cast<Index>(seq[i])] -= 1;
+    c[static_cast<Index>(seq.back())] -= 1.0 / static_cast<double>(k);
+    c[static_cast<Index>(seq.front())] += 1.0 / static_cast<double>(k);
+    CHECK(v[i] == doctest::Approx(c.dot(S * c)).epsilon(1e-9));
+  }
+}

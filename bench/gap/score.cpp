@@ -50,6 +50,9 @@ struct Scenario {
   int where_ok = -1, loc = -1, loc_contains = -1;  // -1 n/a, 0 wrong, 1 right
   std::string where_top;                           // "by/output" of the top entry
   double shrink = NAN, noise_floor_ratio = NAN;
+  // Held-out RMS after over what a right model leaves: the truth's noise times the diagnosis'
+  // sqrt(mean(1 + h)) (verdict.heldout_rms_ideal_um / noise_floor_um), per output; the largest.
+  double shrink_ideal = NAN;
   int gross = 0, gross_found = 0;
 };
 
@@ -194,6 +197,16 @@ void derive(Scenario& s) {
   if (s.noise_rms > 0) s.shrink = after / s.noise_rms;
   if (s.gap.contains("noise_floor_um") && s.noise_rms > 0)
     s.noise_floor_ratio = largest(s.gap["noise_floor_um"]) / s.noise_rms;
+  if (s.noise_rms > 0 && s.gap["verdict"].contains("heldout_rms_ideal_um") &&
+      s.gap["verdict"].contains("heldout_rms_after_um") && s.gap.contains("noise_floor_um")) {
+    const json& ideal = s.gap["verdict"]["heldout_rms_ideal_um"];
+    const double floor = s.gap["noise_floor_um"].get<double>();
+    for (const auto& [o, a] : s.gap["verdict"]["heldout_rms_after_um"].items())
+      if (a.is_number() && ideal.contains(o) && ideal[o].is_number() && floor > 0) {
+        const double r = a.get<double>() / (s.noise_rms * ideal[o].get<double>() / floor);
+        if (std::isnan(s.shrink_ideal) || r > s.shrink_ideal) s.shrink_ideal = r;
+      }
+  }
   // Gross readings found: truth lines among the reported ones.
   std::set<long> lines;
   for (const json& o : s.gap.value("outliers", json::array())) lines.insert(o.value("line", -1L));
@@ -349,7 +362,7 @@ int main(int argc, char** argv) {
   std::map<std::string, std::map<double, Count>> by_effect;
   std::set<double> factor_set;
   Count attribution, none_rate, unexplained, absorbed_none, where, loc, loc_contains, gross;
-  std::vector<double> shrink, floor_ratio, times;
+  std::vector<double> shrink, shrink_ideal, floor_ratio, times;
   std::map<std::string, Count> none_by_cell;
   std::vector<const Scenario*> wrong, where_wrong;
   for (const Scenario& s : all) {
@@ -365,7 +378,7 @@ int main(int argc, char** argv) {
       none_by_cell[cell].add(s.correct);
       by_variant[s.variant.empty() ? "plain" : s.variant].add(s.correct);
       if (s.correct)
-        shrink.push_back(s.shrink);
+        shrink.push_back(s.shrink), shrink_ideal.push_back(s.shrink_ideal);
       else
         wrong.push_back(&s);
       continue;
@@ -384,7 +397,7 @@ int main(int argc, char** argv) {
                                   : s.effect + (s.variant.empty() ? "" : " (" + s.variant + ")")]
              [s.factor]
                  .add(s.correct);
-    if (s.correct) shrink.push_back(s.shrink);
+    if (s.correct) shrink.push_back(s.shrink), shrink_ideal.push_back(s.shrink_ideal);
     if (s.factor < kTargetSnr) continue;
     attribution.add(s.correct);
     by_cell[cell].add(s.correct);
@@ -402,6 +415,8 @@ int main(int argc, char** argv) {
   const std::vector<double> factors(factor_set.begin(), factor_set.end());
   Count shrink_ok;
   for (double r : shrink) shrink_ok.add(!std::isnan(r) && r <= kShrinkLimit);
+  Count shrink_ideal_ok;
+  for (double r : shrink_ideal) shrink_ideal_ok.add(!std::isnan(r) && r <= kShrinkLimit);
   // The worst machine and layout.
   std::string worst_cell;
   double worst = NAN;
@@ -436,6 +451,9 @@ int main(int argc, char** argv) {
        kWhereTarget, where.n},
       {"held-out RMS after <= 1.2 x noise", "share of correct verdicts (and none cases)",
        shrink_ok.rate(), kShrinkTarget, shrink_ok.n},
+      {"... <= 1.2 x what a right model leaves",
+       "the same, against noise x sqrt(mean(1 + h)) (the folds' prediction error)",
+       shrink_ideal_ok.rate(), kShrinkTarget, shrink_ideal_ok.n},
       {"unexplained for the step (SNR >= 3)", "verdict unexplained", unexplained.rate(),
        kUnexplainedTarget, unexplained.n}};
   if (!std::isnan(spindle_gap))
@@ -495,23 +513,28 @@ int main(int argc, char** argv) {
                 {"max", std::isnan(quantile(v, 1)) ? json() : json(quantile(v, 1))}};
   };
   r["shrinkage_ratio"] = stats(shrink);
+  r["shrinkage_ratio_ideal"] = stats(shrink_ideal);
   r["noise_floor_ratio"] = stats(floor_ratio);
   r["run_time_s"] = stats(times);
   json per = json::array();
   for (const Scenario& s : all) {
-    per.push_back({{"dir", s.dir},
-                   {"id", s.id},
-                   {"expected", s.expected},
-                   {"diagnosed", s.diagnosed},
-                   {"named", s.named},
-                   {"correct", s.correct},
-                   {"identifiable", s.identifiable},
-                   {"factor", s.factor},
-                   {"where_top", s.where_top},
-                   {"where_ok", s.where_ok < 0 ? json() : json(s.where_ok == 1)},
-                   {"shrink_ratio", std::isnan(s.shrink) ? json() : json(s.shrink)},
-                   {"time_s", std::isnan(s.time_s) ? json() : json(s.time_s)},
-                   {"error", s.error}});
+    per.push_back(
+        {{"dir", s.dir},
+         {"id", s.id},
+         {"expected", s.expected},
+         {"diagnosed", s.diagnosed},
+         {"named", s.named},
+         {"correct", s.correct},
+         {"identifiable", s.identifiable},
+         {"factor", s.factor},
+         {"where_top", s.where_top},
+         {"where_ok", s.where_ok < 0 ? json() : json(s.where_ok == 1)},
+         {"shrink_ratio", std::isnan(s.shrink) ? json() : json(s.shrink)},
+         {"shrink_ratio_ideal", std::isnan(s.shrink_ideal) ? json() : json(s.shrink_ideal)},
+         {"noise_floor_ratio",
+          std::isnan(s.noise_floor_ratio) ? json() : json(s.noise_floor_ratio)},
+         {"time_s", std::isnan(s.time_s) ? json() : json(s.time_s)},
+         {"error", s.error}});
   }
   r["per_scenario"] = per;
 
@@ -597,6 +620,7 @@ int main(int argc, char** argv) {
        << fnum(quantile(v, 0.95)) << " | " << fnum(quantile(v, 1)) << " |\n";
   };
   srow("held-out RMS after / truth noise RMS (correct verdicts)", shrink);
+  srow("held-out RMS after / (truth noise RMS x sqrt(mean(1 + h))) (the same)", shrink_ideal);
   srow("reported noise floor / truth noise RMS", floor_ratio);
   srow("run time of `weilgen gap`, s", times);
 

@@ -128,6 +128,7 @@ GapData gap_data(const MeasurementTable& table, const Description& desc,
   for (const std::string& c : t.columns_with(ColumnRole::Covariate)) {
     check_varies(c, t.column(c), t.info_of(c).unit.c_str());
     g.covariate[c] = t.column(c);
+    g.covariate_unit[c] = t.info_of(c).unit;
   }
   if (t.has("t_s")) check_varies("t_s", g.time_s, "s");
   if (t.has("cycle")) check_varies("cycle", g.cycle, "", false);
@@ -135,12 +136,14 @@ GapData gap_data(const MeasurementTable& table, const Description& desc,
   if (trace) {
     check_varies("angle_deg", t.column("angle_deg"), "deg");
     g.covariate["angle_deg"] = t.column("angle_deg");
+    g.covariate_unit["angle_deg"] = t.info_of("angle_deg").unit;
   }
   for (const std::string& c : t.columns_with(ColumnRole::Direction)) {
     std::string axis = t.info_of(c).axis;
     if (axis.empty() && trace) {  // a trace's `dir` is its feed (ccw +1, cw -1)
       check_varies("dir", t.column(c), "");
       g.covariate["feed"] = t.column(c);
+      g.covariate_unit["feed"] = "";  // ccw +1, cw -1
       continue;
     }
     if (axis.empty()) {

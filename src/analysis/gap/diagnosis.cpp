@@ -141,10 +141,11 @@ void decide_verdict(GapResult& R, const GapOptions& opt, const std::vector<std::
     if (explained < opt.explain_fraction)
       return unexplained("the accepted effects remove " + pct(explained) +
                          " of the excess and leave a significant gap");
-    if (R.final_rms_um > 2 * R.noise.sigma_um)
+    // Against what a right model would leave at the floor, prediction error included.
+    if (R.final_rms_um > 2 * R.final_ideal_um)
       return unexplained(
-          "the accepted effects leave a significant held-out RMS of more than twice the noise "
-          "floor");
+          "the accepted effects leave a significant held-out RMS of more than twice what the "
+          "noise floor explains");
   }
   R.verdict = first.name;
   R.verdict_reason =
@@ -249,7 +250,7 @@ GapResult GapDiagnosis::run(const Model& model, const ErrorParameterisation& par
   e.fit_folds();
   VectorXd r, h;
   e.heldout(r, h);
-  R.noise = noise_floor(data, r);
+  R.noise = noise_floor(data, r, HeldoutCovariance(e));
   const double s2 = R.noise.sigma_um * R.noise.sigma_um;
 
   auto summarise = [&](const VectorXd& res, std::array<double, kObservationKinds>& rms,
@@ -272,6 +273,23 @@ GapResult GapDiagnosis::run(const Model& model, const ErrorParameterisation& par
     }
     total = na ? std::sqrt(all / static_cast<double>(na)) : kNaN;
   };
+  // The held-out RMS at the floor: sqrt(σ² mean(1 + h)) per output and over all.
+  auto ideal = [&](const VectorXd& res, const VectorXd& lev,
+                   std::array<double, kObservationKinds>& per, double& total) {
+    std::array<double, kObservationKinds> ss{};
+    std::array<std::size_t, kObservationKinds> n{};
+    double all = 0;
+    std::size_t na = 0;
+    for (std::size_t i = 0; i < obs.size(); ++i) {
+      if (!std::isfinite(res[static_cast<Index>(i)])) continue;
+      const double e2 = s2 * (1 + lev[static_cast<Index>(i)]);
+      const auto o = static_cast<std::size_t>(obs[i].output);
+      ss[o] += e2, ++n[o], all += e2, ++na;
+    }
+    for (std::size_t o = 0; o < kObservationKinds; ++o)
+      per[o] = n[o] ? std::sqrt(ss[o] / static_cast<double>(n[o])) : kNaN;
+    total = na ? std::sqrt(all / static_cast<double>(na)) : kNaN;
+  };
   // Σ r² and its expectation σ²(1 + h) over the held-out residuals.
   auto held_gap = [&](const VectorXd& res, const VectorXd& lev) {
     Gap g;
@@ -280,6 +298,7 @@ GapResult GapDiagnosis::run(const Model& model, const ErrorParameterisation& par
     return g;
   };
   summarise(r, R.baseline_rms, R.baseline_rms_um, &R.baseline_max);
+  ideal(r, h, R.baseline_ideal, R.baseline_ideal_um);
   const Gap base = held_gap(r, h);
   gap_stats(base, R.noise.dof, R.baseline_excess_um, R.baseline_p_value);
   R.where = localise(data, r, h, R.noise, options_.alpha);
@@ -345,7 +364,14 @@ GapResult GapDiagnosis::run(const Model& model, const ErrorParameterisation& par
       if (used[k]) continue;
       Evaluated x = std::move(all[k]);
       if (!std::isfinite(x.heldout_sse)) continue;
-      candidates[k].describe(x.variant, x.coef, x.fit);
+      if (candidates[k].determined_part) {
+        x.fit.terms = static_cast<std::size_t>(x.coef.size());
+        const VectorXd c =
+            determined_part(*e.factors, e.full, x.columns, x.coef, x.fit.terms_absorbed);
+        candidates[k].describe(x.variant, c, x.fit);
+      } else {
+        candidates[k].describe(x.variant, x.coef, x.fit);
+      }
       check_shape(x.variant, x.fit);
       ev.push_back(std::move(x));
       ev.back().fit.name = candidates[k].name;
@@ -400,6 +426,7 @@ GapResult GapDiagnosis::run(const Model& model, const ErrorParameterisation& par
     if (p >= options_.alpha) break;
   }
   summarise(cur_r, R.final_rms, R.final_rms_um, nullptr);
+  ideal(cur_r, cur_h, R.final_ideal, R.final_ideal_um);
   const Gap final_gap = held_gap(cur_r, cur_h);
   gap_stats(final_gap, R.noise.dof, R.final_excess_um, R.final_p_value);
   R.residual_after.assign(cur_r.data(), cur_r.data() + cur_r.size());

@@ -180,7 +180,8 @@ void add_missing_error(const EffectContext& ctx, std::vector<Candidate>& out) {
     }
     return E;
   };
-  c.describe = [missing, &d](const Variant& v, const VectorXd& coef, EffectFit& fit) {
+  c.determined_part = true;
+  c.describe = [missing, &d, axes, &desc](const Variant& v, const VectorXd& coef, EffectFit& fit) {
     const Missing& mi = (*missing)[static_cast<std::size_t>(v.hyper[0])];
     // Its region: along its axis' travel for a PDGE, all the data for a constant; the diagnosis
     // puts it in the output where it removed the most.
@@ -200,18 +201,36 @@ void add_missing_error(const EffectContext& ctx, std::vector<Candidate>& out) {
     const bool rot =
         mi.name.size() > 2 && (mi.name[2] == 'A' || mi.name[2] == 'B' || mi.name[2] == 'C');
     const char* unit = rot ? "µrad" : "µm";
-    if (!mi.pdge) {
+    // Terms the model's own errors absorb are left out of coef (determined_part): their
+    // coefficients trade against those errors and say nothing about this one.
+    const std::string absorbed = fit.terms_absorbed
+                                     ? std::to_string(fit.terms_absorbed) + " of " +
+                                           std::to_string(fit.terms) +
+                                           " shape terms absorbed by the model's errors, left out; "
+                                     : "";
+    if (fit.terms && fit.terms_absorbed == fit.terms) {
+      fit.summary = mi.name + (mi.pdge ? "(" + mi.coordinate + ")" : "") +
+                    ": size not determined (the model's errors absorb it; not in the machine "
+                    "file)";
+    } else if (!mi.pdge) {
       fit.params[mi.name] = coef[0];
       fit.summary = mi.name + " = " + num(coef[0], 3) + " " + unit + " (not in the machine file)";
     } else {
+      // Over the positions measured, not the whole travel: the data say nothing beyond them.
+      std::size_t a = 0;
+      for (std::size_t i = 0; i < axes.size(); ++i)
+        if (desc.bodies[static_cast<std::size_t>(axes[i])].joint.coordinate == mi.coordinate) a = i;
+      double lo = INFINITY, hi = -INFINITY;
+      for (const auto& o : d.points.observations)
+        lo = std::min(lo, d.points.poses[o.row][a]), hi = std::max(hi, d.points.poses[o.row][a]);
       double peak = 0;
-      for (int k = 0; k <= 40; ++k) {
-        const double x = mi.basis.a + (mi.basis.b - mi.basis.a) * k / 40.0;
-        peak = std::max(peak, std::abs(mi.basis.value(coef.data(), x)));
-      }
+      for (int k = 0; k <= 40; ++k)
+        peak = std::max(peak, std::abs(mi.basis.value(coef.data(), lo + (hi - lo) * k / 40.0)));
       fit.params[mi.name + "_peak"] = peak;
       fit.summary = mi.name + "(" + mi.coordinate + ") up to " + num(peak, 3) + " " + unit +
-                    " over the travel (" + mi.basis.name() + "; not in the machine file)";
+                    " over the measured " + mi.coordinate + " " + num(lo, 4) + " .. " + num(hi, 4) +
+                    (a < d.axis_units.size() ? " " + d.axis_units[a] : "") + " (" +
+                    mi.basis.name() + "; " + absorbed + "not in the machine file)";
     }
   };
   out.push_back(std::move(c));

@@ -75,6 +75,9 @@ struct Candidate {
       fitted_columns;
   // Fills summary/params/region of `fit` from the full-data coefficients c of the columns.
   std::function<void(const Variant&, const Eigen::VectorXd& c, EffectFit& fit)> describe;
+  // The columns are terms of one shape (a missing PDGE): describe gets only the part of c the
+  // data determine (determined_part; fit.terms and fit.terms_absorbed say how much is left out).
+  bool determined_part = false;
 };
 
 // The library's candidates that apply to the data (e.g. reversal needs a direction column).

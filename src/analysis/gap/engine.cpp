@@ -406,6 +406,49 @@ JointFit joint_fit(const BlockFactors& F, const MatrixXd& A, const VectorXd& y, 
   return j;
 }
 
+VectorXd determined_part(const BlockFactors& F, const FoldFit& full, const MatrixXd& E,
+                         const VectorXd& c, std::size_t& absorbed) {
+  absorbed = 0;
+  const Index q = E.cols();
+  if (q == 0) return c;
+  // E⊥ᵀE⊥ = Σ_b (E_b − Q_b G_b)ᵀ(E_b − Q_b G_b) + Gᵀ(I − UM UMᵀ)G, G the stacked Q_bᵀE_b of
+  // the full fit's blocks: the part outside each block's span, then outside A's within them.
+  const Projection pr = project_exact(F, E, VectorXd::Zero(E.rows()));
+  MatrixXd perp = MatrixXd::Zero(q, q), EtE = MatrixXd::Zero(q, q);
+  Index rows = 0;
+  for (std::size_t b : full.blocks) rows += pr.G[b].rows();
+  MatrixXd G(rows, q);
+  Index at = 0;
+  for (std::size_t b : full.blocks) {
+    perp += pr.Perp[b];
+    EtE += pr.EtE[b][0];
+    G.middleRows(at, pr.G[b].rows()) = pr.G[b];
+    at += pr.G[b].rows();
+  }
+  const MatrixXd UG = full.UM.transpose() * G;
+  perp += G.transpose() * G - UG.transpose() * UG;
+  // z = L c with EᵀE = LᵀL (L = D^½ Vᵀ from EᵀE = V D Vᵀ); B = L⁻ᵀ E⊥ᵀE⊥ L⁻¹.
+  const Eigen::SelfAdjointEigenSolver<MatrixXd> ee(EtE);
+  const VectorXd d = ee.eigenvalues();
+  if (!(d.minCoeff() > 1e-12 * d.maxCoeff())) return c;  // dependent terms: leave c alone
+  const MatrixXd L = d.cwiseSqrt().asDiagonal() * ee.eigenvectors().transpose();
+  const MatrixXd Linv = ee.eigenvectors() * d.cwiseSqrt().cwiseInverse().asDiagonal();
+  const Eigen::SelfAdjointEigenSolver<MatrixXd> bb(Linv.transpose() * perp * Linv);
+  const MatrixXd W = bb.eigenvectors();
+  VectorXd z = W.transpose() * (L * c);
+  // The nearly absorbed part is left out only when it is absurd: more than kAbsurd times the
+  // determined part (RMS over the observations, |z|). A smaller one is the minimum-norm value the
+  // rank cut gives an exactly absorbed term (a missing roll's constant shared with the other
+  // errors' constants), and the shape is reported whole.
+  double under = 0, det = 0;
+  for (Index j = 0; j < q; ++j)
+    (bb.eigenvalues()[j] < kDeterminedFraction * kDeterminedFraction ? under : det) += z[j] * z[j];
+  if (!(under > kAbsurd * kAbsurd * det)) return c;
+  for (Index j = 0; j < q; ++j)
+    if (bb.eigenvalues()[j] < kDeterminedFraction * kDeterminedFraction) z[j] = 0, ++absorbed;
+  return Linv * (W * z);
+}
+
 std::size_t joint_rank(const BlockFactors& F, const MatrixXd& E) {
   MatrixXd N;
   VectorXd z;

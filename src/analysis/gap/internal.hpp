@@ -122,6 +122,41 @@ class Engine {
   }
 };
 
+// The covariance of the held-out residuals under the null hypothesis (the model right, white
+// noise of variance σ²; docs/gap.md, "Noise floor"): an observation k held out by split f has
+// r_k = e_k − a_kᵀ A_f⁺ e_f, so Cov(r_k, r_l) = σ² c(k, l) with
+//   c(k, l) = δ_kl + a_kᵀ G_f a_l                  (k and l held out by the same split f),
+//   c(k, l) = a_kᵀ G_f N_fg G_g a_l − [k trains g] a_kᵀ G_g a_l − [l trains f] a_kᵀ G_f a_l
+//                                                 (k held out by f, l by g),
+// G_f = A_f⁺A_f⁺ᵀ = VS_f VS_fᵀ (so c(k, k) = 1 + h_k) and N_fg = Σ a_i a_iᵀ over the rows both
+// splits train on. Built from the engine's fits (its splits and folds must be current).
+class HeldoutCovariance {
+ public:
+  explicit HeldoutCovariance(const Engine& e);
+  // c(k, l); NaN when k or l is not held out.
+  double operator()(std::size_t k, std::size_t l) const;
+  // c(·, l) prepared for many k (O(p) per k instead of O(p · rank)).
+  struct Column {
+    std::size_t obs = 0;
+    VectorXd Gg_al;           // G_g a_l
+    std::vector<VectorXd> u;  // per split f ≠ g: C_fg w_l − [l trains f] VS_fᵀ a_l
+  };
+  Column column(std::size_t l) const;
+  double operator()(std::size_t k, const Column& c) const;
+  // Var(d_i − d̄)/σ² of the centred successive differences d_i = r_{i+1} − r_i of the held-out
+  // residuals of `obs` (in sequence order; d̄ their mean); with one difference, Var(d_0)/σ².
+  std::vector<double> difference_variances(const std::vector<std::size_t>& obs) const;
+
+ private:
+  double cross(std::size_t k, std::size_t l) const;
+  const Engine* e_;
+  std::vector<int> split_;        // the split holding each observation out (-1: none)
+  std::vector<std::size_t> pos_;  // its row in that split's test part
+  std::vector<MatrixXd> W_;       // per split: A_test VS (rows w_{k,f}ᵀ; h_k = |w_{k,f}|²)
+  std::vector<std::vector<char>> train_;  // per split: trains on observation i
+  std::vector<std::vector<MatrixXd>> C_;  // C_fg = VS_fᵀ N_fg VS_g
+};
+
 // Groups of extra columns (a variant's, observations × q each) seen through block factors:
 // G_b = Q_bᵀ E_b for all groups at once (one pass over the blocks), and per group E_bᵀE_b and
 // E_bᵀy_b.
@@ -173,6 +208,16 @@ struct JointFit {
   VectorXd coef;  // of E's columns (minimum-norm joint solution)
 };
 JointFit joint_fit(const BlockFactors& F, const MatrixXd& A, const VectorXd& y, const MatrixXd& E);
+// The part of a fitted combination E c of shape terms that the data determine. In the metric of
+// the shapes (z = L c, LᵀL = EᵀE) the eigen-directions of the Gram matrix of E's part outside
+// A's span (from the fit on all data, `full`) are shapes with a fraction λ of their squared norm
+// outside it; those with λ < kDeterminedFraction² are nearly absorbed by the model (their
+// coefficient is traded against the model's errors and can be anything). When the fitted shape's
+// part along them is more than kAbsurd times the rest (RMS over the observations), returns c
+// with them left out and their number in `absorbed`; else c whole (absorbed 0).
+inline constexpr double kDeterminedFraction = 0.1, kAbsurd = 10;
+VectorXd determined_part(const BlockFactors& F, const FoldFit& full, const MatrixXd& E,
+                         const VectorXd& c, std::size_t& absorbed);
 // The rank of [A E] alone (the same cut).
 std::size_t joint_rank(const BlockFactors& F, const MatrixXd& E);
 
@@ -195,8 +240,9 @@ inline void gap_stats(const Gap& g, double dof, double& excess, double& p) {
 // Gross readings in the baseline's full-data residual `r` (docs/gap.md, "Outliers").
 std::vector<GapOutlier> find_outliers(const GapData& d, const VectorXd& r);
 
-// The noise floor of the held-out residual (docs/gap.md, "Noise floor").
-NoiseFloor noise_floor(const GapData& d, const VectorXd& heldout);
+// The noise floor of the held-out residual (docs/gap.md, "Noise floor"); `cov` its covariance
+// under the null hypothesis (the small-scale estimate is unbiased under it).
+NoiseFloor noise_floor(const GapData& d, const VectorXd& heldout, const HeldoutCovariance& cov);
 
 // Where the held-out residual concentrates (docs/gap.md, "Where").
 std::vector<GapRegion> localise(const GapData& d, const VectorXd& r, const VectorXd& h,

@@ -55,7 +55,10 @@ std::vector<GapRegion> localise(const GapData& d, const VectorXd& r, const Vecto
   for (const auto& [a, v] : d.dir) add("dir_" + a, "", per_obs(v), false);
   add("cycle", "", per_obs(d.cycle), false);
   for (const auto& [n, v] : d.temperature) add(n, "°C", per_obs(v), true);
-  for (const auto& [n, v] : d.covariate) add(n, n == "rpm" ? "1/min" : "", per_obs(v), true);
+  for (const auto& [n, v] : d.covariate) {
+    const auto u = d.covariate_unit.find(n);
+    add(n, u == d.covariate_unit.end() ? "" : u->second, per_obs(v), true);
+  }
 
   auto bin_stats = [&](GapRegion& g, const std::vector<std::size_t>& idx) {
     Gap gp;

@@ -19,37 +19,51 @@ constexpr std::size_t kRegionDifferences = 60;
 // Differences beyond this many robust scales of their region count as this many.
 constexpr double kClip = 4;
 
+// A sequence of values (repeats of one observation, or the held-out residual of one output in
+// time order) and the variance of each of its centred successive differences d_i − d̄ in units
+// of σ² (of d_0 alone when there is one difference).
+struct Sequence {
+  std::vector<double> value, var;
+};
+
+// White noise: Var(d_i − d̄) = 2σ²(1 + 1/k² − [i is the first or last]/k) for k differences.
+std::vector<double> white_variances(std::size_t values) {
+  if (values < 2) return {};
+  const std::size_t k = values - 1;
+  if (k == 1) return {2.0};
+  const double kk = static_cast<double>(k);
+  std::vector<double> v(k);
+  for (std::size_t i = 0; i < k; ++i)
+    v[i] = 2 * (1 + 1 / (kk * kk) - ((i == 0 || i + 1 == k) ? 1.0 / kk : 0.0));
+  return v;
+}
+
 // Robust pooled scale of successive differences: each sequence of 3 or more has its mean
-// difference removed (a linear drift along it does not count). The differences, in sequence
-// order (time, so neighbours are near in the layout), are cut into regions of about
-// kRegionDifferences; in each, σ² is the mean square of the differences, each clipped at
-// kClip robust scales (1.4826 · median|d − median d|), over 2; the floor is the mean σ² over the
-// regions. The clip keeps a step or a few drift jumps between repeats from inflating the floor
-// as they would a plain mean square; the mean square (not the median's scale) follows noise
-// whose σ differs across the layout (a tracker's noise growing with range: with a 1…4× spread one
-// MAD reads σ 15 % low, and the held-out gap test over-rejects). Bias (simulated, 600
-// differences): −1 % for normal noise (the clip), −3 % for a 1…4× mixture inside every region.
-// Degrees of freedom: the MAD's efficiency (0.37) times the MSSD's (2/3)
-// times the number of differences (kept from the MAD floor: conservative).
-void mssd(const std::vector<std::vector<double>>& sequences, double& sigma2, double& dof,
+// difference removed (a linear drift along it does not count), and each centred difference is
+// rescaled to variance 2σ² by its exact variance under the null hypothesis (white noise for
+// repeats; the held-out residual's own covariance, HeldoutCovariance, for the small-scale
+// estimate). The differences, in sequence order (time, so neighbours are near in the layout),
+// are cut into regions of about kRegionDifferences; in each, σ² is the mean square of the
+// differences, each clipped at kClip robust scales (1.4826 · median|d − median d|), over 2; the
+// floor is the mean σ² over the regions. The clip keeps a step or a few drift jumps between
+// repeats from inflating the floor as they would a plain mean square; the mean square (not the
+// median's scale) follows noise whose σ differs across the layout (a tracker's noise growing
+// with range: with a 1…4× spread one MAD reads σ 15 % low, and the held-out gap test
+// over-rejects). Bias (simulated, 600 differences): −1 % for normal noise (the clip), −3 % for a
+// 1…4× mixture inside every region. Degrees of freedom: the MAD's efficiency (0.37) times the
+// MSSD's (2/3) times the number of differences (kept from the MAD floor: conservative).
+void mssd(const std::vector<Sequence>& sequences, double& sigma2, double& dof,
           std::size_t& differences) {
   std::vector<double> all;
   for (const auto& s : sequences) {
-    if (s.size() < 2) continue;
+    if (s.value.size() < 2) continue;
     std::vector<double> d;
-    for (std::size_t i = 1; i < s.size(); ++i) d.push_back(s[i] - s[i - 1]);
+    for (std::size_t i = 1; i < s.value.size(); ++i) d.push_back(s.value[i] - s.value[i - 1]);
     const std::size_t k = d.size();
-    if (k < 2) {
-      all.push_back(d[0]);
-      continue;
-    }
-    const double mean = std::accumulate(d.begin(), d.end(), 0.0) / static_cast<double>(k);
-    // Var(d_i − d̄) = 2σ²(1 + 1/k² − [i is the first or last]/k) for white noise: rescale to 2σ².
-    const double kk = static_cast<double>(k);
-    for (std::size_t i = 0; i < k; ++i) {
-      const double end = (i == 0 || i + 1 == k) ? 1.0 / kk : 0.0;
-      all.push_back((d[i] - mean) / std::sqrt(1 + 1 / (kk * kk) - end));
-    }
+    const double mean =
+        k < 2 ? 0.0 : std::accumulate(d.begin(), d.end(), 0.0) / static_cast<double>(k);
+    for (std::size_t i = 0; i < k; ++i)
+      if (s.var[i] > 1e-9) all.push_back((d[i] - mean) * std::sqrt(2 / s.var[i]));
   }
   differences = all.size();
   if (all.size() < 3) {
@@ -86,7 +100,7 @@ void mssd(const std::vector<std::vector<double>>& sequences, double& sigma2, dou
 
 }  // namespace
 
-NoiseFloor noise_floor(const GapData& d, const VectorXd& heldout) {
+NoiseFloor noise_floor(const GapData& d, const VectorXd& heldout, const HeldoutCovariance& cov) {
   const auto& obs = d.points.observations;
   NoiseFloor nf;
   auto time_of = [&](std::size_t i) {
@@ -115,34 +129,43 @@ NoiseFloor noise_floor(const GapData& d, const VectorXd& heldout) {
   std::stable_sort(
       repeats_in_time.begin(), repeats_in_time.end(),
       [&](const auto* a, const auto* b) { return time_of(a->front()) < time_of(b->front()); });
-  std::array<std::vector<std::vector<double>>, kObservationKinds> seq;
+  std::array<std::vector<Sequence>, kObservationKinds> seq;
   for (const auto* idx : repeats_in_time) {
-    std::vector<double> s;
-    for (std::size_t i : *idx) s.push_back(obs[i].value);
-    seq[static_cast<std::size_t>(obs[idx->front()].output)].push_back(s);
+    Sequence s;
+    for (std::size_t i : *idx) s.value.push_back(obs[i].value);
+    s.var = white_variances(s.value.size());
+    seq[static_cast<std::size_t>(obs[idx->front()].output)].push_back(std::move(s));
   }
   const bool repeats = repeated * 10 >= obs.size() * 3;  // >= 30 % of observations repeated
-  // Small-scale sequences: the held-out residual in time (or row) order, per output.
-  std::array<std::vector<std::vector<double>>, kObservationKinds> small;
+  // Small-scale sequences: the held-out residual in time (or row) order, per output. Its
+  // successive differences carry the folds' prediction errors, which neighbours far apart in
+  // the design (a rotary layout, a small set) do not share: their exact variance comes from the
+  // folds' factors, so the floor reads σ and not σ times the leverage.
+  std::array<std::vector<Sequence>, kObservationKinds> small;
   {
     std::vector<std::size_t> order(obs.size());
     std::iota(order.begin(), order.end(), 0);
     std::stable_sort(order.begin(), order.end(),
                      [&](std::size_t a, std::size_t b) { return time_of(a) < time_of(b); });
-    std::array<std::vector<double>, kObservationKinds> s;
+    std::array<std::vector<std::size_t>, kObservationKinds> idx;
     for (std::size_t i : order)
       if (std::isfinite(heldout[static_cast<Index>(i)]))
-        s[static_cast<std::size_t>(obs[i].output)].push_back(heldout[static_cast<Index>(i)]);
-    for (std::size_t o = 0; o < kObservationKinds; ++o) small[o].push_back(s[o]);
+        idx[static_cast<std::size_t>(obs[i].output)].push_back(i);
+    for (std::size_t o = 0; o < kObservationKinds; ++o) {
+      Sequence s;
+      for (std::size_t i : idx[o]) s.value.push_back(heldout[static_cast<Index>(i)]);
+      s.var = cov.difference_variances(idx[o]);
+      small[o].push_back(std::move(s));
+    }
   }
   struct Estimate {
     std::array<double, kObservationKinds> per_output{};
     double sigma = kNaN, dof = 0;
     std::size_t n = 0;
   };
-  auto estimate = [](const std::array<std::vector<std::vector<double>>, kObservationKinds>& sq) {
+  auto estimate = [](const std::array<std::vector<Sequence>, kObservationKinds>& sq) {
     Estimate e;
-    std::vector<std::vector<double>> all;
+    std::vector<Sequence> all;
     e.per_output.fill(kNaN);
     for (std::size_t o = 0; o < kObservationKinds; ++o) {
       double s2 = 0, dof = 0;

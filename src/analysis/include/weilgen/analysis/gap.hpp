@@ -34,6 +34,9 @@ struct GapData {
   std::map<std::string, std::vector<double>> dir;  // axis -> ±1 per row (dir or dir_<axis>)
   std::map<std::string, std::vector<double>> temperature;  // T_<name> -> °C per row
   std::map<std::string, std::vector<double>> covariate;    // rpm, ... per row
+  // Each covariate's unit as the measurement reader classifies its column (classify_column:
+  // rpm 1/min, angle_deg deg, feed_mm_min mm/min); "" for none (a trace's feed direction).
+  std::map<std::string, std::string> covariate_unit;
   std::vector<std::string> fixed_axes;  // coordinates not in the table, taken from `fixed`
   std::optional<BallbarCircle> circle;  // a ballbar trace: its circle (observations are dr)
 };
@@ -99,11 +102,11 @@ struct NoiseFloor {
 // `explained` the share of the residual's variation its bins explain: dimensions are ranked by
 // it; the region is the dimension's worst bin, widened over neighbours nearly as bad.
 struct GapRegion {
-  std::string by;           // "output", a coordinate, "t_s", "dir_X", "cycle", "T_3", "rpm"
-  std::string output;       // dx ... dc, dr
-  std::string unit;         // of from/to: the coordinate's (mm, deg), s, °C, 1/min; "" else
+  std::string by;      // "output", a coordinate, "t_s", "dir_X", "cycle", "T_3", "rpm"
+  std::string output;  // dx ... dc, dr
+  std::string unit;    // of from/to: the coordinate's (mm, deg), s, °C, 1/min; "" else
   std::vector<std::string> same_as;  // dimensions with the very same bins (dir_Y = dir_X ...)
-  double from = 0, to = 0;  // the region's range in `unit` (output: 0..0)
+  double from = 0, to = 0;           // the region's range in `unit` (output: 0..0)
   std::size_t n = 0;
   double rms_um = 0, excess_um = 0, p_value = 1;
   double explained = 0;  // between-bin share of the residual's sum of squares (dimensions)
@@ -134,6 +137,10 @@ struct EffectFit {
   // False also for a bump over fewer than 3 sample positions (it cannot be told from a step).
   bool distinguishable = true;
   std::string indistinct_reason;  // why not, one clause
+  // Shapes of several terms (a missing PDGE): the combinations of the terms that the model's own
+  // errors absorb (less than 10 % of the shape's RMS outside the model's span), so the data do
+  // not determine them; the reported size is that of the rest. All of them: size not determined.
+  std::size_t terms = 0, terms_absorbed = 0;
 };
 
 // A gross reading: far outside the spread of the baseline's residual and unlike its neighbours
@@ -165,6 +172,11 @@ struct GapResult {
   std::string verdict_reason;          // one sentence: why this verdict
   std::array<double, kObservationKinds> final_rms{};  // held-out after the accepted effects
   double final_rms_um = 0, final_excess_um = 0, final_p_value = 1;
+  // The held-out RMS a right model would leave: floor · sqrt(mean(1 + h)) over the held-out
+  // residuals, h their held-out leverage (prediction error of the folds included), per output
+  // and over all; before and after the accepted effects.
+  std::array<double, kObservationKinds> baseline_ideal{}, final_ideal{};
+  double baseline_ideal_um = 0, final_ideal_um = 0;
   // Held-out residuals for plots: per observation of the data given (NaN when never held out,
   // and for outliers).
   std::vector<double> residual_before, residual_after;
