@@ -179,6 +179,17 @@ struct Coefficients {
     return std::make_pair(factor, it->second);
   }
 
+  // The first-order coefficients ∂output/∂error_i, position and orientation rows, each written
+  // as factor · placeholder when it is one (the same canonical sign as in the outputs).
+  void first_order(const SymbolicModel& m, std::vector<ex>& pos, std::vector<ex>& rot) {
+    for (int o = 0; o < 6; ++o)
+      for (std::size_t i = 0; i < m.errors.size(); ++i) {
+        const ex c = m.coefficient(o, {static_cast<std::uint16_t>(i)});
+        const auto s = split(c);
+        (o < 3 ? pos : rot).push_back(s ? s->first * s->second : c);
+      }
+  }
+
   // Σ c_m · monomial_m of one output, grouped by placeholder, each group's monomials (and those
   // with an inline coefficient) in nested form (factored_sum).
   // With max_degree > 0, only the monomials up to that degree.
@@ -306,7 +317,6 @@ struct HigherTable {
 
 HigherTable higher_table(const SymbolicModel& m, const std::vector<Monomial>& higher,
                          const InputTable& inputs, std::size_t max_nested) {
-  const std::size_t ne = m.errors.size();
   Coefficients shared;
   shared.everything = true;
   shared.prefix = "_c[";
@@ -323,12 +333,7 @@ HigherTable higher_table(const SymbolicModel& m, const std::vector<Monomial>& hi
     if (!nested) out += GiNaC::symbol("_h[" + std::to_string(o) + "]");
     (o < 3 ? pos : rot).push_back(out);
   }
-  for (int o = 0; o < 6; ++o)
-    for (std::size_t i = 0; i < ne; ++i) {
-      const ex c = m.coefficient(o, {static_cast<std::uint16_t>(i)});
-      const auto s = shared.split(c);
-      (o < 3 ? spos : srot).push_back(s ? s->first * s->second : c);
-    }
+  shared.first_order(m, spos, srot);
   // The table, term by term (each monomial is formed once): per non-zero coefficient, the step
   // from the previous entry's index term * kNumOutputs + output, its placeholder (none: the
   // number 1) and its numeric factor.
@@ -487,12 +492,7 @@ std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_la
     // the two are not computed twice under different signs.
     Coefficients shared = coefs;
     std::vector<ex> spos, srot;
-    for (int o = 0; o < 6; ++o)
-      for (std::size_t i = 0; i < ne; ++i) {
-        const ex c = m.coefficient(o, {static_cast<std::uint16_t>(i)});
-        const auto s = shared.split(c);
-        (o < 3 ? spos : srot).push_back(s ? s->first * s->second : c);
-      }
+    shared.first_order(m, spos, srot);
     dev_coef = function_body(inputs,
                              {{"position", pos},
                               {"orientation", rot},
