@@ -43,19 +43,6 @@ inline constexpr int kWeilgenModelAbiVersion = 3;
 
 #define WEILGEN_DEFINE_MODEL_ABI(ns, var)                                                        \
   namespace var##_impl {                                                                         \
-    inline void deviation(const double* axes, const double* errors, const double* params,        \
-                          double* position, double* orientation) {                               \
-      std::array<double, ns::kNumAxes> a{};                                                      \
-      std::array<double, ns::kNumErrors> e{};                                                    \
-      std::array<double, ns::kNumParams> p{};                                                    \
-      std::copy_n(axes, ns::kNumAxes, a.begin());                                                \
-      std::copy_n(errors, ns::kNumErrors, e.begin());                                            \
-      std::copy_n(params, ns::kNumParams, p.begin());                                            \
-      std::array<double, 3> pos{}, ori{};                                                        \
-      ns::Deviation<double>(a, e, p, position ? &pos : nullptr, orientation ? &ori : nullptr);   \
-      if (position) std::copy_n(pos.begin(), 3, position);                                       \
-      if (orientation) std::copy_n(ori.begin(), 3, orientation);                                 \
-    }                                                                                            \
     inline void coefficients(const double* axes, const double* params, double* position_coeff,   \
                              double* orientation_coeff) {                                        \
       std::array<double, ns::kNumAxes> a{};                                                      \
@@ -82,6 +69,11 @@ inline constexpr int kWeilgenModelAbiVersion = 3;
         if (position) std::copy_n(pos.begin(), 3, position + 3 * j);                             \
         if (orientation) std::copy_n(ori.begin(), 3, orientation + 3 * j);                       \
       }                                                                                          \
+    }                                                                                            \
+    /* One deviation is a batch of one. */                                                       \
+    inline void deviation(const double* axes, const double* errors, const double* params,        \
+                          double* position, double* orientation) {                               \
+      deviation_batch(axes, params, 1, errors, position, orientation);                           \
     }                                                                                            \
     inline void deviation_and_coefficients(                                                      \
         const double* axes, const double* errors, const double* params, double* position,        \
