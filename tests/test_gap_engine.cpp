@@ -53,6 +53,20 @@ double rel(const VectorXd& a, const VectorXd& b) {
   return (a - b).norm() / std::max(1e-300, std::max(a.norm(), b.norm()));
 }
 
+// The largest |c(k, l) − S_kl| over all pairs, by c(k, l) and by the prepared columns.
+std::pair<double, double> worst_entries(const HeldoutCovariance& cov, const MatrixXd& S) {
+  double worst = 0, worst_column = 0;
+  for (std::size_t l = 0; l < static_cast<std::size_t>(S.cols()); ++l) {
+    const HeldoutCovariance::Column c = cov.column(l);
+    for (std::size_t k = 0; k < static_cast<std::size_t>(S.rows()); ++k) {
+      const double want = S(static_cast<Index>(k), static_cast<Index>(l));
+      worst = std::max(worst, std::abs(cov(k, l) - want));
+      worst_column = std::max(worst_column, std::abs(cov(k, c) - want));
+    }
+  }
+  return {worst, worst_column};
+}
+
 }  // namespace
 
 TEST_CASE("gap engine: a split's fit from block factors is the SVD fit of its training rows") {
@@ -239,15 +253,7 @@ TEST_CASE("gap engine: the held-out residuals' covariance is M Mᵀ, M from each
   }
   const MatrixXd S = M * M.transpose();
   const HeldoutCovariance cov(e);
-  double worst = 0, worst_column = 0;
-  for (std::size_t l = 0; l < n; ++l) {
-    const HeldoutCovariance::Column c = cov.column(l);
-    for (std::size_t k = 0; k < n; ++k) {
-      const double want = S(static_cast<Index>(k), static_cast<Index>(l));
-      worst = std::max(worst, std::abs(cov(k, l) - want));
-      worst_column = std::max(worst_column, std::abs(cov(k, c) - want));
-    }
-  }
+  const auto [worst, worst_column] = worst_entries(cov, S);
   CHECK(worst < 1e-9 * S.cwiseAbs().maxCoeff());
   CHECK(worst_column < 1e-9 * S.cwiseAbs().maxCoeff());
   // Leverage on the diagonal: c(k, k) = 1 + h_k, h_k well above 0 for a 60-row design.
@@ -265,4 +271,72 @@ TEST_CASE("gap engine: the held-out residuals' covariance is M Mᵀ, M from each
     c[static_cast<Index>(seq.front())] += 1.0 / static_cast<double>(k);
     CHECK(v[i] == doctest::Approx(c.dot(S * c)).epsilon(1e-9));
   }
+}
+
+TEST_CASE(
+    "gap engine: the estimable held-out residual is free of errors a fold cannot determine, and "
+    "its covariance is M_f S M_fᵀ") {
+  // Two columns non-zero only on split 0's held-out rows: its training rows determine neither,
+  // so its held-out residual carries them whatever θ is. M_0 removes them (2 directions), and the
+  // estimable covariance is the plain one seen through M = blockdiag(M_f).
+  const std::size_t n = 60;
+  MatrixXd A(static_cast<Index>(n), 11);
+  A.leftCols(9) = design(n, 31);
+  const std::vector<Split> splits = three_folds(n);
+  A.rightCols(2).setZero();
+  for (std::size_t k : splits[0].test) {
+    const auto i = static_cast<Index>(k);
+    A(i, 9) = 1 + 0.1 * A(i, 1), A(i, 10) = A(i, 2) * 1e2;
+  }
+  VectorXd y = values(A, 32);
+  auto estimable = [&](const VectorXd& values, VectorXd& r, VectorXd& h, std::size_t& removed) {
+    GapData d;
+    Engine e(d, A, values, 1);
+    e.splits = splits;
+    e.fit_folds();
+    VectorXd h0;
+    e.heldout(r, h0);
+    HeldoutCovariance(e, true).estimable(r, h, removed);
+  };
+  VectorXd r1, h1, r2, h2;
+  std::size_t removed1 = 0, removed2 = 0;
+  estimable(y, r1, h1, removed1);
+  CHECK(removed1 == 2);
+  // 50 and −30 more of the two undetermined errors: the estimable residual does not move.
+  estimable(y + 50 * A.col(9) - 30 * A.col(10), r2, h2, removed2);
+  CHECK(removed2 == 2);
+  CHECK(rel(r1, r2) < 1e-9);
+  CHECK(rel(h1, h2) < 1e-12);
+  // Dense: S = M Mᵀ of the plain held-out residual, M_f = I − U Uᵀ with U the left singular
+  // vectors of A_test (I − A_tr⁺A_tr).
+  GapData d;
+  Engine e(d, A, y, 1);
+  e.splits = splits;
+  e.fit_folds();
+  const HeldoutCovariance plain(e), est(e, true);
+  MatrixXd S(static_cast<Index>(n), static_cast<Index>(n)), Mb = MatrixXd::Zero(S.rows(), S.cols());
+  for (std::size_t k = 0; k < n; ++k)
+    for (std::size_t l = 0; l < n; ++l)
+      S(static_cast<Index>(k), static_cast<Index>(l)) = plain(k, l);
+  for (const Split& s : splits) {
+    const MatrixXd Atr = rows_of(A, s.train), At = rows_of(A, s.test);
+    const MatrixXd P = Atr.completeOrthogonalDecomposition().pseudoInverse() * Atr;
+    const Eigen::JacobiSVD<MatrixXd> svd(At * (MatrixXd::Identity(A.cols(), A.cols()) - P),
+                                         Eigen::ComputeThinU);
+    Index k = 0;
+    while (k < svd.singularValues().size() && svd.singularValues()[k] > 1e-8) ++k;
+    const MatrixXd U = svd.matrixU().leftCols(k);
+    const MatrixXd M = MatrixXd::Identity(At.rows(), At.rows()) - U * U.transpose();
+    for (std::size_t i = 0; i < s.test.size(); ++i)
+      for (std::size_t j = 0; j < s.test.size(); ++j)
+        Mb(static_cast<Index>(s.test[i]), static_cast<Index>(s.test[j])) =
+            M(static_cast<Index>(i), static_cast<Index>(j));
+  }
+  const MatrixXd want = Mb * S * Mb.transpose();
+  const auto [worst, worst_column] = worst_entries(est, want);
+  for (std::size_t l = 0; l < n; ++l)
+    CHECK(1 + h1[static_cast<Index>(l)] ==
+          doctest::Approx(want(static_cast<Index>(l), static_cast<Index>(l))).epsilon(1e-9));
+  CHECK(worst < 1e-9 * want.cwiseAbs().maxCoeff());
+  CHECK(worst_column < 1e-9 * want.cwiseAbs().maxCoeff());
 }

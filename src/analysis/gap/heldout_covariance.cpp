@@ -2,31 +2,62 @@
 // HeldoutCovariance; docs/gap.md, "Noise floor"). Everything is read from the splits' fits: no
 // observations × observations matrix is formed.
 #include <algorithm>
+#include <cmath>
 
 #include "internal.hpp"
 
 namespace weilgen::gap_detail {
 
-HeldoutCovariance::HeldoutCovariance(const Engine& e) : e_(&e) {
+HeldoutCovariance::HeldoutCovariance(const Engine& e, bool estimable) : e_(&e) {
   const std::size_t n = static_cast<std::size_t>(e.y.size());
   const std::size_t K = e.splits.size();
   split_.assign(n, -1);
   pos_.assign(n, 0);
   W_.resize(K);
+  U_.resize(K);
+  rows_.resize(K);
   train_.assign(K, std::vector<char>(n, 0));
+  const BlockFactors& F = *e.factors;
+  std::vector<MatrixXd> RtR(F.R.size());
+  MatrixXd all = MatrixXd::Zero(F.cols, F.cols);
+  for (std::size_t b = 0; b < F.R.size(); ++b) all += RtR[b] = F.R[b].transpose() * F.R[b];
+  // Equilibrated columns: the cut does not depend on the errors' units.
+  VectorXd scale = e.A.colwise().norm();
+  for (Index j = 0; j < scale.size(); ++j) scale[j] = scale[j] > 0 ? 1 / scale[j] : 1.0;
+  const auto D = scale.asDiagonal();
   for (std::size_t f = 0; f < K; ++f) {
     const Split& s = e.splits[f];
+    const FoldFit& ff = e.folds[f];
     for (std::size_t i : s.train) train_[f][i] = 1;
     for (std::size_t i = 0; i < s.test.size(); ++i)
       if (split_[s.test[i]] < 0) split_[s.test[i]] = static_cast<int>(f), pos_[s.test[i]] = i;
-    W_[f] = rows_of(e.A, s.test) * e.folds[f].VS;
+    rows_[f] = rows_of(e.A, s.test);
+    U_[f].resize(rows_[f].rows(), 0);
+    if (estimable) {
+      // B_f = A_test P, P = I − G_f N_f (A_f⁺A_f = G_f N_f projects onto the training rows'
+      // span); its left singular vectors from D BᵀB D = D Pᵀ T P D, T = A_testᵀA_test: nothing
+      // grows with the held-out rows but the final products.
+      MatrixXd N = MatrixXd::Zero(F.cols, F.cols);
+      for (std::size_t b : ff.blocks) N += RtR[b];
+      const MatrixXd T = all - N;
+      const MatrixXd P = MatrixXd::Identity(F.cols, F.cols) - ff.VS * (ff.VS.transpose() * N);
+      const Eigen::SelfAdjointEigenSolver<MatrixXd> top(D * T * D, Eigen::EigenvaluesOnly);
+      const Eigen::SelfAdjointEigenSolver<MatrixXd> eig(D * P.transpose() * T * P * D);
+      const double cut = kEstimableCut * kEstimableCut * top.eigenvalues().maxCoeff();
+      std::vector<Index> keep;
+      for (Index j = 0; j < eig.eigenvalues().size(); ++j)
+        if (eig.eigenvalues()[j] > cut) keep.push_back(j);
+      U_[f].resize(rows_[f].rows(), static_cast<Index>(keep.size()));
+      for (std::size_t j = 0; j < keep.size(); ++j)
+        U_[f].col(static_cast<Index>(j)) = rows_[f] * (P * (D * eig.eigenvectors().col(keep[j]))) /
+                                           std::sqrt(eig.eigenvalues()[keep[j]]);
+      rows_[f] -= U_[f] * (U_[f].transpose() * rows_[f]);  // M_f A_test
+    }
+    W_[f] = rows_[f] * ff.VS;
   }
   if (K < 2) return;
   // N_fg = Σ a_i a_iᵀ over the rows both splits train on = Σ R_bᵀ R_b over their common blocks
   // (A_b = Q_b R_b, Q_b orthonormal).
-  const BlockFactors& F = *e.factors;
-  std::vector<MatrixXd> RtR(F.R.size());
-  for (std::size_t b = 0; b < F.R.size(); ++b) RtR[b] = F.R[b].transpose() * F.R[b];
   C_.assign(K, std::vector<MatrixXd>(K));
   for (std::size_t f = 0; f < K; ++f)
     for (std::size_t g = 0; g < K; ++g) {
@@ -47,8 +78,8 @@ double HeldoutCovariance::cross(std::size_t k, std::size_t l) const {
   const auto wk = W_[f].row(static_cast<Index>(pos_[k]));
   const auto wl = W_[g].row(static_cast<Index>(pos_[l]));
   double c = wk.dot(C_[f][g] * wl.transpose());
-  if (train_[g][k]) c -= (e_->A.row(static_cast<Index>(k)) * e_->folds[g].VS).dot(wl);
-  if (train_[f][l]) c -= wk.dot(e_->A.row(static_cast<Index>(l)) * e_->folds[f].VS);
+  if (train_[g][k]) c -= (row(k) * e_->folds[g].VS).dot(wl);
+  if (train_[f][l]) c -= wk.dot(row(l) * e_->folds[f].VS);
   return c;
 }
 
@@ -56,9 +87,10 @@ double HeldoutCovariance::operator()(std::size_t k, std::size_t l) const {
   const int f = split_[k], g = split_[l];
   if (f < 0 || g < 0) return kNaN;
   if (f != g) return cross(k, l);
-  const auto& W = W_[static_cast<std::size_t>(f)];
-  return (k == l ? 1.0 : 0.0) +
-         W.row(static_cast<Index>(pos_[k])).dot(W.row(static_cast<Index>(pos_[l])));
+  const auto fs = static_cast<std::size_t>(f);
+  const auto pk = static_cast<Index>(pos_[k]), pl = static_cast<Index>(pos_[l]);
+  return (k == l ? 1.0 : 0.0) - U_[fs].row(pk).dot(U_[fs].row(pl)) +
+         W_[fs].row(pk).dot(W_[fs].row(pl));
 }
 
 HeldoutCovariance::Column HeldoutCovariance::column(std::size_t l) const {
@@ -71,8 +103,7 @@ HeldoutCovariance::Column HeldoutCovariance::column(std::size_t l) const {
   for (std::size_t f = 0; f < W_.size(); ++f) {
     if (f == g) continue;
     c.u[f] = C_[f][g] * wl.transpose();
-    if (train_[f][l])
-      c.u[f] -= e_->folds[f].VS.transpose() * e_->A.row(static_cast<Index>(l)).transpose();
+    if (train_[f][l]) c.u[f] -= e_->folds[f].VS.transpose() * row(l).transpose();
   }
   return c;
 }
@@ -83,8 +114,24 @@ double HeldoutCovariance::operator()(std::size_t k, const Column& c) const {
   if (f == g) return (*this)(k, c.obs);
   const auto fk = static_cast<std::size_t>(f);
   double v = W_[fk].row(static_cast<Index>(pos_[k])).dot(c.u[fk].transpose());
-  if (train_[static_cast<std::size_t>(g)][k]) v -= e_->A.row(static_cast<Index>(k)).dot(c.Gg_al);
+  if (train_[static_cast<std::size_t>(g)][k]) v -= row(k).dot(c.Gg_al);
   return v;
+}
+
+void HeldoutCovariance::estimable(VectorXd& r, VectorXd& h, std::size_t& removed) const {
+  h = VectorXd::Zero(r.size());
+  removed = 0;
+  for (std::size_t f = 0; f < e_->splits.size(); ++f) {
+    const std::vector<std::size_t>& test = e_->splits[f].test;
+    const VectorXd rt = rows_of(r, test);
+    const VectorXd Mr = rt - U_[f] * (U_[f].transpose() * rt);
+    for (std::size_t i = 0; i < test.size(); ++i) {
+      const auto o = static_cast<Index>(test[i]), ii = static_cast<Index>(i);
+      r[o] = Mr[ii];
+      h[o] = W_[f].row(ii).squaredNorm() - U_[f].row(ii).squaredNorm();
+    }
+    removed += static_cast<std::size_t>(U_[f].cols());
+  }
 }
 
 std::vector<double> HeldoutCovariance::difference_variances(

@@ -130,9 +130,23 @@ class Engine {
 //                                                 (k held out by f, l by g),
 // G_f = A_f⁺A_f⁺ᵀ = VS_f VS_fᵀ (so c(k, k) = 1 + h_k) and N_fg = Σ a_i a_iᵀ over the rows both
 // splits train on. Built from the engine's fits (its splits and folds must be current).
+//
+// `estimable`: the same for the part of the held-out residual each split's training part can
+// predict (docs/gap.md, "The held-out gap test"). A held-out row a_k of split f has a part b_k
+// outside the span of f's training rows; the minimum-norm fit predicts nothing along it, so r_k
+// carries b_kᵀθ of the true errors θ, which no noise model contains. The residuals of split f are
+// projected off the span of B_f = [b_kᵀ] (M_f = I − U_f U_fᵀ, U_f its left singular vectors,
+// cut kEstimableCut of A_test's largest on equilibrated columns): M_f r_f is free of θ, and its
+// covariance is the above with every held-out row a_k replaced by the rows of M_f A_test and δ_kl
+// by (M_f)_kl.
+inline constexpr double kEstimableCut = 1e-6;
 class HeldoutCovariance {
  public:
-  explicit HeldoutCovariance(const Engine& e);
+  explicit HeldoutCovariance(const Engine& e, bool estimable = false);
+  // Replaces the held-out residual `r` by M r (split by split) and sets `h` so that
+  // c(k, k) = 1 + h_k; `removed`: the directions taken out over all splits (the degrees of
+  // freedom the gap test loses). Without `estimable`, M = I.
+  void estimable(VectorXd& r, VectorXd& h, std::size_t& removed) const;
   // c(k, l); NaN when k or l is not held out.
   double operator()(std::size_t k, std::size_t l) const;
   // c(·, l) prepared for many k (O(p) per k instead of O(p · rank)).
@@ -152,7 +166,13 @@ class HeldoutCovariance {
   const Engine* e_;
   std::vector<int> split_;        // the split holding each observation out (-1: none)
   std::vector<std::size_t> pos_;  // its row in that split's test part
-  std::vector<MatrixXd> W_;       // per split: A_test VS (rows w_{k,f}ᵀ; h_k = |w_{k,f}|²)
+  // The held-out row of k (M_f A_test's with `estimable`).
+  auto row(std::size_t k) const {
+    return rows_[static_cast<std::size_t>(split_[k])].row(static_cast<Index>(pos_[k]));
+  }
+  std::vector<MatrixXd> rows_;  // per split: A_test (M_f A_test with `estimable`)
+  std::vector<MatrixXd> U_;     // per split: U_f (no columns without `estimable`)
+  std::vector<MatrixXd> W_;     // per split: rows_ VS (rows w_{k,f}ᵀ; h_k = |w_{k,f}|²)
   std::vector<std::vector<char>> train_;  // per split: trains on observation i
   std::vector<std::vector<MatrixXd>> C_;  // C_fg = VS_fᵀ N_fg VS_g
 };
@@ -229,12 +249,13 @@ inline std::vector<double> split_theta(const VectorXd& theta, std::size_t np) {
 struct Gap {
   double ss = 0, expected = 0;  // Σ r², Σ σ²(1 + h)
   std::size_t n = 0;
+  std::size_t removed = 0;  // directions projected out (estimable_heldout): n − removed dof
 };
 
 // Excess RMS over the floor and the F-test p-value of a set of held-out residuals.
 inline void gap_stats(const Gap& g, double dof, double& excess, double& p) {
   excess = g.n ? std::sqrt(std::max(0.0, (g.ss - g.expected) / static_cast<double>(g.n))) : 0;
-  p = g.n ? f_sf((g.ss / g.expected), static_cast<double>(g.n), dof) : 1;
+  p = g.n > g.removed ? f_sf(g.ss / g.expected, static_cast<double>(g.n - g.removed), dof) : 1;
 }
 
 // Gross readings in the baseline's full-data residual `r` (docs/gap.md, "Outliers").
