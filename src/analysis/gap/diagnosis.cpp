@@ -171,6 +171,7 @@ void decide_verdict(GapResult& R, const GapOptions& opt, const std::vector<std::
   for (std::size_t k = 0; k < R.explanation.size(); ++k) {
     const EffectFit& f = R.explanation[k];
     if (f.distinguishable || (k > 0 && shape[k] != shape[0])) continue;
+    if (shape[k].first < 0) return unexplained(f.name + " fits, but " + f.indistinct_reason);
     const std::string along = axes[static_cast<std::size_t>(shape[k].first)];
     const std::string out = observation_name(static_cast<std::size_t>(shape[k].second));
     return unexplained(f.name + " along " + along + " in " + out + " fits, but " +
