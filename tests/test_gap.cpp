@@ -31,12 +31,11 @@ struct Row {
 // Effect added to (dx, dy, dz) in µm at a row.
 using EffectFn = std::function<std::array<double, 3>(const Row&)>;
 
-PdgeBasisChoice poly(int degree) {
+PdgeBasisChoice poly2() {
   PdgeBasisChoice c;
-  c.all = "poly:" + std::to_string(degree);
+  c.all = "poly:2";
   return c;
 }
-PdgeBasisChoice poly2() { return poly(2); }
 
 // vmc_3axis with random errors within their spreads (`scale` times; PDGEs in the basis
 // `choice`, default poly:2): its first-order deviation (µm, µrad) and its errors (base units)
@@ -982,15 +981,6 @@ std::vector<ChainRow> head_rtest(const Model& model) {
   return rows;
 }
 
-// The benchmark's rtest_small: head_rtest's first pass, 60 poses.
-std::vector<ChainRow> head_rtest_small(const Model& model) {
-  std::vector<ChainRow> rows;
-  for (const ChainRow& r : head_rtest(model))
-    if (r.cycle == 1) rows.push_back(r);
-  REQUIRE(rows.size() == 60);
-  return rows;
-}
-
 }  // namespace
 
 TEST_CASE("gap: on a head-head machine, a periodic error of the C head is named E_ZC of C") {
@@ -1158,6 +1148,24 @@ TEST_CASE("gap: effect-free data whose noise grows 4x across the layout are none
   CHECK(ratio == doctest::Approx(1).epsilon(0.04));
 }
 
+namespace {
+
+// The first pass (cycle 1) of head_rtest: 60 poses, none repeated.
+std::vector<ChainRow> head_rtest_one_pass(const Model& model) {
+  std::vector<ChainRow> rows;
+  for (const ChainRow& r : head_rtest(model))
+    if (r.cycle == 1) rows.push_back(r);
+  return rows;
+}
+
+PdgeBasisChoice poly(int degree) {
+  PdgeBasisChoice c;
+  c.all = "poly:" + std::to_string(degree);
+  return c;
+}
+
+}  // namespace
+
 TEST_CASE(
     "gap: on a small rotary set without repeats the floor reads the noise, and a step is seen") {
   // head_head_bc, one pass of 60 R-test poses (no pose repeated), time:5 folds, poly:3 PDGEs:
@@ -1166,7 +1174,8 @@ TEST_CASE(
   // the floor read up to 2.8x σ on the benchmark's effect-free sets of this layout and steps
   // were `none`; with the differences' exact variance from the folds' factors it reads σ.
   const auto model = test::builtin_model("head_head_bc");
-  const std::vector<ChainRow> rows = head_rtest_small(*model);
+  const std::vector<ChainRow> rows = head_rtest_one_pass(*model);
+  REQUIRE(rows.size() == 60);
   const PdgeBasisChoice poly3 = poly(3);
   const double noise = 0.5;
   for (std::uint32_t seed : {41u, 42u, 43u, 44u}) {
@@ -1201,7 +1210,8 @@ TEST_CASE(
   // sets read `unexplained` (p down to 1e-7 in the benchmark). The test on the part each fold can
   // predict is at the floor.
   const auto model = test::builtin_model("head_head_bc");
-  const std::vector<ChainRow> rows = head_rtest_small(*model);
+  const std::vector<ChainRow> rows = head_rtest_one_pass(*model);
+  REQUIRE(rows.size() == 60);
   const PdgeBasisChoice poly3 = poly(3);
   const double noise = 0.5;
   int flagged = 0;
@@ -1225,4 +1235,33 @@ TEST_CASE(
     if (r.verdict == "periodic") ++named;
   }
   CHECK(named == 4);
+}
+
+TEST_CASE("gap: a step that an effect of the library only imitates is unexplained (lack of fit)") {
+  // head_head_bc, one pass of 60 R-test poses, time:5 folds, poly:3 PDGEs: a step of 4 µm in dz
+  // from the middle of the run on (outside the library). The model's errors absorb most of it
+  // and a thermal drift in time, a set-up or a shape fits the rest, so a name was given; the
+  // lack-of-fit test after acceptance (free offsets per output in bins of time and of every
+  // axis) finds the structure the named effect leaves along time or an axis.
+  const auto model = test::builtin_model("head_head_bc");
+  const std::vector<ChainRow> rows = head_rtest_one_pass(*model);
+  REQUIRE(rows.size() == 60);
+  const PdgeBasisChoice poly3 = poly(3);
+  int named = 0, seen = 0;
+  for (std::uint32_t seed : {45u, 46u, 47u, 48u, 49u, 50u}) {
+    const std::string csv = chain_csv(
+        *model, rows, 0.5, seed,
+        [&](const ChainRow& r, std::vector<double>&, std::vector<double>&, Eigen::Vector3d& x) {
+          x = Eigen::Vector3d(0, 0, r.t_s >= 30 * 20 ? 4.0 : 0.0);
+        });
+    const GapResult r = diagnose(csv, model, "time:5", poly3);
+    INFO("seed " << seed << ": " << r.verdict << ": " << r.verdict_reason);
+    // (`none` on some seeds: the held-out gap is at the floor; the step is then below what the
+    // layout shows beyond the model, docs/experiments/gap-benchmark.md.)
+    CHECK(r.verdict != "thermal_drift");
+    if (r.verdict != "none" && r.verdict != "unexplained") ++named;
+    if (r.verdict == "unexplained") ++seen;
+  }
+  CHECK(named == 0);
+  CHECK(seen >= 3);
 }

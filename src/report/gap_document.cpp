@@ -70,7 +70,11 @@ json effect_json(const EffectFit& e, const std::array<std::size_t, kObservationK
   return j;
 }
 
+// Why the verdict cannot name it: too many shape degrees of freedom used, else the effect's own
+// reason (a bump narrower than the sampling, a tool offset no tool has).
 std::string not_distinguishable(const EffectFit& e) {
+  if (e.shape_dof_free == 0 || e.shape_dof_used < e.shape_dof_free)
+    return e.indistinct_reason.empty() ? "" : " (" + e.indistinct_reason + ")";
   return " (needs " + std::to_string(e.shape_dof_used) + " shape degrees of freedom where the " +
          "data leave " + std::to_string(e.shape_dof_free) + ": any shape fits)";
 }

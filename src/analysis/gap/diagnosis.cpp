@@ -78,6 +78,68 @@ std::string pct(double fraction) {
   return b;
 }
 
+// What the accepted effects leave along each coordinate (docs/gap.md, "Lack of fit"): one free
+// offset per output and per bin of the coordinate (time and every axis that moves; its distinct
+// positions, or 6 bins of equal count when it has more) joined to the model with the effects, a
+// nested F test on all data, Bonferroni over the coordinates. An effect of the library leaves
+// noise; a shape outside it (a step in time or along an axis) that an effect only imitates
+// leaves a structure there.
+struct LackOfFit {
+  double p_value = 1;
+  std::string along;
+  double excess_ss = 0;  // the bins' drop in SSE beyond the noise they fit (q σ²)
+};
+
+LackOfFit lack_of_fit(const Engine& e, const GapData& d) {
+  const auto& obs = d.points.observations;
+  const std::size_t n = obs.size();
+  std::vector<std::pair<std::string, std::vector<double>>> coords;  // value per observation
+  auto add = [&](const std::string& name, auto&& value) {
+    std::vector<double> v(n);
+    for (std::size_t i = 0; i < n; ++i) v[i] = value(obs[i].row);
+    if (std::any_of(v.begin(), v.end(), [](double x) { return !std::isfinite(x); })) return;
+    if (*std::max_element(v.begin(), v.end()) > *std::min_element(v.begin(), v.end()))
+      coords.emplace_back(name, std::move(v));
+  };
+  add("t_s", [&](std::size_t row) { return row < d.time_s.size() ? d.time_s[row] : kNaN; });
+  for (std::size_t a = 0; a < d.axes.size(); ++a)
+    add(d.axes[a], [&](std::size_t row) { return d.points.poses[row][a]; });
+  LackOfFit worst;
+  constexpr std::size_t kBins = 6;
+  for (const auto& [name, v] : coords) {
+    std::vector<double> levels = v;
+    std::sort(levels.begin(), levels.end());
+    levels.erase(std::unique(levels.begin(), levels.end()), levels.end());
+    std::vector<double> edges;  // bin b holds values below edges[b]
+    if (levels.size() <= kBins) {
+      for (std::size_t l = 1; l < levels.size(); ++l) edges.push_back(levels[l]);
+    } else {
+      std::vector<double> sorted = v;
+      std::sort(sorted.begin(), sorted.end());
+      for (std::size_t b = 1; b < kBins; ++b) edges.push_back(sorted[b * n / kBins]);
+      edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+    }
+    const Index nb = static_cast<Index>(edges.size() + 1);
+    MatrixXd G = MatrixXd::Zero(static_cast<Index>(n), nb * kObservationKinds);
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto b = std::upper_bound(edges.begin(), edges.end(), v[i]) - edges.begin();
+      G(static_cast<Index>(i), obs[i].output * nb + b) = 1;
+    }
+    std::vector<Index> seen;  // the outputs' bins that hold observations
+    for (Index c = 0; c < G.cols(); ++c)
+      if (G.col(c).any()) seen.push_back(c);
+    G = G(Eigen::all, seen).eval();
+    const JointFit f = joint_fit(*e.factors, e.A, e.y, G);
+    const double q = static_cast<double>(f.rank) - static_cast<double>(e.full_rank);
+    const double d2 = static_cast<double>(n) - static_cast<double>(f.rank);
+    if (q <= 0 || d2 <= 0 || !(f.sse > 0)) continue;
+    const double p = std::min(1.0, f_sf(((e.full_sse - f.sse) / q) / (f.sse / d2), q, d2) *
+                                       static_cast<double>(coords.size()));
+    if (p < worst.p_value) worst = {p, name, std::max(0.0, e.full_sse - f.sse - q * f.sse / d2)};
+  }
+  return worst;
+}
+
 // The verdict and its reason from the greedy explanation (docs/gap.md, "Verdict"). `shape` holds
 // each accepted effect's (coordinate, output) when it is a shape along a coordinate.
 void decide_verdict(GapResult& R, const GapOptions& opt, const std::vector<std::string>& axes,
@@ -109,6 +171,7 @@ void decide_verdict(GapResult& R, const GapOptions& opt, const std::vector<std::
   for (std::size_t k = 0; k < R.explanation.size(); ++k) {
     const EffectFit& f = R.explanation[k];
     if (f.distinguishable || (k > 0 && shape[k] != shape[0])) continue;
+    if (shape[k].first < 0) return unexplained(f.name + " fits, but " + f.indistinct_reason);
     const std::string along = axes[static_cast<std::size_t>(shape[k].first)];
     const std::string out = observation_name(static_cast<std::size_t>(shape[k].second));
     return unexplained(f.name + " along " + along + " in " + out + " fits, but " +
@@ -334,6 +397,7 @@ GapResult GapDiagnosis::run(const Model& model, const ErrorParameterisation& par
   std::vector<gap_detail::Candidate> candidates = gap_detail::effect_candidates(ctx, names);
   const double n_candidates = static_cast<double>(std::max<std::size_t>(1, candidates.size()));
 
+  const double base_full_sse = e.full_sse;  // the baseline's SSE on all data
   bool gap_significant = R.baseline_p_value < options_.alpha;
   VectorXd cur_r = r, cur_h = h;
   std::vector<bool> used(candidates.size(), false);
@@ -456,6 +520,24 @@ GapResult GapDiagnosis::run(const Model& model, const ErrorParameterisation& par
   const double explained =
       excess_ss > 0 ? explained_ss / excess_ss : (base.ss > 0 ? explained_ss / base.ss : 0);
   decide_verdict(R, options_, data.axes, gap_significant, explained, accepted_shape);
+  // Lack of fit: a named effect must leave no structure along a coordinate that is both
+  // significant and material, more than 1 − explain_fraction of the structure (the effects' drop
+  // in SSE on all data plus the bins' excess): the same share the held-out test asks of it. An
+  // effect that only imitates a shape outside the library (a step) leaves one; a misfit of a
+  // right effect at high SNR is significant but small.
+  if (!R.explanation.empty() && R.verdict == R.explanation.front().name) {
+    const LackOfFit lof = lack_of_fit(e, data);
+    const double removed = std::max(0.0, base_full_sse - e.full_sse);
+    const double share = lof.excess_ss / (lof.excess_ss + removed);
+    if (lof.p_value < options_.alpha && share > 1 - options_.explain_fraction) {
+      R.verdict = "unexplained";
+      R.verdict_reason =
+          R.explanation.front().name + " fits, but leaves a structure along " +
+          (lof.along == "t_s" ? std::string("time") : lof.along) + " (" + pct(share) +
+          " of the structure, lack of fit p = " + format_significant(lof.p_value, 2) +
+          "): a shape outside the library, which it only imitates";
+    }
+  }
   // The accepted effects' own regions lead the list: where the named cause acts, in the output
   // where it removed the most held-out sum of squares (what the data show of it; the output an
   // error moves most before the model absorbs part of it can be another on a rotary layout).

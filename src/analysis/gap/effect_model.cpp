@@ -236,6 +236,9 @@ void add_missing_error(const EffectContext& ctx, std::vector<Candidate>& out) {
   out.push_back(std::move(c));
 }
 
+// Larger than any tool (mm): a fitted tool offset beyond it is not a set-up error.
+constexpr double kMaxToolOffsetMm = 1000;
+
 void add_tool_offset(const EffectContext& ctx, std::vector<Candidate>& out) {
   const Description& desc = ctx.model->description();
   int tool = -1;
@@ -281,6 +284,15 @@ void add_tool_offset(const EffectContext& ctx, std::vector<Candidate>& out) {
     fit.params[pname + "_mm"] = base + coef[0];
     fit.summary = "tool offset " + num(coef[0], 3) + " mm (" + pname + " " + num(base, 4) + " -> " +
                   num(base + coef[0], 4) + " mm)";
+    // The column is nearly in the model's span on a machine whose rotations are only its small
+    // angular errors: then a tiny remainder, scaled up hundreds of metres, fits whatever shape
+    // is left (a step). No tool set-up error is that large.
+    if (!(std::abs(coef[0]) <= kMaxToolOffsetMm)) {
+      fit.distinguishable = false;
+      fit.indistinct_reason = "its size (" + num(coef[0], 3) +
+                              " mm) is no tool's: a remainder of " +
+                              "the column outside the model's errors imitates the gap";
+    }
   };
   out.push_back(std::move(c));
 }
