@@ -32,12 +32,16 @@ namespace {
 // failure; it stops when a step gains less than kMinGain of the training SSE.
 constexpr int kHigherOrderIterations = 20;
 constexpr double kInitialDamping = 1e-4, kMinDamping = 1e-12, kMinGain = 1e-3;
+// The start's rank cut (declared units, as Identification's Gauss-Newton): nearly collinear
+// PDGE terms (E_XY and E_XX on an R-test, whose axes move together) can cancel in the first-order
+// fit at metres each, where their products with the rotations are metres too.
+constexpr double kStartRankTolerance = 1e-6;
 
 // θ (the first np entries) fitted to the rows `train` of y through the exact kinematics, from
 // the split's linear fit θ0 (all of A's columns; those past np are accepted effects' columns and
 // stay as fitted). The linear fit has no part in the model's null space (minimum norm); the
 // products of errors make some of those directions visible, and Levenberg-Marquardt (Jacobian of
-// the exact chain by central differences per error) estimates them.
+// the exact chain by forward differences per error) estimates them.
 std::vector<double> higher_order_refit(const EffectContext& ctx,
                                        const std::vector<std::size_t>& train,
                                        const VectorXd& theta0, const MatrixXd& A,
@@ -56,6 +60,26 @@ std::vector<double> higher_order_refit(const EffectContext& ctx,
     target[i] = y[r] - A.row(r)
                            .tail(A.cols() - static_cast<Index>(np))
                            .dot(theta0.tail(theta0.size() - static_cast<Index>(np)));
+  }
+  {
+    // The linear fit keeps combinations the data barely see (a rank cut of 1e-9 on equilibrated
+    // columns), which can be huge where the exact chain is far from linear. Start from its
+    // projection on the well-determined directions in declared units (µm, µrad), at zero in
+    // the others.
+    MatrixXd Al(m, static_cast<Index>(np));
+    for (Index i = 0; i < m; ++i)
+      Al.row(i) = A.row(static_cast<Index>(train[static_cast<std::size_t>(i)]))
+                      .head(static_cast<Index>(np));
+    Eigen::HouseholderQR<MatrixXd> qr(Al);
+    const MatrixXd R = qr.matrixQR().topRows(std::min(m, Al.cols())).triangularView<Eigen::Upper>();
+    const Eigen::BDCSVD<MatrixXd> svd(R, Eigen::ComputeThinV);
+    const VectorXd& sv = svd.singularValues();
+    Index rank = 0;
+    while (rank < sv.size() && sv[rank] > kStartRankTolerance * sv[0]) ++rank;
+    const MatrixXd V = svd.matrixV().leftCols(rank);
+    const VectorXd t0 = Eigen::Map<const VectorXd>(theta.data(), static_cast<Index>(np));
+    const VectorXd t = V * (V.transpose() * t0);
+    for (std::size_t p = 0; p < np; ++p) theta[p] = t[static_cast<Index>(p)];
   }
   std::vector<double> err(ne), jac(np);
   auto residual = [&](const std::vector<double>& t) {
@@ -89,15 +113,17 @@ std::vector<double> higher_order_refit(const EffectContext& ctx,
         const std::vector<double>& q = d.points.poses[row];
         param.errors_at(q.data(), theta.data(), err.data());
         param.derivatives(q.data(), jac.data());
+        // Forward differences over 1 declared unit (half the chain evaluations of central
+        // ones): their error, h/2 of a second derivative, slows the steps, not the fit, whose
+        // residual is exact.
+        const auto f0 = exact(*ctx.chain, q, err);
         for (std::size_t k = 0; k < ne; ++k) {
           if (!fitted[k]) continue;
-          const double e0 = err[k], h = desc.errors[k].to_base;  // 1 declared unit
+          const double e0 = err[k], h = desc.errors[k].to_base;
           err[k] = e0 + h;
           const auto p = exact(*ctx.chain, q, err);
-          err[k] = e0 - h;
-          const auto n = exact(*ctx.chain, q, err);
           err[k] = e0;
-          for (std::size_t o = 0; o < 6; ++o) g[k][o] = (p[o] - n[o]) / (2 * h);
+          for (std::size_t o = 0; o < 6; ++o) g[k][o] = (p[o] - f0[o]) / h;
         }
       }
       for (std::size_t p = 0; p < np; ++p)
