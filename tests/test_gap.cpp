@@ -1265,3 +1265,26 @@ TEST_CASE("gap: a step that an effect of the library only imitates is unexplaine
   CHECK(named == 0);
   CHECK(seen >= 3);
 }
+
+TEST_CASE(
+    "gap: products of errors with a part in the R-test's null space are higher_order, to the "
+    "noise") {
+  // head_head_bc on an R-test: the first-order model is rank-deficient, and errors 100x their
+  // spreads have a null-space part the linear fit cannot see; its products with the rest can.
+  // The one column at the minimum-norm errors leaves most of the products unexplained; the
+  // exact chain refitted over all errors (Levenberg-Marquardt) fits them to the noise.
+  const auto model = test::builtin_model("head_head_bc");
+  const double noise = 0.3;
+  const std::string csv = chain_csv(
+      *model, head_rtest(*model), noise, 25,
+      [](const ChainRow&, std::vector<double>&, std::vector<double>& e, Eigen::Vector3d&) {
+        for (double& v : e) v *= 100;
+      });
+  const GapResult r = diagnose(csv, model, "cycle:3", poly2());
+  INFO(r.verdict_reason);
+  CHECK(r.verdict == "higher_order");
+  const EffectFit* e = effect(r, "higher_order");
+  REQUIRE(e);
+  CHECK(e->params.at("scale") == doctest::Approx(1.0).epsilon(0.05));
+  for (int o = 0; o < 3; ++o) CHECK(r.final_rms[o] < 1.2 * noise);
+}

@@ -11,6 +11,7 @@
 #include "weilgen/base/text.hpp"
 #include "weilgen/machine/iso_names.hpp"
 #include "weilgen/machine/pdge_basis.hpp"
+#include "weilgen/uq/lsq.hpp"
 
 namespace weilgen::gap_detail {
 
@@ -24,10 +25,154 @@ std::array<double, 6> exact(const NumericChain& chain, const std::vector<double>
   return v;
 }
 
+namespace {
+
+// The higher_order refit (Levenberg-Marquardt): at most this many Jacobians; the damping λ on
+// equilibrated columns starts here, shrinks ×10 on success down to the floor and grows ×10 on
+// failure; it stops when a step gains less than kMinGain of the training SSE.
+constexpr int kHigherOrderIterations = 20;
+constexpr double kInitialDamping = 1e-4, kMinDamping = 1e-12, kMinGain = 1e-3;
+// The start's rank cut (declared units, as Identification's Gauss-Newton): nearly collinear
+// PDGE terms (E_XY and E_XX on an R-test, whose axes move together) can cancel in the first-order
+// fit at metres each, where their products with the rotations are metres too.
+constexpr double kStartRankTolerance = 1e-6;
+
+// θ (the first np entries) fitted to the rows `train` of y through the exact kinematics, from
+// the split's linear fit θ0 (all of A's columns; those past np are accepted effects' columns and
+// stay as fitted). The linear fit has no part in the model's null space (minimum norm); the
+// products of errors make some of those directions visible, and Levenberg-Marquardt (Jacobian of
+// the exact chain by forward differences per error) estimates them.
+std::vector<double> higher_order_refit(const EffectContext& ctx,
+                                       const std::vector<std::size_t>& train,
+                                       const VectorXd& theta0, const MatrixXd& A,
+                                       const VectorXd& y) {
+  const GapData& d = *ctx.data;
+  const auto& obs = d.points.observations;
+  const ErrorParameterisation& param = *ctx.param;
+  const Description& desc = ctx.model->description();
+  const std::size_t np = param.size(), ne = ctx.model->num_errors();
+  const auto m = static_cast<Index>(train.size());
+  std::vector<double> theta = split_theta(theta0, np);
+  // The target of the exact chain: y less the accepted effects' columns.
+  VectorXd target(m);
+  for (Index i = 0; i < m; ++i) {
+    const auto r = static_cast<Index>(train[static_cast<std::size_t>(i)]);
+    target[i] = y[r] - A.row(r)
+                           .tail(A.cols() - static_cast<Index>(np))
+                           .dot(theta0.tail(theta0.size() - static_cast<Index>(np)));
+  }
+  {
+    // The linear fit keeps combinations the data barely see (a rank cut of 1e-9 on equilibrated
+    // columns), which can be huge where the exact chain is far from linear. Start from its
+    // projection on the well-determined directions in declared units (µm, µrad), at zero in
+    // the others.
+    MatrixXd Al(m, static_cast<Index>(np));
+    for (Index i = 0; i < m; ++i)
+      Al.row(i) = A.row(static_cast<Index>(train[static_cast<std::size_t>(i)]))
+                      .head(static_cast<Index>(np));
+    Eigen::HouseholderQR<MatrixXd> qr(Al);
+    const MatrixXd R = qr.matrixQR().topRows(std::min(m, Al.cols())).triangularView<Eigen::Upper>();
+    const Eigen::BDCSVD<MatrixXd> svd(R, Eigen::ComputeThinV);
+    const VectorXd& sv = svd.singularValues();
+    Index rank = 0;
+    while (rank < sv.size() && sv[rank] > kStartRankTolerance * sv[0]) ++rank;
+    const MatrixXd V = svd.matrixV().leftCols(rank);
+    const VectorXd t0 = Eigen::Map<const VectorXd>(theta.data(), static_cast<Index>(np));
+    const VectorXd t = V * (V.transpose() * t0);
+    for (std::size_t p = 0; p < np; ++p) theta[p] = t[static_cast<Index>(p)];
+  }
+  std::vector<double> err(ne), jac(np);
+  auto residual = [&](const std::vector<double>& t) {
+    VectorXd r(m);
+    std::size_t row = SIZE_MAX;
+    std::array<double, 6> f{};
+    for (Index i = 0; i < m; ++i) {
+      const PointObservation& ob = obs[train[static_cast<std::size_t>(i)]];
+      if (ob.row != row) {
+        row = ob.row;
+        param.errors_at(d.points.poses[row].data(), t.data(), err.data());
+        f = exact(*ctx.chain, d.points.poses[row], err);
+      }
+      r[i] = target[i] - observe(ob, f);
+    }
+    return r;
+  };
+  VectorXd r = residual(theta);
+  std::vector<std::array<double, 6>> g(ne);  // ∂deviation/∂error at one pose (µm per base unit)
+  std::vector<char> fitted(ne, 0);           // errors that some parameter moves
+  for (const IdentParameter& ip : param.parameters())
+    fitted[static_cast<std::size_t>(ip.error)] = 1;
+  double lambda = kInitialDamping;
+  for (int it = 0; it < kHigherOrderIterations; ++it) {
+    MatrixXd J(m, static_cast<Index>(np));
+    std::size_t row = SIZE_MAX;
+    for (Index i = 0; i < m; ++i) {
+      const PointObservation& ob = obs[train[static_cast<std::size_t>(i)]];
+      if (ob.row != row) {
+        row = ob.row;
+        const std::vector<double>& q = d.points.poses[row];
+        param.errors_at(q.data(), theta.data(), err.data());
+        param.derivatives(q.data(), jac.data());
+        // Forward differences over 1 declared unit (half the chain evaluations of central
+        // ones): their error, h/2 of a second derivative, slows the steps, not the fit, whose
+        // residual is exact.
+        const auto f0 = exact(*ctx.chain, q, err);
+        for (std::size_t k = 0; k < ne; ++k) {
+          if (!fitted[k]) continue;
+          const double e0 = err[k], h = desc.errors[k].to_base;
+          err[k] = e0 + h;
+          const auto p = exact(*ctx.chain, q, err);
+          err[k] = e0;
+          for (std::size_t o = 0; o < 6; ++o) g[k][o] = (p[o] - f0[o]) / h;
+        }
+      }
+      for (std::size_t p = 0; p < np; ++p)
+        J(i, static_cast<Index>(p)) =
+            observe(ob, g[static_cast<std::size_t>(param.parameters()[p].error)]) * jac[p];
+    }
+    // Levenberg-Marquardt on the small triangle of J, columns equilibrated (the scaling commutes
+    // with Q): weakly visible directions enter as far as the damping lets them, and λ adapts.
+    Eigen::HouseholderQR<MatrixXd> qr(J);
+    const Index k = std::min(m, J.cols());
+    MatrixXd R = qr.matrixQR().topRows(k).triangularView<Eigen::Upper>();
+    const VectorXd qtr = (qr.householderQ().transpose() * r).head(k);
+    VectorXd scale = R.colwise().norm().transpose();
+    for (Index p = 0; p < scale.size(); ++p)
+      if (!(scale[p] > 0)) scale[p] = 1;
+    R = R * scale.cwiseInverse().asDiagonal();
+    const Eigen::BDCSVD<MatrixXd> svd(R, Eigen::ComputeThinU | Eigen::ComputeThinV);
+    const VectorXd b = svd.matrixU().transpose() * qtr;
+    const VectorXd& sv = svd.singularValues();
+    const double before = r.squaredNorm();
+    std::vector<double> trial;
+    bool better = false;
+    for (int tries = 0; tries < 12 && !better; ++tries) {
+      VectorXd z = VectorXd::Zero(sv.size());
+      for (Index j = 0; j < sv.size(); ++j) z[j] = sv[j] * b[j] / (sv[j] * sv[j] + lambda);
+      const VectorXd step = (svd.matrixV() * z).cwiseQuotient(scale);
+      trial = theta;
+      for (std::size_t p = 0; p < np; ++p) trial[p] += step[static_cast<Index>(p)];
+      VectorXd rt = residual(trial);
+      if (rt.squaredNorm() < before)
+        r = std::move(rt), better = true, lambda = std::max(lambda / 10, kMinDamping);
+      else
+        lambda *= 10;
+    }
+    if (!better) break;
+    theta = std::move(trial);
+    if (r.squaredNorm() > (1 - kMinGain) * before) break;
+  }
+  return theta;
+}
+
+}  // namespace
+
 void add_higher_order(const EffectContext& ctx, std::vector<Candidate>& out) {
   Candidate c;
   c.name = "higher_order";
   c.variants.push_back({"products of errors (exact kinematics)", {}, true});
+  c.refit = [ctx](const std::vector<std::size_t>& train, const VectorXd& theta, const MatrixXd& A,
+                  const VectorXd& y) { return higher_order_refit(ctx, train, theta, A, y); };
   const GapData& d = *ctx.data;
   c.columns = [&d, ctx](const Variant&, const std::vector<double>& theta) {
     const auto& obs = d.points.observations;

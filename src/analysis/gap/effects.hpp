@@ -73,6 +73,14 @@ struct Candidate {
   std::function<Eigen::MatrixXd(const Variant&, const std::vector<std::size_t>& train,
                                 const Eigen::VectorXd& train_residual)>
       fitted_columns;
+  // A nonlinear refit instead of θ_iterations (higher_order): from a split's linear θ (all of
+  // A's columns), the θ (first np entries) fitted to the training rows `train` of y through the
+  // exact kinematics; the columns are taken there. Fitted per split like fitted_columns, so the
+  // held-out improvement is what is tested (it has more effective parameters than columns).
+  std::function<std::vector<double>(const std::vector<std::size_t>& train,
+                                    const Eigen::VectorXd& theta, const Eigen::MatrixXd& A,
+                                    const Eigen::VectorXd& y)>
+      refit;
   // Fills summary/params/region of `fit` from the full-data coefficients c of the columns.
   std::function<void(const Variant&, const Eigen::VectorXd& c, EffectFit& fit)> describe;
   // The columns are terms of one shape (a missing PDGE): describe gets only the part of c the

@@ -32,10 +32,12 @@ struct Score {
   MatrixXd columns;  // a plain variant's full-data columns
 };
 
-// The columns of a θ-dependent variant for the fit `ff`: at its θ, then (theta_iterations) at
-// the θ of the joint fit [A E] with those columns.
+// The columns of a θ-dependent variant for the fit `ff` (on the rows `train`): at its θ, then
+// (theta_iterations) at the θ of the joint fit [A E] with those columns; a candidate's own
+// nonlinear refit instead when it has one.
 MatrixXd theta_columns(const Candidate& c, const Variant& v, const Engine& e, const FoldFit& ff,
-                       std::size_t np) {
+                       std::size_t np, const std::vector<std::size_t>& train) {
+  if (c.refit) return c.columns(v, c.refit(train, ff.theta, e.A, e.y));
   MatrixXd E = c.columns(v, split_theta(ff.theta, np));
   for (int it = 0; it < v.theta_iterations; ++it) {
     Projection exact;
@@ -64,7 +66,7 @@ Score score(const Candidate& c, const Variant& v, const ScoringContext& sc, bool
     Projection own, own_exact;
     if (!plain) {
       E = c.fitted_columns ? c.fitted_columns(v, split.train, ff.res_train)
-                           : theta_columns(c, v, e, ff, sc.np);
+                           : theta_columns(c, v, e, ff, sc.np, split.train);
       own = project(*e.factors, {E}, e.y);
     }
     const ExtraFit x = plain ? fit_extra(ff, shared, 0, *e.factors, s.columns, e.y, shared_exact)
@@ -173,7 +175,7 @@ Evaluated evaluate_one(const Candidate& c, const ScoringContext& sc,
     }
   }
   best.fit.name = c.name;
-  best.regularised = static_cast<bool>(c.fitted_columns);
+  best.regularised = c.fitted_columns || c.refit;
   if (!std::isfinite(best_train)) return best;
   if (!have_after) {
     Score s = score(c, best.variant, sc, true);
@@ -184,8 +186,9 @@ Evaluated evaluate_one(const Candidate& c, const ScoringContext& sc,
   const std::size_t n = static_cast<std::size_t>(e.y.size());
   best.columns = c.fitted_columns
                      ? c.fitted_columns(best.variant, all_rows(n).train, e.full.res_train)
-                 : best.variant.needs_theta ? theta_columns(c, best.variant, e, e.full, sc.np)
-                                            : std::move(best_shared);
+                 : best.variant.needs_theta
+                     ? theta_columns(c, best.variant, e, e.full, sc.np, all_rows(n).train)
+                     : std::move(best_shared);
   best.fit.tested_variants = static_cast<double>(c.variants.size());
   // Held-out before/after.
   const VectorXd& base_r = *sc.base_r;
@@ -230,9 +233,10 @@ Evaluated evaluate_one(const Candidate& c, const ScoringContext& sc,
     best.fit.p_value = std::min(
         1.0, f_sf(best.fit.f_statistic, q, d2) * best.fit.tested_variants * sc.n_candidates);
   }
-  if (c.fitted_columns && q > 0 && before.n > static_cast<std::size_t>(q) + 1) {
-    // A model fitted with regularisation has more effective parameters than columns, so its
-    // in-sample F test flatters it; its held-out improvement does not: test that instead.
+  if (best.regularised && q > 0 && before.n > static_cast<std::size_t>(q) + 1) {
+    // A model fitted per split (with regularisation, or a nonlinear refit) has more effective
+    // parameters than columns, so its in-sample F test flatters it; its held-out improvement
+    // does not: test that instead.
     const double dh = nn - q;
     best.fit.f_statistic = ((before.ss - afterg.ss) / q) / (afterg.ss / dh);
     best.fit.p_value = std::min(
