@@ -144,7 +144,9 @@ nlohmann::json gap_json(const GapResult& r, const Model& model, const std::strin
                           {"heldout_rms_all_um", json_number(r.baseline_rms_um)},
                           {"heldout_rms_ideal_um", per_output_json(r.baseline_ideal, r.count)},
                           {"excess_um", json_number(r.baseline_excess_um)},
-                          {"p_value", json_number(r.baseline_p_value)}}},
+                          {"p_value", json_number(r.baseline_p_value)},
+                          {"lack_of_fit_p_value", json_number(r.baseline_lack_of_fit_p)},
+                          {"lack_of_fit_along", r.baseline_lack_of_fit_along}}},
                         {"noise_floor_um", json_number(r.noise.sigma_um)},
                         {"noise_floor_source", r.noise.source},
                         {"noise_floor_detail", r.noise.detail},
@@ -196,7 +198,11 @@ std::string gap_text(const GapResult& r, const Model& model, const std::string& 
   os << "noise floor " << f3(r.noise.sigma_um) << " µm (" << r.noise.source << ": "
      << r.noise.detail << ")\n";
   os << "held-out gap: RMS " << f3(r.baseline_rms_um) << " µm, excess over the floor "
-     << f3(r.baseline_excess_um) << " µm, p = " << f3(r.baseline_p_value) << "\n\n";
+     << f3(r.baseline_excess_um) << " µm, p = " << f3(r.baseline_p_value)
+     << "; lack of fit on all data p = " << f3(r.baseline_lack_of_fit_p)
+     << (r.baseline_lack_of_fit_along.empty() ? ""
+                                              : " (along " + r.baseline_lack_of_fit_along + ")")
+     << "\n\n";
   if (markdown)
     os << "| output | held-out RMS before | max | after the explanation |\n|---|---|---|---|\n";
   else
