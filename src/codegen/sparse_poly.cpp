@@ -1,0 +1,235 @@
+#include "weilgen/codegen/sparse_poly.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace weilgen::gen {
+
+using GiNaC::ex;
+
+namespace {
+constexpr int kBias = 32768;
+
+std::uint16_t atom_of(std::uint32_t f) { return static_cast<std::uint16_t>(f >> 16); }
+int exp_of(std::uint32_t f) { return static_cast<int>(f & 0xffffu) - kBias; }
+std::uint32_t factor(std::uint16_t atom, long exp) {
+  if (exp <= -kBias || exp >= kBias) throw std::overflow_error("SparsePoly: exponent out of range");
+  return (static_cast<std::uint32_t>(atom) << 16) | static_cast<std::uint32_t>(exp + kBias);
+}
+
+// The product of two monomials: exponents of the same atom add, zero powers vanish.
+AtomKey key_product(const AtomKey& a, const AtomKey& b) {
+  AtomKey out;
+  out.reserve(a.size() + b.size());
+  std::size_t i = 0, j = 0;
+  while (i < a.size() || j < b.size()) {
+    if (j == b.size() || (i < a.size() && atom_of(a[i]) < atom_of(b[j]))) {
+      out.push_back(a[i++]);
+    } else if (i == a.size() || atom_of(b[j]) < atom_of(a[i])) {
+      out.push_back(b[j++]);
+    } else {
+      const int e = exp_of(a[i]) + exp_of(b[j]);
+      if (e != 0) out.push_back(factor(atom_of(a[i]), e));
+      ++i;
+      ++j;
+    }
+  }
+  return out;
+}
+
+bool key_less(const SparsePoly::Term& a, const SparsePoly::Term& b) { return a.key < b.key; }
+}  // namespace
+
+AtomTable::AtomTable() { key_id({}); }
+
+std::size_t AtomTable::KeyHash::operator()(const AtomKey& k) const {
+  std::size_t h = k.size();
+  for (std::uint32_t f : k) h = h * 1000003u ^ f;
+  return h;
+}
+
+std::uint16_t AtomTable::index(const ex& atom) {
+  const auto it = index_.find(atom);
+  if (it != index_.end()) return it->second;
+  if (atoms_.size() >= 0xffffu) throw std::overflow_error("SparsePoly: too many atoms");
+  const auto i = static_cast<std::uint16_t>(atoms_.size());
+  atoms_.push_back(atom);
+  index_.emplace(atom, i);
+  return i;
+}
+
+std::uint32_t AtomTable::key_id(AtomKey key) {
+  const auto it = key_ids_.find(key);
+  if (it != key_ids_.end()) return it->second;
+  const auto id = static_cast<std::uint32_t>(keys_.size());
+  keys_.push_back(key);
+  key_ids_.emplace(std::move(key), id);
+  return id;
+}
+
+std::uint32_t AtomTable::product(std::uint32_t a, std::uint32_t b) {
+  if (a == 0) return b;
+  if (b == 0) return a;
+  if (a > b) std::swap(a, b);
+  const std::uint64_t pair = (static_cast<std::uint64_t>(a) << 32) | b;
+  const auto it = products_.find(pair);
+  if (it != products_.end()) return it->second;
+  const std::uint32_t id = key_id(key_product(keys_[a], keys_[b]));
+  products_.emplace(pair, id);
+  return id;
+}
+
+SparsePoly::SparsePoly(const cln::cl_RA& c) {
+  if (!cln::zerop(c)) terms_.push_back({0, c});
+}
+
+SparsePoly SparsePoly::atom(std::uint16_t index, AtomTable& atoms, int exp) {
+  SparsePoly p;
+  p.terms_.push_back({exp == 0 ? 0 : atoms.key_id({factor(index, exp)}), 1});
+  return p;
+}
+
+std::optional<SparsePoly> SparsePoly::from_ex(const ex& e, AtomTable& atoms) {
+  if (GiNaC::is_a<GiNaC::numeric>(e)) {
+    const auto& n = GiNaC::ex_to<GiNaC::numeric>(e);
+    if (!n.is_rational()) return std::nullopt;
+    return SparsePoly(cln::the<cln::cl_RA>(n.to_cl_N()));
+  }
+  if (GiNaC::is_a<GiNaC::symbol>(e) || GiNaC::is_a<GiNaC::constant>(e))
+    return atom(atoms.index(e), atoms);
+  if (GiNaC::is_a<GiNaC::add>(e)) {
+    std::vector<Term> all;
+    for (std::size_t i = 0; i < e.nops(); ++i) {
+      auto p = from_ex(e.op(i), atoms);
+      if (!p) return std::nullopt;
+      for (auto& t : p->terms_) all.push_back(std::move(t));
+    }
+    return from_terms(std::move(all));
+  }
+  if (GiNaC::is_a<GiNaC::mul>(e)) {
+    SparsePoly r(1);
+    for (std::size_t i = 0; i < e.nops(); ++i) {
+      auto p = from_ex(e.op(i), atoms);
+      if (!p) return std::nullopt;
+      r = r.mul(*p, atoms);
+    }
+    return r;
+  }
+  if (GiNaC::is_a<GiNaC::power>(e)) {
+    if (!GiNaC::is_a<GiNaC::numeric>(e.op(1))) return std::nullopt;
+    const auto& n = GiNaC::ex_to<GiNaC::numeric>(e.op(1));
+    if (!n.is_integer()) return std::nullopt;
+    const long k = n.to_long();
+    auto base = from_ex(e.op(0), atoms);
+    if (!base) return std::nullopt;
+    if (k < 0) {
+      // Only a monomial has an inverse among polynomials in atoms.
+      if (base->terms_.size() != 1) return std::nullopt;
+      const Term& t = base->terms_[0];
+      AtomKey key = atoms.key(t.key);
+      for (auto& f : key) f = factor(atom_of(f), exp_of(f) * k);
+      SparsePoly r;
+      r.terms_.push_back({atoms.key_id(key), cln::expt(cln::recip(t.coeff), -k)});
+      return r;
+    }
+    SparsePoly r(1);
+    for (long i = 0; i < k; ++i) r = r.mul(*base, atoms);
+    return r;
+  }
+  if (GiNaC::is_a<GiNaC::function>(e)) return atom(atoms.index(e.expand()), atoms);  // as expand
+  return std::nullopt;
+}
+
+SparsePoly SparsePoly::from_terms(std::vector<Term> terms) {
+  std::sort(terms.begin(), terms.end(), key_less);
+  SparsePoly p;
+  p.terms_.reserve(terms.size());
+  for (auto& t : terms) {
+    if (!p.terms_.empty() && p.terms_.back().key == t.key) {
+      p.terms_.back().coeff = p.terms_.back().coeff + t.coeff;
+      continue;
+    }
+    if (!p.terms_.empty() && cln::zerop(p.terms_.back().coeff)) p.terms_.pop_back();
+    p.terms_.push_back(std::move(t));
+  }
+  if (!p.terms_.empty() && cln::zerop(p.terms_.back().coeff)) p.terms_.pop_back();
+  return p;
+}
+
+ex SparsePoly::to_ex(const AtomTable& atoms) const {
+  GiNaC::exvector parts;
+  parts.reserve(terms_.size());
+  for (const Term& t : terms_) {
+    const AtomKey& key = atoms.key(t.key);
+    GiNaC::exvector factors;
+    factors.reserve(key.size() + 1);
+    for (std::uint32_t f : key) {
+      const int k = exp_of(f);
+      factors.push_back(k == 1 ? atoms.atom(atom_of(f)) : GiNaC::pow(atoms.atom(atom_of(f)), k));
+    }
+    factors.push_back(GiNaC::numeric(t.coeff));
+    parts.push_back(GiNaC::mul(factors));
+  }
+  return GiNaC::add(parts);
+}
+
+void SparsePoly::multiply_into(const SparsePoly& o, AtomTable& atoms,
+                               std::vector<Term>& out) const {
+  out.reserve(out.size() + terms_.size() * o.terms_.size());
+  for (const Term& a : terms_)
+    for (const Term& b : o.terms_) out.push_back({atoms.product(a.key, b.key), a.coeff * b.coeff});
+}
+
+SparsePoly SparsePoly::mul(const SparsePoly& o, AtomTable& atoms) const {
+  if (terms_.size() == 1 && terms_[0].key == 0 && cln::equal(terms_[0].coeff, 1)) return o;
+  std::vector<Term> raw;
+  multiply_into(o, atoms, raw);
+  return from_terms(std::move(raw));
+}
+
+SparsePoly SparsePoly::operator+(const SparsePoly& o) const {
+  std::vector<Term> raw = terms_;
+  raw.insert(raw.end(), o.terms_.begin(), o.terms_.end());
+  return from_terms(std::move(raw));
+}
+
+SparsePoly SparsePoly::reduced(const std::vector<SquareRule>& rules, AtomTable& atoms) const {
+  if (rules.empty()) return *this;
+  const auto rule_of = [&](std::uint16_t a) -> const SparsePoly* {
+    for (const auto& [atom, r] : rules)
+      if (atom == a) return &r;
+    return nullptr;
+  };
+  std::vector<Term> out;
+  bool changed = false;
+  for (const Term& t : terms_) {
+    SparsePoly factor_poly(1);  // Π r^(k div 2) over the rule atoms of the term
+    bool reduce = false;
+    AtomKey rest;
+    const AtomKey key = atoms.key(t.key);  // a copy: products below may grow the table
+    for (std::uint32_t f : key) {
+      const int k = exp_of(f);
+      const SparsePoly* r = k >= 2 ? rule_of(atom_of(f)) : nullptr;
+      if (!r) {
+        rest.push_back(f);
+        continue;
+      }
+      if (k % 2 == 1) rest.push_back(factor(atom_of(f), 1));
+      reduce = true;
+      for (int i = 0; i < k / 2; ++i) factor_poly = factor_poly.mul(*r, atoms);
+    }
+    if (!reduce) {
+      out.push_back(t);
+      continue;
+    }
+    changed = true;
+    SparsePoly single;
+    single.terms_.push_back({atoms.key_id(rest), t.coeff});
+    single.multiply_into(factor_poly, atoms, out);
+  }
+  if (!changed) return *this;
+  // A rule's right side may hold another rule's atom squared: reduce again until none is left.
+  return from_terms(std::move(out)).reduced(rules, atoms);
+}
+
+}  // namespace weilgen::gen
