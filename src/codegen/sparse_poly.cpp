@@ -38,6 +38,29 @@ AtomKey key_product(const AtomKey& a, const AtomKey& b) {
 }
 
 bool key_less(const SparsePoly::Term& a, const SparsePoly::Term& b) { return a.key < b.key; }
+
+// Lex order on monomials with non-negative exponents, atoms by number: a > b.
+struct LexGreater {
+  bool operator()(const AtomKey& a, const AtomKey& b) const {
+    std::size_t i = 0, j = 0;
+    for (; i < a.size() && j < b.size(); ++i, ++j) {
+      if (a[i] == b[j]) continue;
+      if (atom_of(a[i]) != atom_of(b[j])) return atom_of(a[i]) < atom_of(b[j]);
+      return exp_of(a[i]) > exp_of(b[j]);
+    }
+    return i < a.size();
+  }
+};
+
+// a / b when b's exponents are at most a's, else nothing.
+std::optional<AtomKey> key_quotient(const AtomKey& a, const AtomKey& b) {
+  AtomKey inverse = b;
+  for (auto& f : inverse) f = factor(atom_of(f), -exp_of(f));
+  AtomKey q = key_product(a, inverse);
+  for (std::uint32_t f : q)
+    if (exp_of(f) < 0) return std::nullopt;
+  return q;
+}
 }  // namespace
 
 AtomTable::AtomTable() { key_id({}); }
@@ -230,6 +253,92 @@ SparsePoly SparsePoly::reduced(const std::vector<SquareRule>& rules, AtomTable& 
   if (!changed) return *this;
   // A rule's right side may hold another rule's atom squared: reduce again until none is left.
   return from_terms(std::move(out)).reduced(rules, atoms);
+}
+
+bool SparsePoly::symbols_only(const AtomTable& atoms) const {
+  for (const Term& t : terms_)
+    for (std::uint32_t f : atoms.key(t.key))
+      if (exp_of(f) < 0 || !GiNaC::is_a<GiNaC::symbol>(atoms.atom(atom_of(f)))) return false;
+  return true;
+}
+
+int SparsePoly::degree(std::uint16_t atom, const AtomTable& atoms) const {
+  int k = 0;
+  for (const Term& t : terms_)
+    for (std::uint32_t f : atoms.key(t.key))
+      if (atom_of(f) == atom) k = std::max(k, exp_of(f));
+  return k;
+}
+
+bool SparsePoly::divide_exact(const SparsePoly& d, AtomTable& atoms, SparsePoly& q) const {
+  if (d.is_zero()) throw std::domain_error("SparsePoly: division by zero");
+  std::vector<std::pair<AtomKey, cln::cl_RA>> den;
+  den.reserve(d.terms_.size());
+  for (const Term& t : d.terms_) den.emplace_back(atoms.key(t.key), t.coeff);
+  std::sort(den.begin(), den.end(),
+            [](const auto& a, const auto& b) { return LexGreater{}(a.first, b.first); });
+  const auto& [lead_key, lead_coeff] = den.front();
+  std::map<AtomKey, cln::cl_RA, LexGreater> rest;
+  for (const Term& t : terms_) rest.emplace(atoms.key(t.key), t.coeff);
+  std::vector<Term> quotient;
+  while (!rest.empty()) {
+    const auto lead = rest.begin();
+    const auto m = key_quotient(lead->first, lead_key);
+    if (!m) return false;
+    const cln::cl_RA c = lead->second / lead_coeff;
+    quotient.push_back({atoms.key_id(*m), c});
+    rest.erase(lead);
+    for (std::size_t i = 1; i < den.size(); ++i) {
+      AtomKey key = key_product(*m, den[i].first);
+      const cln::cl_RA delta = -(c * den[i].second);
+      const auto [it, inserted] = rest.emplace(std::move(key), delta);
+      if (inserted) continue;
+      it->second = it->second + delta;
+      if (cln::zerop(it->second)) rest.erase(it);
+    }
+  }
+  q = from_terms(std::move(quotient));
+  return true;
+}
+
+std::optional<SparsePoly> over_divisors(const SparsePoly& c,
+                                        const std::vector<SparseReciprocal>& present,
+                                        AtomTable& atoms) {
+  SparsePoly num = c;
+  std::vector<int> k(present.size(), 0);
+  for (std::size_t i = 0; i < present.size(); ++i) {
+    const std::uint16_t r = present[i].atom;
+    k[i] = num.degree(r, atoms);
+    if (k[i] == 0) continue;
+    std::vector<SparsePoly> powers{SparsePoly(1)};  // D^0 … D^K
+    for (int j = 1; j <= k[i]; ++j) powers.push_back(powers.back().mul(present[i].divisor, atoms));
+    // a·r^j → a·D^(K−j)
+    std::vector<SparsePoly::Term> raw;
+    for (const SparsePoly::Term& t : num.terms()) {
+      AtomKey rest;
+      int j = 0;
+      for (std::uint32_t f : atoms.key(t.key)) {
+        if (atom_of(f) == r)
+          j = exp_of(f);
+        else
+          rest.push_back(f);
+      }
+      const SparsePoly single = SparsePoly::from_terms({{atoms.key_id(std::move(rest)), t.coeff}});
+      single.multiply_into(powers[static_cast<std::size_t>(k[i] - j)], atoms, raw);
+    }
+    num = SparsePoly::from_terms(std::move(raw));
+  }
+  if (num.is_zero()) return num;  // c vanishes: the reciprocals' terms cancel
+  for (std::size_t i = 0; i < present.size(); ++i)
+    for (SparsePoly q; k[i] > 0 && num.divide_exact(present[i].divisor, atoms, q); --k[i])
+      num = std::move(q);
+  const SparseReciprocal* left = nullptr;
+  for (std::size_t i = 0; i < present.size(); ++i) {
+    if (k[i] == 0) continue;
+    if (k[i] > 1 || left) return std::nullopt;
+    left = &present[i];
+  }
+  return left ? num.mul(SparsePoly::atom(left->atom, atoms), atoms) : num;
 }
 
 }  // namespace weilgen::gen

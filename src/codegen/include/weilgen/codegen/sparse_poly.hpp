@@ -76,8 +76,33 @@ class SparsePoly {
   // Every atom^k (k ≥ 2) of a rule's atom replaced by atom^(k mod 2) · r^(k div 2).
   SparsePoly reduced(const std::vector<SquareRule>& rules, AtomTable& atoms) const;
 
+  // True when every atom is a GiNaC symbol and every exponent positive: a polynomial over the
+  // rationals as GiNaC::divide takes it (the precondition of degree and divide_exact).
+  bool symbols_only(const AtomTable& atoms) const;
+  // The highest exponent of `atom` over the terms (0 when absent).
+  int degree(std::uint16_t atom, const AtomTable& atoms) const;
+  // Exact division: true and q with *this = d·q when d divides *this, else false (q untouched).
+  // Multivariate division by lex order on atom numbers; the first leading term that d's does not
+  // divide proves a non-zero remainder, so a failing division stops there.
+  bool divide_exact(const SparsePoly& d, AtomTable& atoms, SparsePoly& q) const;
+
  private:
   std::vector<Term> terms_;  // sorted by key, merged
 };
+
+// A reciprocal symbol's atom and its divisor D (expanded), in the order the model numbers them.
+struct SparseReciprocal {
+  std::uint16_t atom;
+  SparsePoly divisor;
+};
+
+// The fraction form of c (ModelBuilder's as_fraction) over polynomials in symbols: with the
+// reciprocals r_i = 1/D_i present in c, c = N / Π D_i^K_i, N = Σ_k a_k D_i^(K_i−k) divisor by
+// divisor; each D_i is divided out of N while it divides exactly. The polynomial N, or N·r_i over
+// one remaining D_i; nothing when c stays as it is (several divisors left, or a power of one).
+// c and every divisor must be symbols_only.
+std::optional<SparsePoly> over_divisors(const SparsePoly& c,
+                                        const std::vector<SparseReciprocal>& present,
+                                        AtomTable& atoms);
 
 }  // namespace weilgen::gen
