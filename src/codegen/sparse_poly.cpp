@@ -179,21 +179,35 @@ SparsePoly SparsePoly::from_terms(std::vector<Term> terms) {
   return p;
 }
 
-ex SparsePoly::to_ex(const AtomTable& atoms) const {
-  GiNaC::exvector parts;
-  parts.reserve(terms_.size());
-  for (const Term& t : terms_) {
-    const AtomKey& key = atoms.key(t.key);
+const ex& AtomTable::monomial(std::uint32_t id) const {
+  if (monomials_.size() <= id) monomials_.resize(keys_.size());
+  ex& m = monomials_[id];
+  if (m.is_zero()) {  // not built yet (a monomial is never 0)
     GiNaC::exvector factors;
-    factors.reserve(key.size() + 1);
-    for (std::uint32_t f : key) {
+    factors.reserve(keys_[id].size());
+    for (std::uint32_t f : keys_[id]) {
       const int k = exp_of(f);
-      factors.push_back(k == 1 ? atoms.atom(atom_of(f)) : GiNaC::pow(atoms.atom(atom_of(f)), k));
+      factors.push_back(k == 1 ? atoms_[atom_of(f)] : GiNaC::pow(atoms_[atom_of(f)], k));
     }
-    factors.push_back(GiNaC::numeric(t.coeff));
-    parts.push_back(GiNaC::mul(factors));
+    m = GiNaC::mul(factors);
   }
-  return GiNaC::add(parts);
+  return m;
+}
+
+// The expanded sum as GiNaC's add of (monomial, rational) pairs: the canonical form that the sum
+// of the terms' products would have (add splits each product into these same pairs).
+ex SparsePoly::to_ex(const AtomTable& atoms) const {
+  GiNaC::epvector pairs;
+  pairs.reserve(terms_.size());
+  ex constant = 0;
+  for (const Term& t : terms_) {
+    if (t.key == 0) {
+      constant = GiNaC::numeric(t.coeff);
+      continue;
+    }
+    pairs.emplace_back(atoms.monomial(t.key), GiNaC::numeric(t.coeff));
+  }
+  return GiNaC::add(std::move(pairs), constant);
 }
 
 void SparsePoly::multiply_into(const SparsePoly& o, AtomTable& atoms,

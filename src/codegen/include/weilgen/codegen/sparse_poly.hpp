@@ -36,6 +36,8 @@ class AtomTable {
   std::uint32_t key_id(AtomKey key);  // 0 is the unit monomial
   const AtomKey& key(std::uint32_t id) const { return keys_[id]; }
   std::uint32_t product(std::uint32_t a, std::uint32_t b);
+  // The monomial as GiNaC's canonical product (1 for the unit), built once per monomial.
+  const GiNaC::ex& monomial(std::uint32_t id) const;
 
  private:
   struct KeyHash {
@@ -46,6 +48,7 @@ class AtomTable {
   std::vector<AtomKey> keys_;
   std::unordered_map<AtomKey, std::uint32_t, KeyHash> key_ids_;
   std::unordered_map<std::uint64_t, std::uint32_t> products_;
+  mutable std::vector<GiNaC::ex> monomials_;  // by key id; empty until first asked
 };
 
 class SparsePoly {
