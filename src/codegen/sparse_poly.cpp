@@ -237,6 +237,13 @@ SparsePoly SparsePoly::reduced(const std::vector<SquareRule>& rules, AtomTable& 
       if (atom == a) return &r;
     return nullptr;
   };
+  // Most results hold no square of a rule's atom: found without copying a key.
+  const auto needs = [&](const Term& t) {
+    for (std::uint32_t f : atoms.key(t.key))
+      if (exp_of(f) >= 2 && rule_of(atom_of(f))) return true;
+    return false;
+  };
+  if (std::none_of(terms_.begin(), terms_.end(), needs)) return *this;
   std::vector<Term> out;
   bool changed = false;
   for (const Term& t : terms_) {
