@@ -3,11 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <stdexcept>
 #include <utility>
 
 #include "weilgen/base/text.hpp"
 #include "weilgen/codegen/cse.hpp"
+#include "weilgen/codegen/sparse_poly.hpp"
 
 namespace weilgen::gen {
 
@@ -236,6 +238,7 @@ struct Builder {
   // same, divisor by divisor. Anything else (several divisors left, or a power of one) stays as
   // it is.
   ex as_fraction(const ex& c) const {
+    if (const auto fast = as_fraction_sparse(c)) return *fast;
     std::vector<const Reciprocal*> present;
     for (const Reciprocal& r : model.reciprocals)
       if (c.has(r.symbol)) present.push_back(&r);
@@ -243,6 +246,27 @@ struct Builder {
     const auto it = fractions.find(c);
     if (it != fractions.end()) return it->second;
     return fractions.emplace(c, over_divisors(c, present)).first->second;
+  }
+
+  // as_fraction over SparsePoly forms when c and the divisors present are polynomials in symbols
+  // (then GiNaC's exact division could not throw and over_divisors decides the same); nothing
+  // otherwise.
+  std::optional<ex> as_fraction_sparse(const ex& c) const {
+    const auto s = alg.to_sparse(c);
+    if (!s || !s->symbols_only(alg.atoms())) return std::nullopt;
+    std::vector<SparseReciprocal> present;
+    for (const Reciprocal& r : model.reciprocals) {
+      const std::uint16_t atom = alg.atoms().index(r.symbol);
+      if (s->degree(atom, alg.atoms()) == 0) continue;
+      const auto den = alg.to_sparse(r.divisor.expand());
+      if (!den || !den->symbols_only(alg.atoms())) return std::nullopt;
+      present.push_back({atom, *den});
+    }
+    if (present.empty()) return c;
+    const auto it = fractions.find(c);
+    if (it != fractions.end()) return it->second;
+    const auto f = gen::over_divisors(*s, present, alg.atoms());
+    return fractions.emplace(c, f ? alg.from_sparse(*f) : c).first->second;
   }
 
   static bool is_monomial(const ex& d) {

@@ -30,6 +30,15 @@ Algebra::Algebra(int order, std::vector<Monomial> relations, GiNaC::exmap trig_r
     }
     squares_.emplace_back(from.op(0), to);
   }
+  sparse_ = trig_rules_.empty() || !squares_.empty();
+  for (const auto& [x, to] : squares_) {
+    auto r = SparsePoly::from_ex(to.expand(), atoms_);
+    if (!r) {
+      sparse_ = false;
+      break;
+    }
+    square_rules_.emplace_back(atoms_.index(x), std::move(*r));
+  }
   // Keep only minimal generators: drop those of degree > r (already vanish) and multiples.
   for (auto& r : relations) std::sort(r.begin(), r.end());
   std::sort(relations.begin(), relations.end(), [](const Monomial& a, const Monomial& b) {
@@ -111,6 +120,21 @@ ex Algebra::normalize(const ex& c) const {
   return e;
 }
 
+std::optional<SparsePoly> Algebra::to_sparse(const ex& c) const {
+  if (!sparse_) return std::nullopt;
+  if (const auto it = sparse_of_.find(c); it != sparse_of_.end()) return it->second;
+  auto s = SparsePoly::from_ex(c, atoms_);
+  if (s) sparse_of_.emplace(c, *s);
+  return s;
+}
+
+ex Algebra::from_sparse(const SparsePoly& p) const {
+  SparsePoly r = p.reduced(square_rules_, atoms_);
+  ex e = r.to_ex(atoms_);
+  sparse_of_.emplace(e, std::move(r));
+  return e;
+}
+
 Poly::Poly(const ex& constant) { add_term({}, constant); }
 
 Poly Poly::error(std::uint16_t index) {
@@ -167,6 +191,13 @@ Poly Poly::operator-() const {
 
 Poly Poly::scaled(const ex& c, const Algebra& alg) const {
   Poly p;
+  if (const auto sc = alg.to_sparse(c)) {
+    for (const auto& [m, t] : terms_) {
+      const auto st = alg.to_sparse(t);
+      p.add_term(m, st ? alg.from_sparse(st->mul(*sc, alg.atoms())) : alg.normalize(t * c));
+    }
+    return p;
+  }
   for (const auto& [m, t] : terms_) p.add_term(m, alg.normalize(t * c));
   return p;
 }
@@ -175,8 +206,59 @@ Poly Poly::mul(const Poly& o, const Algebra& alg) const {
   return sum_of_products({{this, &o}}, alg);
 }
 
+bool Poly::to_sparse(const Algebra& alg, SparseTerms& out) const {
+  out.assign(static_cast<std::size_t>(alg.order()) + 1, {});
+  for (const auto& [m, c] : terms_) {
+    if (static_cast<int>(m.size()) > alg.order()) continue;
+    auto s = alg.to_sparse(c);
+    if (!s) return false;
+    out[m.size()].emplace_back(&m, std::move(*s));
+  }
+  return true;
+}
+
+Poly Poly::sparse_sum_of_products(
+    const std::vector<std::pair<const SparseTerms*, const SparseTerms*>>& pairs,
+    const Algebra& alg) {
+  const int r = alg.order();
+  AtomTable& atoms = alg.atoms();
+  std::map<Monomial, std::vector<SparsePoly::Term>> raw;
+  for (const auto& [sa, sb] : pairs) {
+    for (int da = 0; da <= r; ++da) {
+      for (const auto& [ma, ca] : (*sa)[static_cast<std::size_t>(da)]) {
+        for (int d = 0; d <= r - da; ++d) {
+          for (const auto& [mb, cb] : (*sb)[static_cast<std::size_t>(d)]) {
+            Monomial m = monomial_product(*ma, *mb);
+            if (alg.vanishes(m)) continue;  // never formed: truncation inside the product
+            ca.multiply_into(cb, atoms, raw[std::move(m)]);
+          }
+        }
+      }
+    }
+  }
+  Poly p;
+  for (auto& [m, parts] : raw) {
+    const SparsePoly s = SparsePoly::from_terms(std::move(parts));
+    if (s.is_zero()) continue;
+    ex c = alg.from_sparse(s);
+    if (!c.is_zero()) p.terms_.emplace_hint(p.terms_.end(), m, c);
+  }
+  return p;
+}
+
 Poly Poly::sum_of_products(const std::vector<std::pair<const Poly*, const Poly*>>& pairs,
                            const Algebra& alg) {
+  {
+    std::vector<SparseTerms> sparse(2 * pairs.size());
+    std::vector<std::pair<const SparseTerms*, const SparseTerms*>> sparse_pairs;
+    bool ok = true;
+    for (std::size_t k = 0; k < pairs.size() && ok; ++k) {
+      ok = pairs[k].first->to_sparse(alg, sparse[2 * k]) &&
+           pairs[k].second->to_sparse(alg, sparse[2 * k + 1]);
+      sparse_pairs.emplace_back(&sparse[2 * k], &sparse[2 * k + 1]);
+    }
+    if (ok) return sparse_sum_of_products(sparse_pairs, alg);
+  }
   // Raw products per monomial over all pairs, each sum normalised once.
   const int r = alg.order();
   std::map<Monomial, GiNaC::exvector> raw;
@@ -262,6 +344,22 @@ Mat4 Mat4::zero() { return {}; }
 
 Mat4 Mat4::mul(const Mat4& o, const Algebra& alg) const {
   Mat4 r;
+  // Every entry converted once (each meets four products).
+  Poly::SparseTerms sa[4][4], sb[4][4];
+  bool ok = true;
+  for (int i = 0; i < 4 && ok; ++i)
+    for (int j = 0; j < 4 && ok; ++j)
+      ok = m[i][j].to_sparse(alg, sa[i][j]) && o.m[i][j].to_sparse(alg, sb[i][j]);
+  if (ok) {
+    for (int i = 0; i < 4; ++i) {
+      for (int j = 0; j < 4; ++j) {
+        std::vector<std::pair<const Poly::SparseTerms*, const Poly::SparseTerms*>> pairs;
+        for (int k = 0; k < 4; ++k) pairs.emplace_back(&sa[i][k], &sb[k][j]);
+        r.m[i][j] = Poly::sparse_sum_of_products(pairs, alg);
+      }
+    }
+    return r;
+  }
   for (int i = 0; i < 4; ++i) {
     for (int j = 0; j < 4; ++j) {
       std::vector<std::pair<const Poly*, const Poly*>> pairs;

@@ -11,8 +11,12 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
+#include <unordered_map>
 #include <utility>
 #include <vector>
+
+#include "weilgen/codegen/sparse_poly.hpp"
 
 namespace weilgen::gen {
 
@@ -33,6 +37,12 @@ class Algebra {
   // Expands and reduces a coefficient (cos² → 1 − sin²) into canonical polynomial form.
   GiNaC::ex normalize(const GiNaC::ex& c) const;
   const std::vector<Monomial>& relations() const { return relations_; }
+  // The fast coefficient arithmetic: c as a SparsePoly over the algebra's atoms, nothing when c
+  // is not a polynomial in atoms or the rules are not all symbol² → r (then GiNaC does it).
+  std::optional<SparsePoly> to_sparse(const GiNaC::ex& c) const;
+  // The normalised coefficient of a SparsePoly (cos² → 1 − sin² on exponents): normalize's result.
+  GiNaC::ex from_sparse(const SparsePoly& p) const;
+  AtomTable& atoms() const { return atoms_; }
 
  private:
   int order_;
@@ -41,6 +51,12 @@ class Algebra {
   GiNaC::exvector trig_bases_;                                // x of every rule x^2 -> ...
   std::vector<std::pair<GiNaC::ex, GiNaC::ex>> squares_;      // (x, r) when every rule is x^2 -> r
   GiNaC::ex reduce_squares(const GiNaC::ex& expanded) const;  // one substitution pass
+  bool sparse_ = true;
+  mutable AtomTable atoms_;  // grows as coefficients meet new atoms
+  // SparsePoly form by coefficient: the products' results come back as their inputs.
+  mutable std::unordered_map<GiNaC::ex, SparsePoly, std::hash<GiNaC::ex>, GiNaC::ex_is_equal>
+      sparse_of_;
+  std::vector<SparsePoly::SquareRule> square_rules_;
 };
 
 // An algebra element: Σ coefficient · monomial. Zero coefficients are never stored.
@@ -81,6 +97,15 @@ class Poly {
   GiNaC::ex to_ex(const std::vector<GiNaC::symbol>& error_symbols) const;
 
  private:
+  friend struct Mat4;
+  // The terms with SparsePoly coefficients by degree ≤ r; false when one has no SparsePoly form.
+  using SparseTerms = std::vector<std::vector<std::pair<const Monomial*, SparsePoly>>>;
+  bool to_sparse(const Algebra& alg, SparseTerms& out) const;
+  // sum_of_products over coefficients in SparsePoly form: the same truncation, the same sums per
+  // monomial, one conversion back per monomial.
+  static Poly sparse_sum_of_products(
+      const std::vector<std::pair<const SparseTerms*, const SparseTerms*>>& pairs,
+      const Algebra& alg);
   void add_term(const Monomial& m, const GiNaC::ex& c);
   Terms terms_;
 };
