@@ -203,6 +203,10 @@ void decide_verdict(GapResult& R, const GapOptions& opt, const std::vector<std::
                        " is significant on its own (p = " + format_significant(first.p_value, 2) +
                        ") although the held-out gap over all data is at the noise floor (p = " +
                        format_significant(R.baseline_p_value, 2) + ")";
+    if (R.baseline_lack_of_fit_p < opt.alpha * opt.alpha * opt.alpha)
+      R.verdict_reason +=
+          "; on all data the model alone leaves a structure along " + R.baseline_lack_of_fit_along +
+          " (lack of fit p = " + format_significant(R.baseline_lack_of_fit_p, 2) + ")";
     return;
   }
   // Two effects at once each remove about half: the accepted set is judged together.
