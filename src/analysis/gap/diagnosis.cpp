@@ -86,7 +86,7 @@ std::string pct(double fraction) {
 // leaves a structure there.
 struct LackOfFit {
   double p_value = 1;
-  std::string along;
+  std::string along;     // "time" or an axis
   double excess_ss = 0;  // the bins' drop in SSE beyond the noise they fit (q σ²)
 };
 
@@ -101,7 +101,7 @@ LackOfFit lack_of_fit(const Engine& e, const GapData& d) {
     if (*std::max_element(v.begin(), v.end()) > *std::min_element(v.begin(), v.end()))
       coords.emplace_back(name, std::move(v));
   };
-  add("t_s", [&](std::size_t row) { return row < d.time_s.size() ? d.time_s[row] : kNaN; });
+  add("time", [&](std::size_t row) { return row < d.time_s.size() ? d.time_s[row] : kNaN; });
   for (std::size_t a = 0; a < d.axes.size(); ++a)
     add(d.axes[a], [&](std::size_t row) { return d.points.poses[row][a]; });
   LackOfFit worst;
@@ -327,13 +327,14 @@ GapResult GapDiagnosis::run(const Model& model, const ErrorParameterisation& par
   VectorXd r, h;
   e.heldout(r, h);
   // The floor from the part of the held-out residual its splits can predict (a fold's
-  // undetermined directions would count as noise).
+  // undetermined directions would count as noise). The baseline's covariance serves its gap
+  // test below too; it is built again only when an accepted effect changes the fits.
+  const HeldoutCovariance base_cov(e, true);
   {
-    const HeldoutCovariance cov(e, true);
     VectorXd m = r, lev;
     std::size_t removed = 0;
-    cov.estimable(m, lev, removed);
-    R.noise = noise_floor(data, m, cov);
+    base_cov.estimable(m, lev, removed);
+    R.noise = noise_floor(data, m, base_cov);
   }
   const double s2 = R.noise.sigma_um * R.noise.sigma_um;
 
@@ -382,11 +383,12 @@ GapResult GapDiagnosis::run(const Model& model, const ErrorParameterisation& par
     return g;
   };
   // The same on the part of each held-out residual its split can predict
-  // (HeldoutCovariance::estimable): the significance of a gap and its excess.
-  auto estimable_gap = [&](const VectorXd& res) {
+  // (HeldoutCovariance::estimable, of the engine's current fits): the significance of a gap and
+  // its excess.
+  auto estimable_gap = [&](const HeldoutCovariance& cov, const VectorXd& res) {
     VectorXd m = res, lev;
     std::size_t removed = 0;
-    HeldoutCovariance(e, true).estimable(m, lev, removed);
+    cov.estimable(m, lev, removed);
     Gap g = held_gap(m, lev);
     g.removed = removed;
     return g;
@@ -394,7 +396,9 @@ GapResult GapDiagnosis::run(const Model& model, const ErrorParameterisation& par
   summarise(r, R.baseline_rms, R.baseline_rms_um, &R.baseline_max);
   ideal(r, h, R.baseline_ideal, R.baseline_ideal_um);
   const Gap base = held_gap(r, h);
-  gap_stats(estimable_gap(r), R.noise.dof, R.baseline_excess_um, R.baseline_p_value);
+  // The held-out gap after the effects accepted so far (the baseline's at first).
+  Gap cur_gap = estimable_gap(base_cov, r);
+  gap_stats(cur_gap, R.noise.dof, R.baseline_excess_um, R.baseline_p_value);
   R.where = localise(data, r, h, R.noise, options_.alpha);
   R.residual_before.assign(r.data(), r.data() + r.size());
 
@@ -418,7 +422,7 @@ GapResult GapDiagnosis::run(const Model& model, const ErrorParameterisation& par
   // the two tests would double the false alarms on effect-free data.
   const LackOfFit lof0 = lack_of_fit(e, data);
   R.baseline_lack_of_fit_p = lof0.p_value;
-  R.baseline_lack_of_fit_along = lof0.along == "t_s" ? "time" : lof0.along;
+  R.baseline_lack_of_fit_along = lof0.along;
   const double alpha3 = options_.alpha * options_.alpha * options_.alpha;
   bool gap_significant = R.baseline_p_value < options_.alpha || R.baseline_lack_of_fit_p < alpha3;
   VectorXd cur_r = r, cur_h = h;
@@ -509,11 +513,13 @@ GapResult GapDiagnosis::run(const Model& model, const ErrorParameterisation& par
     e.A = AE;
     e.refit();
     e.heldout(cur_r, cur_h);
+    const HeldoutCovariance cov(e, true);
     // A regularised model's columns joined the design as fitted on all data, so the folds'
     // refit would see held-out rows through them: its own held-out residual (each fold's columns
     // fitted on that fold's training part) is the honest one, and the search ends with it.
     if (pick->regularised) {
       cur_r = pick->heldout;
+      cur_gap = estimable_gap(cov, cur_r);
       R.explanation.push_back(fit);
       accepted_shape.emplace_back(-1, -1);
       break;
@@ -528,14 +534,15 @@ GapResult GapDiagnosis::run(const Model& model, const ErrorParameterisation& par
     // Thermal drift may need a second sensor or lag; other effects are taken once.
     for (std::size_t k = 0; k < candidates.size(); ++k)
       if (candidates[k].name == fit.name && fit.name != "thermal_drift") used[k] = true;
+    cur_gap = estimable_gap(cov, cur_r);
     double ex = 0, p = 1;
-    gap_stats(estimable_gap(cur_r), R.noise.dof, ex, p);
+    gap_stats(cur_gap, R.noise.dof, ex, p);
     if (p >= options_.alpha) break;
   }
   summarise(cur_r, R.final_rms, R.final_rms_um, nullptr);
   ideal(cur_r, cur_h, R.final_ideal, R.final_ideal_um);
   const Gap final_gap = held_gap(cur_r, cur_h);
-  gap_stats(estimable_gap(cur_r), R.noise.dof, R.final_excess_um, R.final_p_value);
+  gap_stats(cur_gap, R.noise.dof, R.final_excess_um, R.final_p_value);
   R.residual_after.assign(cur_r.data(), cur_r.data() + cur_r.size());
   // Of the excess over the floor (of the whole held-out SS when the floor exceeds it), on all of
   // the held-out residual as each candidate's share is (on the predictable part alone, a step
@@ -557,9 +564,8 @@ GapResult GapDiagnosis::run(const Model& model, const ErrorParameterisation& par
     if (lof.p_value < options_.alpha && share > 1 - options_.explain_fraction) {
       R.verdict = "unexplained";
       R.verdict_reason =
-          R.explanation.front().name + " fits, but leaves a structure along " +
-          (lof.along == "t_s" ? std::string("time") : lof.along) + " (" + pct(share) +
-          " of the structure, lack of fit p = " + format_significant(lof.p_value, 2) +
+          R.explanation.front().name + " fits, but leaves a structure along " + lof.along + " (" +
+          pct(share) + " of the structure, lack of fit p = " + format_significant(lof.p_value, 2) +
           "): a shape outside the library, which it only imitates";
     }
   }
