@@ -75,6 +75,9 @@ struct Builder {
   CanonicalText& canon;
   // as_fraction by coefficient: at order 3 the same coefficient recurs in many monomials.
   std::map<ex, ex, GiNaC::ex_is_less>& fractions;
+  // Each reciprocal's atom and its divisor in SparsePoly form (nothing when the divisor is not a
+  // polynomial in symbols), by reciprocal: converted once, not for every coefficient.
+  std::vector<std::pair<std::uint16_t, std::optional<SparsePoly>>>& sparse_divisors;
 
   void unit_vector(const Vec3& v, ex (&u)[3]) const {
     for (int i = 0; i < 3; ++i) u[i] = exact_decimal(v[i]);
@@ -254,12 +257,16 @@ struct Builder {
   std::optional<ex> as_fraction_sparse(const ex& c) const {
     const auto s = alg.to_sparse(c);
     if (!s || !s->symbols_only(alg.atoms())) return std::nullopt;
+    while (sparse_divisors.size() < model.reciprocals.size()) {
+      const Reciprocal& r = model.reciprocals[sparse_divisors.size()];
+      auto den = alg.to_sparse(r.divisor.expand());
+      if (den && !den->symbols_only(alg.atoms())) den.reset();
+      sparse_divisors.emplace_back(alg.atoms().index(r.symbol), std::move(den));
+    }
     std::vector<SparseReciprocal> present;
-    for (const Reciprocal& r : model.reciprocals) {
-      const std::uint16_t atom = alg.atoms().index(r.symbol);
+    for (const auto& [atom, den] : sparse_divisors) {
       if (s->degree(atom, alg.atoms()) == 0) continue;
-      const auto den = alg.to_sparse(r.divisor.expand());
-      if (!den || !den->symbols_only(alg.atoms())) return std::nullopt;
+      if (!den) return std::nullopt;
       present.push_back({atom, *den});
     }
     if (present.empty()) return c;
@@ -608,7 +615,8 @@ SymbolicModel build_model(const Description& desc, int order_override) {
   model.relations = alg.relations();
   CanonicalText canon;
   std::map<ex, ex, GiNaC::ex_is_less> fractions;
-  const Builder b{desc, model, alg, canon, fractions};
+  std::vector<std::pair<std::uint16_t, std::optional<SparsePoly>>> sparse_divisors;
+  const Builder b{desc, model, alg, canon, fractions, sparse_divisors};
 
   // P: the tool frame (at the tool point) in the workpiece frame, or the output transform.
   const Mat4 p = desc.output
