@@ -56,20 +56,20 @@ class PipeCutterBaseline {
     // Error motion carried by a body: Trans(δx, δy, δz) · Rx(εx) · Ry(εy) · Rz(εz).
     const auto motion = [&](std::vector<Step>& s, const std::string& k) {
       for (int a = 0; a < 3; ++a)
-        s.push_back(error_step(false, a, err(std::string("E_") + "XYZ"[a] + k), 1));
+        s.push_back(step(Step::ErrorTranslation, a, err(std::string("E_") + "XYZ"[a] + k), 1));
       for (int a = 0; a < 3; ++a)
-        s.push_back(error_step(true, a, err(std::string("E_") + "ABC"[a] + k), 1));
+        s.push_back(step(Step::ErrorRotation, a, err(std::string("E_") + "ABC"[a] + k), 1));
     };
     // Chuck rotor: parallelism Ry(E_B0k) · Rz(E_C0k), the rotation A (deg), its error motion.
     const auto rotor = [&](std::vector<Step>& s, const std::string& k) {
-      s.push_back(error_step(true, 1, err("E_B0" + k), 1));
-      s.push_back(error_step(true, 2, err("E_C0" + k), 1));
-      s.push_back(joint_step(true, 0, 2, M_PI / 180));
+      s.push_back(step(Step::ErrorRotation, 1, err("E_B0" + k), 1));
+      s.push_back(step(Step::ErrorRotation, 2, err("E_C0" + k), 1));
+      s.push_back(step(Step::Revolute, 0, 2, M_PI / 180));
       motion(s, k);
     };
     // Feeding chuck: carriage at L01 moving by X, its error motion, the rotor A12 = A04.
     feed_.push_back(fixed_step(L01_));
-    feed_.push_back(joint_step(false, 0, 0, 1));
+    feed_.push_back(step(Step::Prismatic, 0, 0, 1));
     motion(feed_, "X");
     rotor(feed_, "A12");
     main_.push_back(fixed_step(L04_ - L45_));
@@ -81,11 +81,11 @@ class PipeCutterBaseline {
       std::vector<Step> s;
       s.push_back(fixed_step(plane - reach_));
       const int t = err((axis == 1 ? "E_C0" : "E_B0") + k), a = err("E_A0" + k);
-      s.push_back(error_step(true, axis == 1 ? 2 : 1, t, 1));
-      s.push_back(error_step(true, 0, a, 1));
-      s.push_back(joint_step(false, axis, coordinate, sign));
-      s.push_back(error_step(true, 0, a, -1));
-      s.push_back(error_step(true, axis == 1 ? 2 : 1, t, -1));
+      s.push_back(step(Step::ErrorRotation, axis == 1 ? 2 : 1, t, 1));
+      s.push_back(step(Step::ErrorRotation, 0, a, 1));
+      s.push_back(step(Step::Prismatic, axis, coordinate, sign));
+      s.push_back(step(Step::ErrorRotation, 0, a, -1));
+      s.push_back(step(Step::ErrorRotation, axis == 1 ? 2 : 1, t, -1));
       motion(s, k);
       s.push_back(fixed_step(reach_));
       return s;
@@ -148,20 +148,14 @@ class PipeCutterBaseline {
     s.x = x;
     return s;
   }
-  static Step joint_step(bool revolute, int axis, int coordinate, double scale) {
+  // A joint (index: coordinate in q, scale: sign or deg -> rad) or an error step (index: error,
+  // scale: +1, or -1 for an inverse step) along or about axis 0, 1, 2.
+  static Step step(Step::Kind kind, int axis, int index, double scale) {
     Step s;
-    s.kind = revolute ? Step::Revolute : Step::Prismatic;
-    s.axis = axis;
-    s.index = coordinate;
-    s.scale = scale;
-    return s;
-  }
-  static Step error_step(bool rotation, int axis, int index, double sign) {
-    Step s;
-    s.kind = rotation ? Step::ErrorRotation : Step::ErrorTranslation;
+    s.kind = kind;
     s.axis = axis;
     s.index = index;
-    s.scale = sign;
+    s.scale = scale;
     return s;
   }
 
