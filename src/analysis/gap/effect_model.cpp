@@ -72,7 +72,8 @@ std::vector<double> higher_order_refit(const EffectContext& ctx,
                       .head(static_cast<Index>(np));
     Eigen::HouseholderQR<MatrixXd> qr(Al);
     const MatrixXd R = qr.matrixQR().topRows(std::min(m, Al.cols())).triangularView<Eigen::Upper>();
-    const Eigen::BDCSVD<MatrixXd> svd(R, Eigen::ComputeThinV);
+    // Jacobi, not Eigen 3.4.0's BDCSVD (out-of-bounds read on rank-deficient input: lsq.cpp).
+    const Eigen::JacobiSVD<MatrixXd> svd(R, Eigen::ComputeThinV);
     const VectorXd& sv = svd.singularValues();
     Index rank = 0;
     while (rank < sv.size() && sv[rank] > kStartRankTolerance * sv[0]) ++rank;
@@ -134,22 +135,19 @@ std::vector<double> higher_order_refit(const EffectContext& ctx,
     // with Q): weakly visible directions enter as far as the damping lets them, and λ adapts.
     Eigen::HouseholderQR<MatrixXd> qr(J);
     const Index k = std::min(m, J.cols());
-    MatrixXd R = qr.matrixQR().topRows(k).triangularView<Eigen::Upper>();
+    const MatrixXd R = qr.matrixQR().topRows(k).triangularView<Eigen::Upper>();
     const VectorXd qtr = (qr.householderQ().transpose() * r).head(k);
-    VectorXd scale = R.colwise().norm().transpose();
-    for (Index p = 0; p < scale.size(); ++p)
-      if (!(scale[p] > 0)) scale[p] = 1;
-    R = R * scale.cwiseInverse().asDiagonal();
-    const Eigen::BDCSVD<MatrixXd> svd(R, Eigen::ComputeThinU | Eigen::ComputeThinV);
-    const VectorXd b = svd.matrixU().transpose() * qtr;
-    const VectorXd& sv = svd.singularValues();
+    const EquilibratedSvd svd(R, 0, /*full_v=*/false);
+    const VectorXd& scale = svd.scale();
+    const VectorXd b = svd.U().transpose() * qtr;
+    const VectorXd sv = svd.sigma().head(b.size());
     const double before = r.squaredNorm();
     std::vector<double> trial;
     bool better = false;
     for (int tries = 0; tries < 12 && !better; ++tries) {
       VectorXd z = VectorXd::Zero(sv.size());
       for (Index j = 0; j < sv.size(); ++j) z[j] = sv[j] * b[j] / (sv[j] * sv[j] + lambda);
-      const VectorXd step = (svd.matrixV() * z).cwiseQuotient(scale);
+      const VectorXd step = (svd.V().leftCols(sv.size()) * z).cwiseQuotient(scale);
       trial = theta;
       for (std::size_t p = 0; p < np; ++p) trial[p] += step[static_cast<Index>(p)];
       VectorXd rt = residual(trial);
