@@ -523,6 +523,30 @@ TEST_CASE("gap: ballbar traces are dr observations, and reversal on X is read fr
   CHECK(feed >= 1);
 }
 
+TEST_CASE("gap: on a ballbar trace the lack of fit sees a step in y in time (a centre shift)") {
+  // A 4 µm step in y (after 3 of 6 cycles) moves the circle's centre: dr changes by 4 sin θ,
+  // which averages out over each of the time bins, whole cycles here as in the benchmark's
+  // ballbar layouts, so a free offset of dr per bin did not see it (p = 1 here, and on the
+  // benchmark's head_head_bc ballbar_yz step); free x, y, z offsets seen through u do.
+  PdgeBasisChoice c;
+  c.all = "poly:2";
+  const ErrorParameterisation p(vmc()->description(), c, vmc()->parameters());
+  auto run = [&](const EffectFn& fn) {
+    const MeasurementTable t = parse_measurements(ballbar_synth(23, fn, 6), "bb.csv");
+    return GapDiagnosis().run(*vmc(), p, gap_data(t, vmc()->description()),
+                              *parse_holdout("cycle:4"), "test");
+  };
+  const GapResult step = run([](const Row& w) {
+    return std::array<double, 3>{0, w.t_s >= 540 ? 4.0 : 0.0, 0};
+  });
+  CHECK(step.baseline_lack_of_fit_p < 1e-6);
+  CHECK(step.baseline_lack_of_fit_along == "time");
+  // Effect-free, the same test reads noise.
+  const GapResult clean = run(none);
+  CHECK(clean.baseline_lack_of_fit_p > 0.01);
+  CHECK(clean.verdict == "none");
+}
+
 TEST_CASE(
     "gap: a thermal growth on a ballbar trace with a spindle sensor is named (no empty "
     "variant: a growth along z that an XY trace cannot see)") {
