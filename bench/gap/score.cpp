@@ -290,6 +290,7 @@ int main(int argc, char** argv) {
         argc < 2 ? stderr : stdout,
         "usage: weilgen_gap_score SUITE_DIR [--out DIR]\n"
         "  reads SUITE_DIR/manifest.tsv, sNNNN/truth.json and sNNNN/gap.json (and\n"
+        "  sNNNN/gap_oracle.json, the oracle file's diagnosis, and\n"
         "  SUITE_DIR/spindle/{gap,ridge}.json when present); writes results.json and\n"
         "  results.md into --out (default SUITE_DIR). Exit 0: every target passes, 3: one\n"
         "  fails\n");
