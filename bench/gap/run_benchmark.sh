@@ -5,13 +5,19 @@
 #   bench/gap/run_benchmark.sh WEILGEN [WORKDIR] [--quick] [--jobs N] [--machines M1,M2]
 #                              [--layouts L1,L2] [--effects E1,E2,pairs,outliers,hetero]
 #                              [--reps N] [--nones N] [--spindle DATA.csv | --no-spindle]
-#                              [--rotary-fourier H] [--resume] [-- EXTRA GAP ARGS]
+#                              [--rotary-fourier H] [--resume] [--no-oracle] [-- EXTRA GAP ARGS]
 #
 # WEILGEN is the weilgen executable (or any program with its `gap` interface, e.g.
 # bench/gap/fake_gap.sh). WORKDIR defaults to build-gap/gap-bench. Results: WORKDIR/results.md
-# and WORKDIR/results.json. The real spindle study (its held-out RMS against the ridge
-# baseline) runs when its data are found (--spindle, default /work/shared/data/fl_thermal/
-# spindle_thermal.csv or ../shared/data/fl_thermal beside the repository).
+# and WORKDIR/results.json. Each scenario is also diagnosed on its oracle file (data_oracle.csv,
+# the same data without the withheld effects and gross readings; into gap_oracle.json): its
+# baseline's held-out RMS is what a model knowing the effects would leave. Those runs get
+# --effects tool_offset (one cheap candidate: only the baseline is read); --no-oracle skips them.
+# --resume reruns only what is missing or older than its data (an older suite without oracle
+# files gets them; the synth leaves unchanged files untouched). The real spindle study (its
+# held-out RMS against the ridge baseline) runs when its data are found (--spindle, default
+# /work/shared/data/fl_thermal/spindle_thermal.csv or ../shared/data/fl_thermal beside the
+# repository).
 # Exit status: 0 all targets pass, 3 some target fails, 1 error.
 # The synth and score programs are found in $WEILGEN_GAP_BIN, else build-gap/bench/gap or
 # build/bench/gap under the repository.
@@ -20,7 +26,7 @@ set -euo pipefail
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 root=$(cd "$here/../.." && pwd)
 
-usage() { sed -n '2,18p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '2,23p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; }
 [[ $# -ge 1 && $1 != -h && $1 != --help ]] || { usage; exit 2; }
 
 weilgen=$1
@@ -31,6 +37,7 @@ work=$root/build-gap/gap-bench
 if [[ $# -ge 1 && $1 != --* ]]; then work=$1; shift; fi
 jobs=2
 resume=0
+oracle=1
 spindle=
 for c in /work/shared/data/fl_thermal/spindle_thermal.csv "$root/../shared/data/fl_thermal/spindle_thermal.csv"; do
   [[ -z $spindle && -f $c ]] && spindle=$c
@@ -52,6 +59,7 @@ while [[ $# -gt 0 ]]; do
     --spindle) spindle=$2; shift 2 ;;
     --no-spindle) spindle=; shift ;;
     --resume) resume=1; shift ;;
+    --no-oracle) oracle=0; shift ;;
     --) shift; gap_args+=("$@"); break ;;
     *) echo "run_benchmark.sh: unknown option $1" >&2; exit 2 ;;
   esac
@@ -69,27 +77,47 @@ fi
   exit 1
 }
 
+# Whether to write the suite: always, except on --resume with every file there.
+need_synth() {
+  [[ $resume == 0 || ! -f $work/manifest.tsv ]] && return 0
+  [[ $oracle == 1 ]] || return 1
+  local d
+  for d in $(grep -v '^#' "$work/manifest.tsv" | cut -f1); do
+    [[ -f $work/$d/data_oracle.csv ]] || return 0
+  done
+  return 1
+}
+
 start=$(date +%s)
-if [[ $resume == 0 || ! -f $work/manifest.tsv ]]; then
+if need_synth; then
   "$bin/weilgen_gap_synth" --suite "$work" --threads "$jobs" "${synth_args[@]}"
 fi
 
-# One scenario: its wall time goes to gap.time, its output to gap.log, its exit status to gap.rc.
-run_one() {
-  local dir=$1 model=$2 d=$work/$1
-  if [[ $resume == 1 && -f $d/gap.json && $d/gap.json -nt $d/data.csv ]]; then return 0; fi
-  rm -f "$d/gap.json"
+# One diagnosis: `weilgen gap` on DIR/DATA.csv into DIR/OUT.json; its wall time goes to
+# OUT.time, its output to OUT.log, its exit status to OUT.rc.
+run_gap() {
+  local dir=$1 model=$2 data=$3 out=$4 d=$work/$1
+  shift 4
+  if [[ $resume == 1 && -f $d/$out.json && $d/$out.json -nt $d/$data.csv ]]; then return 0; fi
+  rm -f "$d/$out.json"
   local t0 t1 rc=0
   t0=$(date +%s.%N)
-  "$weilgen" gap "$model" --data "$d/data.csv" --json "$d/gap.json" ${GAP_ARGS:-} \
-    >"$d/gap.log" 2>&1 || rc=$?
+  "$weilgen" gap "$model" --data "$d/$data.csv" --json "$d/$out.json" ${GAP_ARGS:-} "$@" \
+    >"$d/$out.log" 2>&1 || rc=$?
   t1=$(date +%s.%N)
-  echo "$t0 $t1" | awk '{printf "%.3f\n", $2 - $1}' >"$d/gap.time"
-  echo "$rc" >"$d/gap.rc"
-  [[ $rc == 0 ]] || echo "  $dir ($model): weilgen gap exited $rc, see $d/gap.log" >&2
+  echo "$t0 $t1" | awk '{printf "%.3f\n", $2 - $1}' >"$d/$out.time"
+  echo "$rc" >"$d/$out.rc"
+  [[ $rc == 0 ]] || echo "  $dir ($model, $data.csv): weilgen gap exited $rc, see $d/$out.log" >&2
 }
-export -f run_one
-export work weilgen resume
+# One scenario: the diagnosis (gap.*) and, on the oracle file, the oracle's (gap_oracle.*).
+run_one() {
+  run_gap "$1" "$2" data gap
+  if [[ $oracle == 1 && -f $work/$1/data_oracle.csv ]]; then
+    run_gap "$1" "$2" data_oracle gap_oracle --effects tool_offset
+  fi
+}
+export -f run_gap run_one
+export work weilgen resume oracle
 GAP_ARGS="${gap_args[*]:-}"
 export GAP_ARGS
 

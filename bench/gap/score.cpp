@@ -4,7 +4,9 @@
 // spindle study's DIR/spindle/{gap.json,ridge.json} when present; writes results.json and
 // results.md: the targets, attribution by machine and layout, by effect and signal-to-noise, the
 // confusion matrix, the top "where" entry, gross readings found, shrinkage and run times.
-// Knows nothing of the diagnosis but its JSON schema.
+// sNNNN/gap_oracle.json, when present, is the diagnosis of the oracle file (the same data without
+// the withheld effects and gross readings): its baseline's held-out RMS is the reference of the
+// "... <= 1.2 x the oracle's" row. Knows nothing of the diagnosis but its JSON schema.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -53,6 +55,14 @@ struct Scenario {
   // Held-out RMS after over what a right model leaves: the truth's noise times the diagnosis'
   // sqrt(mean(1 + h)) (verdict.heldout_rms_ideal_um / noise_floor_um), per output; the largest.
   double shrink_ideal = NAN;
+  // The oracle's (gap_oracle.json) baseline held-out RMS, the largest output, and after / it.
+  json oracle;                   // null when absent
+  bool oracle_expected = false;  // data_oracle.csv is there
+  double oracle_rms = NAN, shrink_oracle = NAN;
+  bool oracle_same_holdout = true;
+  // Effect-free without gross readings: the oracle file is the data file, so the two baselines
+  // must agree (a check that the oracle runs see the same model, arguments and folds).
+  int oracle_consistent = -1;  // -1 n/a, 0 differ, 1 agree
   int gross = 0, gross_found = 0;
 };
 
@@ -207,6 +217,18 @@ void derive(Scenario& s) {
         if (std::isnan(s.shrink_ideal) || r > s.shrink_ideal) s.shrink_ideal = r;
       }
   }
+  if (s.oracle.is_object() && s.oracle.contains("baseline") &&
+      s.oracle["baseline"].contains("heldout_rms_um")) {
+    const json& ob = s.oracle["baseline"];
+    s.oracle_rms = largest(ob["heldout_rms_um"]);
+    if (s.oracle_rms > 0) s.shrink_oracle = after / s.oracle_rms;
+    const json& b = s.gap.value("baseline", json::object());
+    s.oracle_same_holdout = b.value("holdout", "") == ob.value("holdout", "");
+    if (s.effect == "none" && s.gross == 0 && b.contains("heldout_rms_um")) {
+      const double x = largest(b["heldout_rms_um"]);
+      s.oracle_consistent = std::abs(x - s.oracle_rms) <= 1e-9 * std::max(1.0, x) ? 1 : 0;
+    }
+  }
   // Gross readings found: truth lines among the reported ones.
   std::set<long> lines;
   for (const json& o : s.gap.value("outliers", json::array())) lines.insert(o.value("line", -1L));
@@ -268,6 +290,7 @@ int main(int argc, char** argv) {
         argc < 2 ? stderr : stdout,
         "usage: weilgen_gap_score SUITE_DIR [--out DIR]\n"
         "  reads SUITE_DIR/manifest.tsv, sNNNN/truth.json and sNNNN/gap.json (and\n"
+        "  sNNNN/gap_oracle.json, the oracle file's diagnosis, and\n"
         "  SUITE_DIR/spindle/{gap,ridge}.json when present); writes results.json and\n"
         "  results.md into --out (default SUITE_DIR). Exit 0: every target passes, 3: one\n"
         "  fails\n");
@@ -309,6 +332,14 @@ int main(int argc, char** argv) {
         }
       } else {
         s.error = "no gap.json (see gap.log)";
+      }
+      const fs::path og = suite / s.dir / "gap_oracle.json";
+      s.oracle_expected = fs::exists(suite / s.dir / "data_oracle.csv");
+      if (fs::exists(og)) {
+        try {
+          s.oracle = json::parse(read_text(og));
+        } catch (const std::exception&) {
+        }
       }
       const fs::path tf = suite / s.dir / "gap.time";
       if (fs::exists(tf)) {
@@ -362,11 +393,36 @@ int main(int argc, char** argv) {
   std::map<std::string, std::map<double, Count>> by_effect;
   std::set<double> factor_set;
   Count attribution, none_rate, unexplained, absorbed_none, where, loc, loc_contains, gross;
-  std::vector<double> shrink, shrink_ideal, floor_ratio, times;
+  std::vector<double> shrink, shrink_ideal, shrink_oracle, floor_ratio, times;
+  // The three shrinkage rows by layout (the same scenarios as the rows).
+  struct LayoutShrink {
+    Count noise, ideal, oracle;
+    std::vector<double> oracle_ratio;
+  };
+  std::map<std::string, LayoutShrink> shrink_by_layout;
+  auto add_shrink = [&](const Scenario& s) {
+    shrink.push_back(s.shrink);
+    shrink_ideal.push_back(s.shrink_ideal);
+    shrink_oracle.push_back(s.shrink_oracle);
+    LayoutShrink& l = shrink_by_layout[s.layout];
+    l.noise.add(!std::isnan(s.shrink) && s.shrink <= kShrinkLimit);
+    l.ideal.add(!std::isnan(s.shrink_ideal) && s.shrink_ideal <= kShrinkLimit);
+    l.oracle.add(!std::isnan(s.shrink_oracle) && s.shrink_oracle <= kShrinkLimit);
+    l.oracle_ratio.push_back(s.shrink_oracle);
+  };
+  // Oracle runs: expected (data_oracle.csv), found, same hold-out, consistent when effect-free.
+  int oracle_expected = 0, oracle_found = 0, oracle_other_holdout = 0;
+  Count oracle_consistent;
   std::map<std::string, Count> none_by_cell;
   std::vector<const Scenario*> wrong, where_wrong;
   for (const Scenario& s : all) {
     if (!std::isnan(s.time_s)) times.push_back(s.time_s);
+    oracle_expected += s.oracle_expected;
+    if (!std::isnan(s.oracle_rms)) {
+      ++oracle_found;
+      oracle_other_holdout += !s.oracle_same_holdout;
+    }
+    if (s.oracle_consistent >= 0) oracle_consistent.add(s.oracle_consistent == 1);
     if (!std::isnan(s.noise_floor_ratio)) floor_ratio.push_back(s.noise_floor_ratio);
     if (s.gross > 0) {
       gross.ok += s.gross_found;
@@ -378,7 +434,7 @@ int main(int argc, char** argv) {
       none_by_cell[cell].add(s.correct);
       by_variant[s.variant.empty() ? "plain" : s.variant].add(s.correct);
       if (s.correct)
-        shrink.push_back(s.shrink), shrink_ideal.push_back(s.shrink_ideal);
+        add_shrink(s);
       else
         wrong.push_back(&s);
       continue;
@@ -397,7 +453,7 @@ int main(int argc, char** argv) {
                                   : s.effect + (s.variant.empty() ? "" : " (" + s.variant + ")")]
              [s.factor]
                  .add(s.correct);
-    if (s.correct) shrink.push_back(s.shrink), shrink_ideal.push_back(s.shrink_ideal);
+    if (s.correct) add_shrink(s);
     if (s.factor < kTargetSnr) continue;
     attribution.add(s.correct);
     by_cell[cell].add(s.correct);
@@ -417,6 +473,9 @@ int main(int argc, char** argv) {
   for (double r : shrink) shrink_ok.add(!std::isnan(r) && r <= kShrinkLimit);
   Count shrink_ideal_ok;
   for (double r : shrink_ideal) shrink_ideal_ok.add(!std::isnan(r) && r <= kShrinkLimit);
+  Count shrink_oracle_ok;
+  for (double r : shrink_oracle) shrink_oracle_ok.add(!std::isnan(r) && r <= kShrinkLimit);
+  const bool with_oracle = oracle_expected + oracle_found > 0;
   // The worst machine and layout.
   std::string worst_cell;
   double worst = NAN;
@@ -456,6 +515,13 @@ int main(int argc, char** argv) {
        shrink_ideal_ok.rate(), kShrinkTarget, shrink_ideal_ok.n},
       {"unexplained for the step (SNR >= 3)", "verdict unexplained", unexplained.rate(),
        kUnexplainedTarget, unexplained.n}};
+  // After the "ideal" row: the reference a model knowing the effects reaches on these poses.
+  if (with_oracle)
+    targets.insert(targets.begin() + 6,
+                   {"... <= 1.2 x the oracle's",
+                    "the same, against the baseline's held-out RMS on the same data without the "
+                    "effect (gap_oracle.json)",
+                    shrink_oracle_ok.rate(), kShrinkTarget, shrink_oracle_ok.n});
   if (!std::isnan(spindle_gap))
     targets.push_back({"spindle: held-out RMS <= 0.9 x ridge", "ridge RMS x 0.9 / weilgen RMS",
                        kSpindleRatio * spindle_ridge / spindle_gap, 1.0, 1});
@@ -514,6 +580,23 @@ int main(int argc, char** argv) {
   };
   r["shrinkage_ratio"] = stats(shrink);
   r["shrinkage_ratio_ideal"] = stats(shrink_ideal);
+  if (with_oracle) {
+    r["shrinkage_ratio_oracle"] = stats(shrink_oracle);
+    r["oracle"] = {{"expected", oracle_expected},
+                   {"found", oracle_found},
+                   {"other_holdout", oracle_other_holdout},
+                   {"effect_free_baseline_agrees", oracle_consistent.to_json()}};
+  }
+  json jl = json::object();
+  for (const auto& [layout, l] : shrink_by_layout) {
+    jl[layout] = {{"noise", l.noise.to_json()}, {"ideal", l.ideal.to_json()}};
+    if (with_oracle) {
+      jl[layout]["oracle"] = l.oracle.to_json();
+      const double m = quantile(l.oracle_ratio, 0.5);
+      jl[layout]["oracle_ratio_median"] = std::isnan(m) ? json() : json(m);
+    }
+  }
+  r["shrinkage_by_layout"] = jl;
   r["noise_floor_ratio"] = stats(floor_ratio);
   r["run_time_s"] = stats(times);
   json per = json::array();
@@ -531,6 +614,8 @@ int main(int argc, char** argv) {
          {"where_ok", s.where_ok < 0 ? json() : json(s.where_ok == 1)},
          {"shrink_ratio", std::isnan(s.shrink) ? json() : json(s.shrink)},
          {"shrink_ratio_ideal", std::isnan(s.shrink_ideal) ? json() : json(s.shrink_ideal)},
+         {"shrink_ratio_oracle", std::isnan(s.shrink_oracle) ? json() : json(s.shrink_oracle)},
+         {"oracle_heldout_rms_um", std::isnan(s.oracle_rms) ? json() : json(s.oracle_rms)},
          {"noise_floor_ratio",
           std::isnan(s.noise_floor_ratio) ? json() : json(s.noise_floor_ratio)},
          {"time_s", std::isnan(s.time_s) ? json() : json(s.time_s)},
@@ -621,8 +706,29 @@ int main(int argc, char** argv) {
   };
   srow("held-out RMS after / truth noise RMS (correct verdicts)", shrink);
   srow("held-out RMS after / (truth noise RMS x sqrt(mean(1 + h))) (the same)", shrink_ideal);
+  if (with_oracle)
+    srow("held-out RMS after / the oracle's baseline held-out RMS (the same)", shrink_oracle);
   srow("reported noise floor / truth noise RMS", floor_ratio);
   srow("run time of `weilgen gap`, s", times);
+
+  md << "\nThe shrinkage rows by layout (share within 1.2x):\n\n| layout | n | x noise | x ideal |"
+     << (with_oracle
+             ? " x oracle | median after / oracle |\n| --- | ---: | ---: | ---: | ---: | ---: |\n"
+             : "\n| --- | ---: | ---: | ---: |\n");
+  for (const auto& [layout, l] : shrink_by_layout) {
+    md << "| " << layout << " | " << l.noise.n << " | " << l.noise.text() << " | " << l.ideal.text()
+       << " |";
+    if (with_oracle)
+      md << " " << l.oracle.text() << " | " << fnum(quantile(l.oracle_ratio, 0.5)) << " |";
+    md << "\n";
+  }
+  if (with_oracle)
+    md << "\nOracle runs (`weilgen gap` on data_oracle.csv, the data without the withheld effects "
+          "and gross readings): "
+       << oracle_found << " of " << oracle_expected << " found, " << oracle_other_holdout
+       << " with another hold-out than the run's; on effect-free data without gross readings "
+          "(the same file) their baseline equals the run's in "
+       << oracle_consistent.text() << ".\n";
 
   auto listing = [&](const char* title, const std::vector<const Scenario*>& v) {
     md << "\n## " << title << "\n\n";

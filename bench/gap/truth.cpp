@@ -995,11 +995,12 @@ std::vector<std::string> Synthesiser::comment_lines() const {
   return head_lines;
 }
 
-std::string Synthesiser::csv(bool with_effect, bool with_noise) const {
+std::string Synthesiser::csv(bool with_effect, bool with_noise, bool with_gross) const {
   std::vector<double> v = measured(with_effect);
   if (with_noise) {
     for (std::size_t i = 0; i < v.size(); ++i) v[i] += noise_um_[i];
-    for (const GrossReading& g : gross_) v[g.observation] += g.size_um;
+    if (with_gross)
+      for (const GrossReading& g : gross_) v[g.observation] += g.size_um;
   }
   const std::vector<std::string> head_lines = comment_lines();
   const bool ballbar = column_dim_[0] < 0;

@@ -113,8 +113,10 @@ class Synthesiser {
   ~Synthesiser();
 
   // The measurement file; the variants without effect or noise serve the self-check (gross
-  // readings come with the noise).
-  std::string csv(bool with_effect = true, bool with_noise = true) const;
+  // readings come with the noise unless with_gross is false). csv(false, true, false) is the
+  // oracle file: the same truth machine, poses and noise with the withheld effects and the gross
+  // readings removed exactly (what a model that knew the effects would be left with).
+  std::string csv(bool with_effect = true, bool with_noise = true, bool with_gross = true) const;
   nlohmann::json truth() const;
   // Path or shipped name of the model machine `weilgen gap` is given.
   const std::string& model_machine() const { return model_machine_; }
