@@ -175,16 +175,19 @@ LackOfFit lack_of_fit(const Engine& e, const GapData& d, const MatrixXd* extra =
 // directions a fold cannot predict from its training poses, where it carries the true errors
 // (docs/gap.md §1): no effect removes that part, so the share over all of it understates what
 // a right effect explains (a missing error at SNR 3 on 60 R-test poses: 28 % of all, the whole
-// predictable part). The larger share is the one judged.
+// predictable part). The larger share is the one judged; when only the predictable part's
+// meets the verdict's thresholds (`predictable_decides`), the held-out evidence is the weaker,
+// and the effect must leave no significant lack of fit on all data at all.
 struct Explained {
   double all = 0, predictable = 0;
+  bool predictable_decides = false;  // set by decide_verdict
   double share() const { return std::max(all, predictable); }
 };
 
 // The verdict and its reason from the greedy explanation (docs/gap.md, "Verdict"). `shape` holds
 // each accepted effect's (coordinate, output) when it is a shape along a coordinate.
 void decide_verdict(GapResult& R, const GapOptions& opt, const std::vector<std::string>& axes,
-                    bool gap_significant, const Explained& ex,
+                    bool gap_significant, Explained& ex,
                     const std::vector<std::pair<int, int>>& shape) {
   const double explained = ex.share();
   auto unexplained = [&](std::string why) {
@@ -265,14 +268,15 @@ void decide_verdict(GapResult& R, const GapOptions& opt, const std::vector<std::
           "the accepted effects leave a significant held-out RMS of more than twice what the "
           "noise floor explains");
   }
+  ex.predictable_decides =
+      ex.all < 0.5 || (R.final_p_value < opt.alpha && ex.all < opt.explain_fraction);
   R.verdict = first.name;
   R.verdict_reason =
       first.name + " removes " + pct(first.explained_fraction) +
       " of the excess held-out sum of squares" +
       (R.explanation.size() > 1 ? ", the accepted effects " + pct(ex.all) : "") +
-      (ex.predictable > ex.all && ex.all < opt.explain_fraction
-           ? " (" + pct(ex.predictable) + " of the part the folds can predict)"
-           : "") +
+      (ex.predictable_decides ? " (" + pct(ex.predictable) + " of the part the folds can predict)"
+                              : "") +
       (R.final_p_value >= opt.alpha ? "; the remaining gap is at the noise floor" : "");
 }
 
@@ -637,15 +641,20 @@ GapResult GapDiagnosis::run(const Model& model, const ErrorParameterisation& par
   }
   decide_verdict(R, options_, data.axes, gap_significant, ex, accepted_shape);
   // Lack of fit: a named effect must leave no structure along a coordinate that is both
-  // significant and material (LackOfFit::material).
+  // significant and material (LackOfFit::material); none significant when only the part the
+  // folds can predict carries it (Explained).
   if (!R.explanation.empty() && R.verdict == R.explanation.front().name) {
     const LackOfFit lof = lack_of_fit(e, data);
     const double removed = std::max(0.0, base_full_sse - e.full_sse);
-    if (lof.material(removed, options_)) {
+    if (ex.predictable_decides ? lof.p_value < options_.alpha : lof.material(removed, options_)) {
       R.verdict = "unexplained";
       R.verdict_reason =
-          R.explanation.front().name + " fits, but leaves a structure along " + lof.along + " (" +
-          pct(lof.share(removed)) +
+          R.explanation.front().name +
+          (ex.predictable_decides
+               ? " removes " + pct(ex.all) + " of the excess held-out sum of squares (" +
+                     pct(ex.predictable) + " of the part the folds can predict), but"
+               : " fits, but") +
+          " leaves a structure along " + lof.along + " (" + pct(lof.share(removed)) +
           " of the structure, lack of fit p = " + format_significant(lof.p_value, 2) +
           "): a shape outside the library, which it only imitates";
     }
