@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <boost/math/distributions/normal.hpp>
 #include <cmath>
+#include <numeric>
 
 #include "internal.hpp"
 
@@ -108,6 +109,56 @@ std::vector<GapOutlier> find_outliers(const GapData& d, const VectorXd& r) {
   std::sort(out.begin(), out.end(),
             [](const GapOutlier& a, const GapOutlier& b) { return a.observation < b.observation; });
   return out;
+}
+
+// In rounds: the deleted residuals of the fit on the readings left, the readings find_outliers
+// flags removed, refit, until a round flags none (at most 4 rounds: a spike pulls the fit
+// towards itself and masks a smaller one beside it only until it is gone).
+std::vector<GapOutlier> gross_readings(const MatrixXd& A, const GapData& d, unsigned threads) {
+  std::vector<GapOutlier> all;
+  std::vector<std::size_t> index(d.points.observations.size());  // into `d`
+  std::iota(index.begin(), index.end(), 0);
+  GapData cur = d;
+  for (int round = 0; round < 4; ++round) {
+    const auto& obs = cur.points.observations;
+    VectorXd y(static_cast<Index>(obs.size()));
+    for (std::size_t i = 0; i < obs.size(); ++i) y[static_cast<Index>(i)] = obs[i].value;
+    const FoldFit f = fit_fold(rows_of(A, index), y, all_rows(obs.size()), threads);
+    VectorXd r = f.res_train;
+    for (Index i = 0; i < r.size(); ++i) r[i] /= std::max(1e-3, 1 - f.lev_train[i]);
+    std::vector<GapOutlier> found = find_outliers(cur, r);
+    if (found.empty()) break;
+    std::vector<std::size_t> kept;
+    GapData next = without_readings(cur, found, kept);
+    for (GapOutlier& g : found) g.observation = index[g.observation];
+    all.insert(all.end(), found.begin(), found.end());
+    for (std::size_t& k : kept) k = index[k];
+    cur = std::move(next);
+    index = std::move(kept);
+  }
+  std::sort(all.begin(), all.end(),
+            [](const GapOutlier& a, const GapOutlier& b) { return a.observation < b.observation; });
+  return all;
+}
+
+GapData without_readings(const GapData& d, const std::vector<GapOutlier>& gross,
+                         std::vector<std::size_t>& kept) {
+  const auto& obs = d.points.observations;
+  GapData clean = d;
+  clean.points.observations.clear();
+  clean.points.count = {};
+  kept.clear();
+  std::size_t next = 0;
+  for (std::size_t i = 0; i < obs.size(); ++i) {
+    if (next < gross.size() && gross[next].observation == i) {
+      ++next;
+      continue;
+    }
+    kept.push_back(i);
+    clean.points.observations.push_back(obs[i]);
+    ++clean.points.count[static_cast<std::size_t>(obs[i].output)];
+  }
+  return clean;
 }
 
 }  // namespace weilgen::gap_detail
