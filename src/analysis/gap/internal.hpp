@@ -258,8 +258,9 @@ inline void gap_stats(const Gap& g, double dof, double& excess, double& p) {
   p = g.n > g.removed ? f_sf(g.ss / g.expected, static_cast<double>(g.n - g.removed), dof) : 1;
 }
 
-// Gross readings in a full-data deleted residual `r` (docs/gap.md, "Outliers").
-std::vector<GapOutlier> find_outliers(const GapData& d, const VectorXd& r);
+// Gross readings in the residual `res` of a fit on all of `d` whose leverages are `lev`
+// (docs/gap.md, "Outliers").
+std::vector<GapOutlier> find_outliers(const GapData& d, const VectorXd& res, const VectorXd& lev);
 
 // Gross readings of `d` against the model whose design is `A` (row i: observation i; the
 // baseline, or the baseline and the accepted effects), in rounds until a round finds none.
