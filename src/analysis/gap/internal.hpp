@@ -258,8 +258,18 @@ inline void gap_stats(const Gap& g, double dof, double& excess, double& p) {
   p = g.n > g.removed ? f_sf(g.ss / g.expected, static_cast<double>(g.n - g.removed), dof) : 1;
 }
 
-// Gross readings in the baseline's full-data residual `r` (docs/gap.md, "Outliers").
-std::vector<GapOutlier> find_outliers(const GapData& d, const VectorXd& r);
+// Gross readings in the residual `res` of a fit on all of `d` whose leverages are `lev`
+// (docs/gap.md, "Outliers").
+std::vector<GapOutlier> find_outliers(const GapData& d, const VectorXd& res, const VectorXd& lev);
+
+// Gross readings of `d` against the model whose design is `A` (row i: observation i; the
+// baseline, or the baseline and the accepted effects), in rounds until a round finds none.
+std::vector<GapOutlier> gross_readings(const MatrixXd& A, const GapData& d, unsigned threads);
+
+// `d` without the observations `gross` (sorted by observation); `kept` receives the indices
+// into `d` of the observations kept, in order.
+GapData without_readings(const GapData& d, const std::vector<GapOutlier>& gross,
+                         std::vector<std::size_t>& kept);
 
 // The noise floor of the held-out residual (docs/gap.md, "Noise floor"); `cov` its covariance
 // under the null hypothesis (the small-scale estimate is unbiased under it).

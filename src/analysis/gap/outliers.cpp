@@ -1,14 +1,15 @@
-// Gross readings (docs/gap.md, "Outliers"): a reading whose baseline residual (deleted: divided
-// by 1 − its leverage, so a reading at the edge of the design cannot hide) lies beyond
-// max(6, z_n) robust standard deviations of its output's residuals (z_n: the two-sided normal
-// quantile that n readings exceed by chance with probability 1 %), and whose nearest neighbours
-// do not share it: neither those in the pose space nor, when the data have a time, those
-// nearest in time. A smooth effect moves its neighbours too (a bump or a reversal its pose
-// neighbours, a drift its time neighbours: the same pose an hour later is not its neighbour),
-// so it is not taken for an outlier; a spike is.
+// Gross readings (docs/gap.md, "Outliers"): a reading whose studentised residual (of a fit on
+// all data: the baseline, or the baseline and the accepted effects) lies beyond max(6, z_n)
+// robust standard deviations of its output's residuals (z_n: the two-sided normal quantile
+// that n readings exceed by chance with probability 1 %) and of its 20 nearest neighbours'
+// in the pose space, and whose nearest neighbours do not share it: neither those in the pose
+// space nor, when the data have a time, those nearest in time. A smooth effect moves its
+// neighbours too (a bump or a reversal its pose neighbours, a drift its time neighbours: the
+// same pose an hour later is not its neighbour), so it is not taken for an outlier; a spike is.
 #include <algorithm>
 #include <boost/math/distributions/normal.hpp>
 #include <cmath>
+#include <numeric>
 
 #include "internal.hpp"
 
@@ -25,11 +26,23 @@ double median(std::vector<double> v) {
   return m;
 }
 
+// The wider neighbourhood in the pose space whose spread a gross reading must exceed too.
+constexpr std::size_t kLocal = 20;
+
 }  // namespace
 
-std::vector<GapOutlier> find_outliers(const GapData& d, const VectorXd& r) {
+std::vector<GapOutlier> find_outliers(const GapData& d, const VectorXd& res, const VectorXd& lev) {
   const auto& obs = d.points.observations;
   std::vector<GapOutlier> out;
+  // Studentised: a residual's variance is σ²(1 − h), so r/√(1 − h) has the same spread at every
+  // leverage (the deleted r/(1 − h) would spread wider at the design's edge); a spike of size δ
+  // reads δ√(1 − h) in it, δ in the deleted residual, which is reported.
+  VectorXd r = res, deleted = res;
+  for (Index i = 0; i < r.size(); ++i) {
+    const double keep = std::max(1e-6, 1 - lev[i]);
+    r[i] /= std::sqrt(keep);
+    deleted[i] /= keep;
+  }
   // Scale of each coordinate over the data, so that neighbours weigh axes alike.
   const std::size_t na = d.axes.size();
   std::vector<double> lo(na, INFINITY), hi(na, -INFINITY);
@@ -82,8 +95,20 @@ std::vector<GapOutlier> find_outliers(const GapData& d, const VectorXd& r) {
           if (hi[a] > lo[a]) dist += std::pow((pi[a] - pj[a]) / (hi[a] - lo[a]), 2);
         near.push_back({dist, j});
       }
+      const std::size_t wide = std::min<std::size_t>(kLocal, near.size());
+      std::partial_sort(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(wide), near.end());
+      // Against the spread of its wider neighbourhood too: noise that grows across the
+      // workspace (a tracker's range) puts honest readings of the far poses beyond the global
+      // scale, not beyond their neighbours'.
+      std::vector<double> local;
+      for (std::size_t m = 0; m < wide; ++m) local.push_back(r[static_cast<Index>(near[m].second)]);
+      const double local_centre = median(local);
+      for (double& x : local) x = std::abs(x - local_centre);
+      const double local_sigma = 1.4826 * median(local);
+      if (wide >= kLocal / 2 &&
+          std::abs(r[static_cast<Index>(i)] - local_centre) <= z * std::max(sigma, local_sigma))
+        continue;
       const std::size_t k = std::min<std::size_t>(4, near.size());
-      std::partial_sort(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(k), near.end());
       std::vector<std::size_t> pose_nb;
       for (std::size_t m = 0; m < k; ++m) pose_nb.push_back(near[m].second);
       if (shared(pose_nb, dev)) continue;
@@ -100,7 +125,7 @@ std::vector<GapOutlier> find_outliers(const GapData& d, const VectorXd& r) {
       g.line = obs[i].line;
       g.output = observation_name(static_cast<std::size_t>(o));
       g.value_um = obs[i].value;
-      g.residual_um = r[static_cast<Index>(i)];
+      g.residual_um = deleted[static_cast<Index>(i)];
       g.sigmas = dev;
       out.push_back(g);
     }
@@ -108,6 +133,54 @@ std::vector<GapOutlier> find_outliers(const GapData& d, const VectorXd& r) {
   std::sort(out.begin(), out.end(),
             [](const GapOutlier& a, const GapOutlier& b) { return a.observation < b.observation; });
   return out;
+}
+
+// In rounds: the deleted residuals of the fit on the readings left, the readings find_outliers
+// flags removed, refit, until a round flags none (at most 4 rounds: a spike pulls the fit
+// towards itself and masks a smaller one beside it only until it is gone).
+std::vector<GapOutlier> gross_readings(const MatrixXd& A, const GapData& d, unsigned threads) {
+  std::vector<GapOutlier> all;
+  std::vector<std::size_t> index(d.points.observations.size());  // into `d`
+  std::iota(index.begin(), index.end(), 0);
+  GapData cur = d;
+  for (int round = 0; round < 4; ++round) {
+    const auto& obs = cur.points.observations;
+    VectorXd y(static_cast<Index>(obs.size()));
+    for (std::size_t i = 0; i < obs.size(); ++i) y[static_cast<Index>(i)] = obs[i].value;
+    const FoldFit f = fit_fold(rows_of(A, index), y, all_rows(obs.size()), threads);
+    std::vector<GapOutlier> found = find_outliers(cur, f.res_train, f.lev_train);
+    if (found.empty()) break;
+    std::vector<std::size_t> kept;
+    GapData next = without_readings(cur, found, kept);
+    for (GapOutlier& g : found) g.observation = index[g.observation];
+    all.insert(all.end(), found.begin(), found.end());
+    for (std::size_t& k : kept) k = index[k];
+    cur = std::move(next);
+    index = std::move(kept);
+  }
+  std::sort(all.begin(), all.end(),
+            [](const GapOutlier& a, const GapOutlier& b) { return a.observation < b.observation; });
+  return all;
+}
+
+GapData without_readings(const GapData& d, const std::vector<GapOutlier>& gross,
+                         std::vector<std::size_t>& kept) {
+  const auto& obs = d.points.observations;
+  GapData clean = d;
+  clean.points.observations.clear();
+  clean.points.count = {};
+  kept.clear();
+  std::size_t next = 0;
+  for (std::size_t i = 0; i < obs.size(); ++i) {
+    if (next < gross.size() && gross[next].observation == i) {
+      ++next;
+      continue;
+    }
+    kept.push_back(i);
+    clean.points.observations.push_back(obs[i]);
+    ++clean.points.count[static_cast<std::size_t>(obs[i].output)];
+  }
+  return clean;
 }
 
 }  // namespace weilgen::gap_detail

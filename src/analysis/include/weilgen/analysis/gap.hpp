@@ -212,6 +212,13 @@ class GapDiagnosis {
                 const HoldoutScheme& scheme, const std::string& reason) const;
 
  private:
+  // `round` counts the diagnoses before this one that removed gross readings.
+  GapResult diagnose(const Model& model, const ErrorParameterisation& param, const GapData& data,
+                     const HoldoutScheme& scheme, const std::string& reason, int round) const;
+  GapResult diagnose_without(const Model& model, const ErrorParameterisation& param,
+                             const GapData& data, const HoldoutScheme& scheme,
+                             const std::string& reason, std::vector<GapOutlier> gross,
+                             int round) const;
   GapOptions options_;
 };
 
