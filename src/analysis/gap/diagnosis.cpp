@@ -456,6 +456,7 @@ GapResult GapDiagnosis::run(const Model& model, const ErrorParameterisation& par
           along;
     }
   };
+  bool by_lack_of_fit = false;  // this round goes on on the lack of fit alone
   for (int step = 0; step < options_.max_effects; ++step) {
     ScoringContext sc;
     sc.engine = &e;
@@ -506,6 +507,11 @@ GapResult GapDiagnosis::run(const Model& model, const ErrorParameterisation& par
     if (step == 0 && pick && !gap_significant && !pick->regularised && pick->fit.p_value < alpha3)
       gap_significant = true;
     if (!pick || !gap_significant) break;
+    // A round entered on the lack of fit alone (the held-out gap at the floor) seeks the
+    // structure all data show: a shape that uses every shape dof the data leave along its
+    // coordinate fits any structure there (also the small misfit of a right effect at high SNR,
+    // vmc_3axis grid: a period after the right bump), so it cannot be that explanation.
+    if (by_lack_of_fit && !pick->fit.distinguishable) break;
     // Accept: its columns join the model.
     EffectFit fit = pick->fit;
     MatrixXd AE(e.A.rows(), e.A.cols() + pick->columns.cols());
@@ -544,6 +550,7 @@ GapResult GapDiagnosis::run(const Model& model, const ErrorParameterisation& par
     // still stands out on all data; stopping there named the drift alone or called it a shape
     // outside the library.
     if (p >= options_.alpha && lack_of_fit(e, data).p_value >= alpha3) break;
+    by_lack_of_fit = p >= options_.alpha;
   }
   summarise(cur_r, R.final_rms, R.final_rms_um, nullptr);
   ideal(cur_r, cur_h, R.final_ideal, R.final_ideal_um);
