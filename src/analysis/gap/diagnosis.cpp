@@ -522,20 +522,24 @@ GapResult GapDiagnosis::diagnose(const Model& model, const ErrorParameterisation
         pick = &x;
         break;
       }
-    // Of the significant candidates that follow the held-out data about as well as the best
-    // (remove at least half the excess it removes), the best that leaves no material structure
-    // on all data (LackOfFit::material): two effects can follow one shape (a bump along C as a
-    // period of 164 deg), and the one that only imitates it leaves a structure the other does
-    // not. A candidate that removes much less is another effect, for a later round (a bump
-    // beside a reversal). When every one leaves a structure, the best; the check after the
-    // search judges the explanation.
+    // A shape that leaves a material structure along its own coordinate (LackOfFit::material)
+    // only imitates the shape there (a bump along C read as a period of 164 deg): of the
+    // significant candidates that follow the held-out data about as well (remove at least half
+    // the excess it removes), the best that leaves none is taken instead. A structure along
+    // another coordinate, or a candidate that removes much less, is another effect for a later
+    // round (a bump beside a reversal: the reversal stays first). When every one leaves a
+    // structure, the best; the check after the search judges the explanation.
+    const auto along_itself = [&](const Evaluated& x, const LackOfFit& l) {
+      return x.variant.shape_axis >= 0 &&
+             data.axes[static_cast<std::size_t>(x.variant.shape_axis)] == l.along;
+    };
     if (pick && !pick->regularised) {
       auto structure = [&](const Evaluated& x) { return lack_of_fit(e, data, &x.columns); };
       auto removed = [&](const LackOfFit& l) {
         return std::max(0.0, base_full_sse - l.reference_sse);
       };
       const LackOfFit lp = structure(*pick);
-      if (lp.material(removed(lp), options_))
+      if (lp.material(removed(lp), options_) && along_itself(*pick, lp))
         for (const Evaluated& x : ev) {
           if (&x == pick || !x.fit.significant || x.regularised ||
               x.fit.explained_fraction < 0.5 * pick->fit.explained_fraction)
