@@ -91,12 +91,15 @@ struct LackOfFit {
   double reference_sse = 0;  // SSE on all data of the model tested (with `extra`)
 
   // Significant and material: more than 1 − explain_fraction of the structure, which is the
-  // effects' drop in SSE on all data (`removed`) plus the bins' excess; the same share the
-  // held-out test asks of an effect. An effect that only imitates a shape outside the library
-  // (a step) leaves one; a misfit of a right effect at high SNR is significant but small.
-  double share(double removed) const { return excess_ss / (excess_ss + removed); }
-  bool material(double removed, const GapOptions& opt) const {
-    return p_value < opt.alpha && share(removed) > 1 - opt.explain_fraction;
+  // effects' drop in SSE on all data (from the baseline's `base_sse` to reference_sse) plus the
+  // bins' excess; the same share the held-out test asks of an effect. An effect that only
+  // imitates a shape outside the library (a step) leaves one; a misfit of a right effect at high
+  // SNR is significant but small.
+  double share(double base_sse) const {
+    return excess_ss / (excess_ss + std::max(0.0, base_sse - reference_sse));
+  }
+  bool material(double base_sse, const GapOptions& opt) const {
+    return p_value < opt.alpha && share(base_sse) > 1 - opt.explain_fraction;
   }
 };
 
@@ -421,7 +424,8 @@ GapResult GapDiagnosis::diagnose(const Model& model, const ErrorParameterisation
   ideal(r, h, R.baseline_ideal, R.baseline_ideal_um);
   const Gap base = held_gap(r, h);
   // The held-out gap after the effects accepted so far (the baseline's at first).
-  Gap cur_gap = estimable_gap(base_cov, r);
+  const Gap base_estimable = estimable_gap(base_cov, r);
+  Gap cur_gap = base_estimable;
   gap_stats(cur_gap, R.noise.dof, R.baseline_excess_um, R.baseline_p_value);
   R.where = localise(data, r, h, R.noise, options_.alpha);
   R.residual_before.assign(r.data(), r.data() + r.size());
@@ -483,6 +487,9 @@ GapResult GapDiagnosis::diagnose(const Model& model, const ErrorParameterisation
   // Candidates the lack of fit set aside, and why (said unless accepted later, as one of two).
   std::vector<std::pair<std::string, std::string>> passed_over;
   bool by_lack_of_fit = false;  // this round goes on on the lack of fit alone
+  // The lack of fit of the engine's current model, when computed after the last acceptance (the
+  // check after the search reads the same model).
+  std::optional<LackOfFit> lof_after;
   for (int step = 0; step < options_.max_effects; ++step) {
     ScoringContext sc;
     sc.engine = &e;
@@ -535,21 +542,17 @@ GapResult GapDiagnosis::diagnose(const Model& model, const ErrorParameterisation
     };
     if (pick && !pick->regularised) {
       auto structure = [&](const Evaluated& x) { return lack_of_fit(e, data, &x.columns); };
-      auto removed = [&](const LackOfFit& l) {
-        return std::max(0.0, base_full_sse - l.reference_sse);
-      };
       const LackOfFit lp = structure(*pick);
-      if (lp.material(removed(lp), options_) && along_itself(*pick, lp))
+      if (lp.material(base_full_sse, options_) && along_itself(*pick, lp))
         for (const Evaluated& x : ev) {
           if (&x == pick || !x.fit.significant || x.regularised ||
               x.fit.explained_fraction < 0.5 * pick->fit.explained_fraction)
             continue;
-          const LackOfFit lx = structure(x);
-          if (!lx.material(removed(lx), options_)) {
+          if (!structure(x).material(base_full_sse, options_)) {
             passed_over.emplace_back(
                 pick->fit.name,
                 pick->fit.name + " follows the held-out data about as well but " +
-                    "leaves a structure along " + lp.along + " (" + pct(lp.share(removed(lp))) +
+                    "leaves a structure along " + lp.along + " (" + pct(lp.share(base_full_sse)) +
                     " of the structure, lack of fit p = " + format_significant(lp.p_value, 2) +
                     ")");
             pick = &x;
@@ -579,6 +582,7 @@ GapResult GapDiagnosis::diagnose(const Model& model, const ErrorParameterisation
     AE << e.A, pick->columns;
     e.A = AE;
     e.refit();
+    lof_after.reset();
     e.heldout(cur_r, cur_h);
     const HeldoutCovariance cov(e, true);
     // A regularised model's columns joined the design as fitted on all data, so the folds'
@@ -610,8 +614,11 @@ GapResult GapDiagnosis::diagnose(const Model& model, const ErrorParameterisation
     // gap is at the floor while a bump along C, mostly in directions a fold cannot predict,
     // still stands out on all data; stopping there named the drift alone or called it a shape
     // outside the library.
-    if (p >= options_.alpha && lack_of_fit(e, data).p_value >= alpha3) break;
     by_lack_of_fit = p >= options_.alpha;
+    if (by_lack_of_fit) {
+      lof_after = lack_of_fit(e, data);
+      if (lof_after->p_value >= alpha3) break;
+    }
   }
   summarise(cur_r, R.final_rms, R.final_rms_um, nullptr);
   ideal(cur_r, cur_h, R.final_ideal, R.final_ideal_um);
@@ -627,7 +634,8 @@ GapResult GapDiagnosis::diagnose(const Model& model, const ErrorParameterisation
   Explained ex;
   ex.all = excess_ss > 0 ? explained_ss / excess_ss : (base.ss > 0 ? explained_ss / base.ss : 0);
   {
-    const Gap b = estimable_gap(base_cov, r), f = estimable_gap(base_cov, cur_r);
+    const Gap& b = base_estimable;
+    const Gap f = estimable_gap(base_cov, cur_r);
     const double excess = std::max(0.0, b.ss - b.expected);
     ex.predictable = excess > 0 ? (b.ss - f.ss) / excess : 0;
   }
@@ -636,9 +644,9 @@ GapResult GapDiagnosis::diagnose(const Model& model, const ErrorParameterisation
   // significant and material (LackOfFit::material); none significant when only the part the
   // folds can predict carries it (Explained).
   if (!R.explanation.empty() && R.verdict == R.explanation.front().name) {
-    const LackOfFit lof = lack_of_fit(e, data);
-    const double removed = std::max(0.0, base_full_sse - e.full_sse);
-    if (ex.predictable_decides ? lof.p_value < options_.alpha : lof.material(removed, options_)) {
+    const LackOfFit lof = lof_after ? *lof_after : lack_of_fit(e, data);
+    if (ex.predictable_decides ? lof.p_value < options_.alpha
+                               : lof.material(base_full_sse, options_)) {
       R.verdict = "unexplained";
       R.verdict_reason =
           R.explanation.front().name +
@@ -646,7 +654,7 @@ GapResult GapDiagnosis::diagnose(const Model& model, const ErrorParameterisation
                ? " removes " + pct(ex.all) + " of the excess held-out sum of squares (" +
                      pct(ex.predictable) + " of the part the folds can predict), but"
                : " fits, but") +
-          " leaves a structure along " + lof.along + " (" + pct(lof.share(removed)) +
+          " leaves a structure along " + lof.along + " (" + pct(lof.share(base_full_sse)) +
           " of the structure, lack of fit p = " + format_significant(lof.p_value, 2) +
           "): a shape outside the library, which it only imitates";
     }

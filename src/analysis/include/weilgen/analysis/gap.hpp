@@ -167,7 +167,7 @@ struct GapResult {
   double baseline_excess_um = 0, baseline_p_value = 1;  // held-out gap over the noise floor
   // The baseline's lack of fit on all data (free offsets per output in bins of time and of every
   // moving axis, nested F test, Bonferroni over the coordinates) and the coordinate it is worst
-  // along ("t_s" or an axis): a gap the held-out test misses when the folds cannot predict it.
+  // along ("time" or an axis): a gap the held-out test misses when the folds cannot predict it.
   double baseline_lack_of_fit_p = 1;
   std::string baseline_lack_of_fit_along;
   std::vector<GapRegion> where;        // significant regions first (by p-value), then the rest
