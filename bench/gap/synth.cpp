@@ -98,12 +98,20 @@ void write_file(const fs::path& path, const std::string& text) {
   fs::rename(tmp, path);
 }
 
-void write_scenario(const ScenarioSpec& spec, const fs::path& dir) {
-  const Synthesiser s(spec);
+// A scenario's files in `dir`: the data, the oracle reference (the same truth, poses and noise
+// without the withheld effects and gross readings; `weilgen gap` on it leaves what a model
+// knowing them would) and the truth, which is returned.
+json write_scenario_files(const Synthesiser& s, const fs::path& dir) {
   fs::create_directories(dir);
   write_file(dir / "data.csv", s.csv());
   write_file(dir / "data_oracle.csv", s.csv(false, true, false));
-  write_file(dir / "truth.json", s.truth().dump(2) + "\n");
+  json t = s.truth();
+  write_file(dir / "truth.json", t.dump(2) + "\n");
+  return t;
+}
+
+void write_scenario(const ScenarioSpec& spec, const fs::path& dir) {
+  write_scenario_files(Synthesiser(spec), dir);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -258,25 +266,18 @@ int run_suite(const Args& args) {
       std::snprintf(name, sizeof name, "s%04zu", i + 1);
       try {
         const Synthesiser s(entries[i].spec);
-        const fs::path sd = dir / name;
-        fs::create_directories(sd);
-        write_file(sd / "data.csv", s.csv());
-        // The oracle reference: the same truth, poses and noise without the withheld effects
-        // and gross readings; `weilgen gap` on it leaves what a model knowing them would.
-        write_file(sd / "data_oracle.csv", s.csv(false, true, false));
         // Scenario directories are opaque (sNNNN) so nothing about the truth reaches the
         // diagnosis through a path; the manifest maps them to ids.
+        const json t = write_scenario_files(s, dir / name);
         const std::string model = fs::is_regular_file(s.model_machine())
                                       ? fs::absolute(s.model_machine()).string()
                                       : s.model_machine();  // a shipped machine's name
-        const json t = s.truth();
         char extra[160];
         std::snprintf(extra, sizeof extra, "\t%s\t%.3g\t%.3g",
                       t["expected_verdict"].get<std::string>().c_str(),
                       t["effect"]["visible_fraction"].get<double>(),
                       t["effect"]["raw_signal_rms_um"].get<double>());
         lines[i] = std::string(name) + "\t" + entries[i].id + "\t" + model + extra;
-        write_file(sd / "truth.json", t.dump(2) + "\n");
       } catch (const std::exception& e) {
         std::lock_guard<std::mutex> lock(mu);
         if (error.empty()) error = entries[i].id + ": " + e.what();
