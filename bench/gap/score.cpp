@@ -400,14 +400,15 @@ int main(int argc, char** argv) {
     std::vector<double> oracle_ratio;
   };
   std::map<std::string, LayoutShrink> shrink_by_layout;
+  const auto shrink_within = [](double r) { return !std::isnan(r) && r <= kShrinkLimit; };
   auto add_shrink = [&](const Scenario& s) {
     shrink.push_back(s.shrink);
     shrink_ideal.push_back(s.shrink_ideal);
     shrink_oracle.push_back(s.shrink_oracle);
     LayoutShrink& l = shrink_by_layout[s.layout];
-    l.noise.add(!std::isnan(s.shrink) && s.shrink <= kShrinkLimit);
-    l.ideal.add(!std::isnan(s.shrink_ideal) && s.shrink_ideal <= kShrinkLimit);
-    l.oracle.add(!std::isnan(s.shrink_oracle) && s.shrink_oracle <= kShrinkLimit);
+    l.noise.add(shrink_within(s.shrink));
+    l.ideal.add(shrink_within(s.shrink_ideal));
+    l.oracle.add(shrink_within(s.shrink_oracle));
     l.oracle_ratio.push_back(s.shrink_oracle);
   };
   // Oracle runs: expected (data_oracle.csv), found, same hold-out, consistent when effect-free.
@@ -469,12 +470,13 @@ int main(int argc, char** argv) {
     }
   }
   const std::vector<double> factors(factor_set.begin(), factor_set.end());
-  Count shrink_ok;
-  for (double r : shrink) shrink_ok.add(!std::isnan(r) && r <= kShrinkLimit);
-  Count shrink_ideal_ok;
-  for (double r : shrink_ideal) shrink_ideal_ok.add(!std::isnan(r) && r <= kShrinkLimit);
-  Count shrink_oracle_ok;
-  for (double r : shrink_oracle) shrink_oracle_ok.add(!std::isnan(r) && r <= kShrinkLimit);
+  auto count_within = [&](const std::vector<double>& ratios) {
+    Count c;
+    for (double r : ratios) c.add(shrink_within(r));
+    return c;
+  };
+  const Count shrink_ok = count_within(shrink), shrink_ideal_ok = count_within(shrink_ideal),
+              shrink_oracle_ok = count_within(shrink_oracle);
   const bool with_oracle = oracle_expected + oracle_found > 0;
   // The worst machine and layout.
   std::string worst_cell;
