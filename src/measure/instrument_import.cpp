@@ -13,6 +13,7 @@
 #include <tuple>
 
 #include "weilgen/base/atomic_file.hpp"
+#include "weilgen/base/constants.hpp"
 #include "weilgen/base/error.hpp"
 #include "weilgen/base/format.hpp"
 #include "weilgen/base/text.hpp"
@@ -23,7 +24,6 @@ namespace weilgen {
 
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 const char* const kDegree = "\xC2\xB0";   // °
 const char* const kOrdinal = "\xC2\xBA";  // º, often typed for °
 

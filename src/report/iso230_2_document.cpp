@@ -64,7 +64,6 @@ json differences_json(const AdjacentDifferences& D, const std::vector<double>& p
 }
 
 // Table cells: fixed decimals (3 unless said), "-" when not computed.
-std::string fmt(double v, int decimals = 3) { return format_fixed(v, decimals); }
 
 std::string dir_label(int d) { return d > 0 ? "+1" : "-1"; }
 
@@ -90,9 +89,9 @@ void add_band(LinePlot& p, const std::vector<double>& mean, const std::vector<do
 
 std::string range_text(const ValueRange& r, int decimals, const std::string& unit) {
   if (r.empty()) return "-";
-  if (r.max - r.min < 0.5 * std::pow(10.0, -decimals)) return fmt(r.mean, decimals) + " " + unit;
-  return fmt(r.min, decimals) + " .. " + fmt(r.max, decimals) + " " + unit + " (mean " +
-         fmt(r.mean, decimals) + ")";
+  if (r.max - r.min < 0.5 * std::pow(10.0, -decimals)) return format_fixed(r.mean, decimals) + " " + unit;
+  return format_fixed(r.min, decimals) + " .. " + format_fixed(r.max, decimals) + " " + unit + " (mean " +
+         format_fixed(r.mean, decimals) + ")";
 }
 
 std::string with_source(const std::string& text, const std::string& source) {
@@ -185,7 +184,7 @@ std::vector<std::string> iso230_2_tolerance_statement(const Iso230_2StudyResult&
   for (const ToleranceCheck& c : res.tolerance) {
     std::ostringstream l;
     l << "  " << std::left << std::setw(8) << (c.name == "band" ? std::string("|x +- 2s|") : c.name)
-      << std::right << std::setw(10) << fmt(c.value) << " " << u << (c.pass ? " <= " : " >  ")
+      << std::right << std::setw(10) << format_fixed(c.value, 3) << " " << u << (c.pass ? " <= " : " >  ")
       << std::setw(8) << format_number(c.limit) << " " << u << "  " << (c.pass ? "pass" : "FAIL");
     out.push_back(l.str());
     if (!c.pass) failed.push_back(c.name);
@@ -218,10 +217,10 @@ std::string iso230_2_text(const std::string& data, const Iso230_2StudyResult& re
     << "R_i up" << std::setw(9) << "R_i dn" << std::setw(9) << "R_i" << std::setw(10) << "mean bi"
     << "\n";
   for (std::size_t i = 0; i < m; ++i)
-    o << std::setw(12) << format_number(P[i]) << std::setw(10) << fmt(F.mean_up[i]) << std::setw(10)
-      << fmt(F.mean_down[i]) << std::setw(9) << fmt(F.s_up[i]) << std::setw(9) << fmt(F.s_down[i])
-      << std::setw(9) << fmt(F.B_i[i]) << std::setw(9) << fmt(F.R_i_up[i]) << std::setw(9)
-      << fmt(F.R_i_down[i]) << std::setw(9) << fmt(F.R_i[i]) << std::setw(10) << fmt(F.mean_bi[i])
+    o << std::setw(12) << format_number(P[i]) << std::setw(10) << format_fixed(F.mean_up[i], 3) << std::setw(10)
+      << format_fixed(F.mean_down[i], 3) << std::setw(9) << format_fixed(F.s_up[i], 3) << std::setw(9) << format_fixed(F.s_down[i], 3)
+      << std::setw(9) << format_fixed(F.B_i[i], 3) << std::setw(9) << format_fixed(F.R_i_up[i], 3) << std::setw(9)
+      << format_fixed(F.R_i_down[i], 3) << std::setw(9) << format_fixed(F.R_i[i], 3) << std::setw(10) << format_fixed(F.mean_bi[i], 3)
       << "\n";
 
   struct Row {
@@ -251,12 +250,12 @@ std::string iso230_2_text(const std::string& data, const Iso230_2StudyResult& re
     << "\n";
   for (const Row& r : rows) {
     o << "  " << std::left << std::setw(7) << r.name << std::setw(37) << r.what << std::right;
-    for (const IsoFigures* s : sets) o << std::setw(12) << (s ? fmt(s->*(r.field)) : "-");
+    for (const IsoFigures* s : sets) o << std::setw(12) << (s ? format_fixed(s->*(r.field), 3) : "-");
     o << "\n";
   }
   o << std::left << std::setw(46) << "  coverage factor k (up/down)" << std::right;
   for (const IsoFigures* s : sets)
-    o << std::setw(12) << (s ? fmt(s->k_up, 2) + "/" + fmt(s->k_down, 2) : std::string("-"));
+    o << std::setw(12) << (s ? format_fixed(s->k_up, 2) + "/" + format_fixed(s->k_down, 2) : std::string("-"));
   o << "\n";
   if (!res.tolerance.empty()) {
     o << "\nTolerances (" << u << ")\n";
@@ -282,20 +281,20 @@ std::string iso230_2_text(const std::string& data, const Iso230_2StudyResult& re
         return s.str();
       };
       o << std::setw(20) << (format_number(P[q]) + ".." + format_number(P[q + 1])) << std::setw(10)
-        << fmt(D.differences[kUp].mean[q]) << std::setw(9) << fmt(D.differences[kUp].s[q])
-        << std::setw(10) << pv(kUp) << std::setw(10) << fmt(D.differences[kDown].mean[q])
-        << std::setw(9) << fmt(D.differences[kDown].s[q]) << std::setw(10) << pv(kDown) << "\n";
+        << format_fixed(D.differences[kUp].mean[q], 3) << std::setw(9) << format_fixed(D.differences[kUp].s[q], 3)
+        << std::setw(10) << pv(kUp) << std::setw(10) << format_fixed(D.differences[kDown].mean[q], 3)
+        << std::setw(9) << format_fixed(D.differences[kDown].s[q], 3) << std::setw(10) << pv(kDown) << "\n";
     }
-    o << "  s of differences / s of positions: up " << fmt(D.s_ratio[kUp]) << ", down "
-      << fmt(D.s_ratio[kDown]) << " (sqrt 2 = 1.414 without drift)\n";
+    o << "  s of differences / s of positions: up " << format_fixed(D.s_ratio[kUp], 3) << ", down "
+      << format_fixed(D.s_ratio[kDown], 3) << " (sqrt 2 = 1.414 without drift)\n";
     o << "\n"
       << std::setw(12) << "target mm" << std::setw(11) << "chart up" << std::setw(9) << "s* up"
       << std::setw(11) << "chart dn" << std::setw(9) << "s* dn"
       << "\n";
     for (std::size_t i = 0; i < m; ++i)
-      o << std::setw(12) << format_number(P[i]) << std::setw(11) << fmt(D.chart[kUp].value[i])
-        << std::setw(9) << fmt(D.chart[kUp].s[i]) << std::setw(11) << fmt(D.chart[kDown].value[i])
-        << std::setw(9) << fmt(D.chart[kDown].s[i]) << "\n";
+      o << std::setw(12) << format_number(P[i]) << std::setw(11) << format_fixed(D.chart[kUp].value[i], 3)
+        << std::setw(9) << format_fixed(D.chart[kUp].s[i], 3) << std::setw(11) << format_fixed(D.chart[kDown].value[i], 3)
+        << std::setw(9) << format_fixed(D.chart[kDown].s[i], 3) << "\n";
     o << "\nAnomaly test (F test of each difference's variance against the same-parity others,\n"
          "Bonferroni over "
       << D.tests << " tests, alpha " << format_number(D.alpha) << "): ";
@@ -305,7 +304,7 @@ std::string iso230_2_text(const std::string& data, const Iso230_2StudyResult& re
       o << "\n";
       for (const auto& a : D.anomalous_differences)
         o << "  dir " << dir_label(a.direction) << ": " << format_number(P[a.from]) << ".."
-          << format_number(P[a.to]) << " mm, s " << fmt(a.s) << " " << u << ", F " << fmt(a.F, 2)
+          << format_number(P[a.to]) << " mm, s " << format_fixed(a.s, 3) << " " << u << ", F " << format_fixed(a.F, 2)
           << ", p " << std::setprecision(3) << a.p_value << "\n";
       for (const auto& a : D.anomalous_positions)
         o << "  anomalous position: " << cols.axis << "=" << format_number(P[a.target])
@@ -319,14 +318,14 @@ std::string iso230_2_text(const std::string& data, const Iso230_2StudyResult& re
       << "\n";
     for (std::size_t c = 0; c < C.cycles.size(); ++c) {
       o << std::setw(8) << C.cycles[c];
-      if (!C.time_h.empty()) o << std::setw(9) << fmt(C.time_h[c], 3);
-      o << std::setw(10) << fmt(C.offset_up[c]) << std::setw(10) << fmt(C.offset_down[c])
-        << std::setw(10) << fmt(C.offset[c]) << "\n";
+      if (!C.time_h.empty()) o << std::setw(9) << format_fixed(C.time_h[c], 3);
+      o << std::setw(10) << format_fixed(C.offset_up[c], 3) << std::setw(10) << format_fixed(C.offset_down[c], 3)
+        << std::setw(10) << format_fixed(C.offset[c], 3) << "\n";
     }
-    o << "  drift rate: " << fmt(C.rate_per_cycle, 4) << " +- " << fmt(C.rate_per_cycle_se, 4)
+    o << "  drift rate: " << format_fixed(C.rate_per_cycle, 4) << " +- " << format_fixed(C.rate_per_cycle_se, 4)
       << " " << u << "/cycle";
     if (std::isfinite(C.rate_per_h))
-      o << ", " << fmt(C.rate_per_h, 4) << " +- " << fmt(C.rate_per_h_se, 4) << " " << u << "/h";
+      o << ", " << format_fixed(C.rate_per_h, 4) << " +- " << format_fixed(C.rate_per_h_se, 4) << " " << u << "/h";
     o << "\n";
   } else {
     o << "\nDrift elimination: needs at least 2 targets (skipped).\n";

@@ -18,7 +18,6 @@ const char* const kUpColour = "#1f77b4";    // forward (↑)
 const char* const kDownColour = "#d62728";  // reverse (↓)
 
 std::string h(const std::string& s) { return xml_escape(s); }
-std::string num(double v, int decimals = 3) { return format_fixed(v, decimals); }
 
 bool word_char(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }
 
@@ -97,7 +96,7 @@ std::string figures_table(const IsoFigures& F, const std::string& set, const std
   auto cell = [&](const char* key, double IsoFigures::*f) {
     if (!key) return std::string("<td class=\"num na\">\xE2\x80\x93</td>");
     return "<td class=\"num\"><span data-set=\"" + set + "\" data-key=\"" + key + "_um\">" +
-           num(F.*f) + "</span>" + limit_of(key) + "</td>";
+           format_fixed(F.*f, 3) + "</span>" + limit_of(key) + "</td>";
   };
   std::ostringstream o;
   o << "<table class=\"figures\"><thead><tr><th>Figure (" << unit_html(u)
@@ -108,7 +107,7 @@ std::string figures_table(const IsoFigures& F, const std::string& set, const std
       << cell(r.bi, r.f_bi) << cell(r.up, r.f_up) << cell(r.down, r.f_down) << "</tr>\n";
   }
   o << "<tr class=\"k\"><td>Coverage factor</td><td class=\"sym\">k</td><td></td><td class=\"num\">"
-    << num(F.k_up, 2) << "</td><td class=\"num\">" << num(F.k_down, 2) << "</td></tr>\n";
+    << format_fixed(F.k_up, 2) << "</td><td class=\"num\">" << format_fixed(F.k_down, 2) << "</td></tr>\n";
   o << "</tbody></table>\n";
   return o.str();
 }
@@ -188,7 +187,7 @@ void environment_table(std::ostream& o, const NormalisationResult& n) {
     std::string source;
   };
   const std::string air_source =
-      n.air_applied ? "Edl\xC3\xA9n (Birch & Downs), " + num(n.wavelength_nm, 3) + " nm" : "";
+      n.air_applied ? "Edl\xC3\xA9n (Birch & Downs), " + format_fixed(n.wavelength_nm, 3) + " nm" : "";
   const Row rows[] = {
       {"Material temperature", n.material_temperature_C, 1, 2,
        "\xC2\xB0"
@@ -205,7 +204,7 @@ void environment_table(std::ostream& o, const NormalisationResult& n) {
       {"Air correction \xCE\xB4<sub>air</sub>", n.air_correction_um, 1, 3, "\xC2\xB5m", ""},
       {"Expansion correction \xCE\xB4<sub>T</sub>", n.material_correction_um, 1, 3, "\xC2\xB5m",
        n.material_applied
-           ? "\xCE\xB1 = " + num(n.expansion_ppm_per_K, 2) + " \xC2\xB5m/(m\xC2\xB7K)"
+           ? "\xCE\xB1 = " + format_fixed(n.expansion_ppm_per_K, 2) + " \xC2\xB5m/(m\xC2\xB7K)"
            : ""}};
   bool any = false;
   for (const Row& r : rows) any |= !r.v.empty();
@@ -216,7 +215,7 @@ void environment_table(std::ostream& o, const NormalisationResult& n) {
     if (r.v.empty()) continue;
     o << "<tr><td>" << r.name << "</td>";
     for (double v : {r.v.min, r.v.mean, r.v.max})
-      o << "<td class=\"num\">" << num(v * r.scale, r.decimals) << "</td>";
+      o << "<td class=\"num\">" << format_fixed(v * r.scale, r.decimals) << "</td>";
     o << "<td>" << r.unit << "</td><td>" << h(r.source) << "</td></tr>\n";
   }
   o << "</table>\n";
@@ -390,9 +389,9 @@ std::string iso230_2_html(const std::string& data, const Iso230_2StudyResult& re
   if (res.classical.student) {
     const IsoFigures& S = *res.classical.student;
     o << "<p>With the Student-t coverage factor for " << runs.cycles[kUp].size()
-      << " cycles (k = " << num(S.k_up, 2) << " / " << num(S.k_down, 2)
-      << "): A = <span data-set=\"student\" data-key=\"A_um\">" << num(S.A) << "</span> "
-      << pretty(u) << ", R = <span data-set=\"student\" data-key=\"R_um\">" << num(S.R)
+      << " cycles (k = " << format_fixed(S.k_up, 2) << " / " << format_fixed(S.k_down, 2)
+      << "): A = <span data-set=\"student\" data-key=\"A_um\">" << format_fixed(S.A, 3) << "</span> "
+      << pretty(u) << ", R = <span data-set=\"student\" data-key=\"R_um\">" << format_fixed(S.R, 3)
       << "</span> " << pretty(u) << ".</p>\n";
   }
   if (!res.tolerance.empty()) {
@@ -403,7 +402,7 @@ std::string iso230_2_html(const std::string& data, const Iso230_2StudyResult& re
         << (c.name == "band" ? std::string("every x\xCC\x84 \xC2\xB1 2s within \xC2\xB1 limit")
                              : h(c.name))
         << "</td><td class=\"num\" data-set=\"tolerance\" data-key=\"" << h(c.name) << "\">"
-        << num(c.value) << "</td><td class=\"num\">" << format_number(c.limit)
+        << format_fixed(c.value, 3) << "</td><td class=\"num\">" << format_number(c.limit)
         << "</td><td class=\"" << (c.pass ? "pass\">pass" : "fail\">FAIL") << "</td></tr>\n";
     o << "</tbody></table>\n";
   }
@@ -422,7 +421,7 @@ std::string iso230_2_html(const std::string& data, const Iso230_2StudyResult& re
   for (std::size_t i = 0; i < m; ++i) {
     auto td = [&](const char* k, double v) {
       return "<td class=\"num\" data-set=\"classical\" data-key=\"" + std::string(k) +
-             "\" data-index=\"" + std::to_string(i) + "\">" + num(v) + "</td>";
+             "\" data-index=\"" + std::to_string(i) + "\">" + format_fixed(v, 3) + "</td>";
     };
     o << "<tr><td class=\"num\">" << format_number(P[i]) << "</td>"
       << td("mean_up_um", F.mean_up[i]) << td("mean_down_um", F.mean_down[i])
@@ -430,9 +429,9 @@ std::string iso230_2_html(const std::string& data, const Iso230_2StudyResult& re
       << td("R_i_up_um", F.R_i_up[i]) << td("R_i_down_um", F.R_i_down[i]) << td("R_i_um", F.R_i[i])
       << td("mean_bi_um", F.mean_bi[i]);
     if (D)
-      o << "<td class=\"num\">" << num(D->chart[kUp].value[i]) << "</td><td class=\"num\">"
-        << num(D->chart[kUp].s[i]) << "</td><td class=\"num\">" << num(D->chart[kDown].value[i])
-        << "</td><td class=\"num\">" << num(D->chart[kDown].s[i]) << "</td>";
+      o << "<td class=\"num\">" << format_fixed(D->chart[kUp].value[i], 3) << "</td><td class=\"num\">"
+        << format_fixed(D->chart[kUp].s[i], 3) << "</td><td class=\"num\">" << format_fixed(D->chart[kDown].value[i], 3)
+        << "</td><td class=\"num\">" << format_fixed(D->chart[kDown].s[i], 3) << "</td>";
     o << "</tr>\n";
   }
   o << "</tbody></table></section>\n";
@@ -452,10 +451,10 @@ std::string iso230_2_html(const std::string& data, const Iso230_2StudyResult& re
     cyc.width = 760;
     cyc.height = 300;
     o << "<section id=\"drift\"><h2>Thermal drift</h2>\n<figure>" << svg_chart(cyc)
-      << "</figure>\n<p>Drift rate " << num(C.rate_per_cycle, 4) << " \xC2\xB1 "
-      << num(C.rate_per_cycle_se, 4) << " " << pretty(u) << " per cycle";
+      << "</figure>\n<p>Drift rate " << format_fixed(C.rate_per_cycle, 4) << " \xC2\xB1 "
+      << format_fixed(C.rate_per_cycle_se, 4) << " " << pretty(u) << " per cycle";
     if (std::isfinite(C.rate_per_h))
-      o << ", " << num(C.rate_per_h, 4) << " \xC2\xB1 " << num(C.rate_per_h_se, 4) << " "
+      o << ", " << format_fixed(C.rate_per_h, 4) << " \xC2\xB1 " << format_fixed(C.rate_per_h_se, 4) << " "
         << pretty(u) << "/h";
     o << " (within-group least squares, standard error). Anomaly test (F test of each adjacent "
          "difference, Bonferroni over "
