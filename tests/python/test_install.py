@@ -10,7 +10,10 @@ def test_installed_module_imports_and_opens_a_machine(tmp_path):
     subprocess.run([os.environ["WEILGEN_CMAKE"], "--install", os.environ["WEILGEN_BUILD_DIR"],
                     "--prefix", str(prefix)], check=True, capture_output=True)
     site = prefix / os.environ["WEILGEN_PYTHON_INSTALL_DIR"]
-    assert any(p.name.startswith("weilgen.") and p.suffix == ".so" for p in site.iterdir())
+    package = site / "weilgen"
+    assert any(p.name.startswith("_weilgen.") and p.suffix == ".so" for p in package.iterdir())
+    for name in ("__init__.py", "__init__.pyi", "py.typed", "_flags.json", "_verbs.py"):
+        assert (package / name).is_file(), name
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "WEILGEN_MACHINES_DIR")}
     env["PYTHONPATH"] = str(site)
     script = ("import weilgen, numpy as np; print(weilgen.__file__); "
