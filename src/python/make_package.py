@@ -19,6 +19,7 @@ import subprocess
 import sys
 import textwrap
 
+sys.dont_write_bytecode = True  # a build never writes into the source tree
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "weilgen"))
 import _parity  # noqa: E402  (the package's own list, read before the package exists)
 

@@ -51,9 +51,9 @@ def _flatten(record, prefix=""):
         name = prefix + key
         if isinstance(value, dict):
             out.update(_flatten(value, "" if key == "pose" and not prefix else name + "."))
-        elif (isinstance(value, np.ndarray) and value.shape == (2,)
-              and key.lower().endswith("ci")):
-            out[name + "_lo"], out[name + "_hi"] = value.tolist()
+        elif (isinstance(value, (np.ndarray, list)) and len(value) == 2
+              and key.lower().endswith("ci")):  # an array, or a list from json.load
+            out[name + "_lo"], out[name + "_hi"] = list(value)
         else:
             out[name] = value
     return out
