@@ -45,7 +45,7 @@ def _flatten(record, prefix=""):
     """A record as one level: the pose's axes as columns of their own, other dicts as
     'key.sub', an interval (a '*ci' pair) as key_lo and key_hi."""
     out = {}
-    first = [k for k in ("pose", "output", "error") if k in record and not prefix]
+    first = [k for k in ("pose", "output", "error", "name") if k in record and not prefix]
     for key in first + [k for k in record if k not in first]:
         value = record[key]
         name = prefix + key
