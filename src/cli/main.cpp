@@ -25,7 +25,7 @@ const std::map<std::string, Verb>& verbs() {
 #ifndef WEILGEN_CODEGEN_ONLY
       {"show",
        {weilgen::cli::verb_show,
-        "show <machine> [--output dx] [--format text|latex|json] [--notation iso|alias]\n"
+        "show <machine> [--output dx] [--format text|latex|json|sympy] [--notation iso|alias]\n"
         "      [--order r]\n"
         "      print the closed-form error expressions"}},
       {"list", {weilgen::cli::verb_list, "list\n      list the shipped machines"}},

@@ -68,7 +68,7 @@ def annotation(flag):
         return "Optional[int]"
     if kind == "repeatable" or name in STRUCTURED_TEXT:
         return "Optional[_Items]"
-    return "Optional[_Text]"
+    return "Optional[_Text]" if flag["name"] in PATHS else "Optional[_Value]"
 
 
 def type_words(flag):

@@ -81,6 +81,8 @@ def test_nan_inf_and_none_name_row_and_column(vmc, bad):
         vmc.deviation(np.array(axes[:2] * 2)[:3] * 0 - 10, errors)
     with pytest.raises(ValueError, match=r"coefficients: axes row 0, column X \(mm\)"):
         vmc.coefficients({"X": [bad], "Y": [-1], "Z": [0]})
+    with pytest.raises(ValueError, match=r"deviation: params: tool_length is nan"):
+        vmc.deviation(np.zeros(3) - 1, np.zeros(21), params={"tool_length": float("nan")})
     # check=False: no check, the value goes through (hot loops).
     out = vmc.deviation(np.array(axes, dtype=float), np.zeros(21), check=False)
     assert np.isfinite(out[:2]).all()

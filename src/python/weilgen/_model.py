@@ -1,5 +1,6 @@
 """weilgen.Model: the extension's model with named inputs, checked values, closed forms and
 pickling (docs/python.md, 'weilgen.Model')."""
+import math
 import os
 import warnings
 from collections.abc import Mapping
@@ -117,6 +118,21 @@ class Model(_weilgen.Model):
                     "check=False skips this check)" % (function, what, row, names[col], units[col], v))
         return array
 
+    def _check_params(self, function, params):
+        if params is None:
+            return
+        items = params.items() if isinstance(params, Mapping) else \
+            zip(self.params, np.ravel(np.asarray(params, dtype=object)))
+        for name, value in items:
+            try:
+                finite = value is not None and math.isfinite(float(value))
+            except (TypeError, ValueError):
+                continue  # not a number: the extension says what is wrong
+            if not finite:
+                raise _weilgen.ArgumentError(
+                    "%s: params: %s is %r, not a finite number (check=False skips this check)"
+                    % (function, name, value))
+
     def _warn_travel(self, function, axes):
         rows = np.atleast_2d(axes)
         if rows.ndim != 2 or rows.shape[-1] != len(self.axes):
@@ -163,6 +179,7 @@ class Model(_weilgen.Model):
         a = self._rows("deviation", axes, "axes", self.axes, self.axis_units, None, check)
         e = self._rows("deviation", errors, "errors", self.errors, self.error_units, 0.0, check)
         if check:
+            self._check_params("deviation", params)
             self._warn_travel("deviation", a)
         return _weilgen.Model.deviation(self, a, e, params)
 
@@ -174,10 +191,11 @@ class Model(_weilgen.Model):
         """
         a = self._rows("coefficients", axes, "axes", self.axes, self.axis_units, None, check)
         if check:
+            self._check_params("coefficients", params)
             self._warn_travel("coefficients", a)
         return _weilgen.Model.coefficients(self, a, params)
 
-    def closed_form(self, output=None, *, notation="iso", format="text"):
+    def closed_form(self, output=None, notation="iso", format="text"):
         """The closed-form deviation, as `weilgen show` prints it.
 
         Parameters
