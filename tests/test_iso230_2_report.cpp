@@ -177,8 +177,9 @@ TEST_CASE("iso230-2 --report: writes the HTML with the JSON, bad targets are ref
   CHECK(r.status == 3);  // the small example has no T_table column
   r = run(cli("iso230-2 " + small_csv() + " --expansion 11.5 --material-temperature 20"));
   CHECK(r.status == 0);
-  CHECK(r.out.find("Normalised to 20 degC (ISO 1): expansion coefficient 11.5 um/(m K), material "
-                   "temperature 20.00 degC [--material-temperature]") != std::string::npos);
+  CHECK(r.out.find("Normalised to 20 degC by weilgen (ISO 1; --normalise auto): corrected with "
+                   "alpha 11.5 um/(m K) (--expansion); material temperature 20.00 degC "
+                   "[--material-temperature]") != std::string::npos);
 }
 
 TEST_CASE("iso230-2 --csv and --plot: the per-target table equals the JSON, refusals come first") {

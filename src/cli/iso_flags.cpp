@@ -16,6 +16,11 @@ po::options_description iso_options(IsoFlags& f) {
   o.add_options()("format", po::value<std::string>(&f.format)->default_value(f.format),
                   "the data file's layout: auto, tidy, carto (Renishaw XL-80/CARTO wide CSV) or "
                   "wide (docs/data-format.md, 'Instrument files')")(
+      "normalise", po::value<std::string>(&f.normalise)->default_value(f.normalise),
+      "corrections the instrument may already have applied: auto (never one the file says the "
+      "instrument applied; docs/iso230-2.md, 'Instrument compensation state'), force (normalise "
+      "to 20 degC with the coefficient given, and allow --air-compensation edlen, whatever the "
+      "file says) or never (no correction by weilgen)")(
       "expansion", ranged(&f.expansion_ppm_per_K, NumberRange::closed(-100, 100)),
       "expansion coefficient of the machine's material, um/(m K) = ppm/K: normalise the "
       "deviations to 20 degC (default: header key expansion_ppm_per_K, else none)")(
@@ -51,6 +56,7 @@ void apply_iso_flags(const IsoFlags& f, const po::variables_map& vm, Iso230_2Stu
                      ImportOptions& imp) {
   if (lower(f.format) != "auto") imp.format = parse_instrument_format(f.format);
   NormalisationOptions& n = s.normalisation;
+  n.mode = parse_normalise_mode(f.normalise);
   if (vm.count("expansion")) n.expansion_ppm_per_K = f.expansion_ppm_per_K;
   if (vm.count("wavelength")) n.wavelength_nm = f.wavelength_nm;
   if (vm.count("air-index-assumed")) n.assumed_index = f.air_index_assumed;

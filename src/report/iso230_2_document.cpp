@@ -125,53 +125,55 @@ std::vector<std::string> iso230_2_normalisation_statement(const Iso230_2StudyRes
   const std::string datum = res.columns.axis + " = " + format_number(n.datum_mm) + " mm";
   std::vector<std::string> out;
   const std::string tm =
-      with_source(range_text(n.material_temperature_C, 2, "degC"), n.material_source);
+      n.material_temperature_C.empty()
+          ? std::string("no material temperature recorded")
+          : "material temperature " +
+                with_source(range_text(n.material_temperature_C, 2, "degC"), n.material_source);
   if (n.material_applied) {
     out.push_back("Normalised to " + format_number(n.reference_temperature_C) +
-                  " degC (ISO 1): expansion coefficient " + format_number(n.expansion_ppm_per_K) +
-                  " um/(m K), material temperature " + tm +
+                  " degC by weilgen (ISO 1; --normalise " + to_string(n.mode) +
+                  "): " + n.material_decision + "; " + tm +
                   "; correction -alpha (T - 20 degC) L, L the travel from the datum " + datum +
                   ": " + range_text(n.material_correction_um, 3, "um") + ".");
-  } else if (!n.material_temperature_C.empty()) {
-    out.push_back(
-        "Not normalised to 20 degC (no expansion coefficient: --expansion or the header "
-        "key expansion_ppm_per_K); material temperature " +
-        tm + ".");
+  } else if (n.material_compensation == "instrument") {
+    out.push_back("Normalised to 20 degC by the instrument, not by weilgen (--normalise " +
+                  std::string(to_string(n.mode)) + "): " + n.material_decision + "; " + tm + ".");
   } else {
-    out.push_back(
-        "Not normalised to 20 degC: no expansion coefficient and no material "
-        "temperature recorded.");
+    out.push_back("Not normalised to 20 degC (--normalise " + std::string(to_string(n.mode)) +
+                  "): " + n.material_decision + "; " + tm + ".");
   }
   const std::string air = air_readings(n);
+  const std::string recorded = air.empty() ? std::string(".") : "; air as recorded: " + air + ".";
+  if (n.air_applied) {
+    out.push_back(
+        "Air refraction corrected by weilgen with the modified Edlen equation of "
+        "Birch & Downs (1993, corrected 1994) (" +
+        n.air_decision + "), vacuum wavelength " + format_number(n.wavelength_nm) + " nm, air " +
+        air + ": n - 1 = " + format_significant(n.air_refractivity.min, 6) + " .. " +
+        format_significant(n.air_refractivity.max, 6) + "; readings counted with n0 = " +
+        format_number(n.assumed_index) + "; correction L (n0/n - 1) from the datum " + datum +
+        ": " + range_text(n.air_correction_um, 3, "um") + ".");
+    return out;
+  }
   switch (n.air) {
-    case AirCompensation::Edlen:
-      out.push_back(
-          "Air refraction corrected by weilgen with the modified Edlen equation of "
-          "Birch & Downs (1993, corrected 1994), vacuum wavelength " +
-          format_number(n.wavelength_nm) + " nm, air " + air +
-          ": n - 1 = " + format_significant(n.air_refractivity.min, 6) + " .. " +
-          format_significant(n.air_refractivity.max, 6) + "; readings counted with n0 = " +
-          format_number(n.assumed_index) + "; correction L (n0/n - 1) from the datum " + datum +
-          ": " + range_text(n.air_correction_um, 3, "um") + ".");
-      break;
     case AirCompensation::Instrument:
-      out.push_back("Air refraction compensated by the instrument" +
-                    (air.empty() ? std::string(".") : "; air as recorded: " + air + "."));
+      out.push_back("Air refraction compensated by the instrument: " + n.air_decision + recorded);
       break;
     case AirCompensation::None:
+    case AirCompensation::Edlen:
       out.push_back(
-          "Air refraction NOT compensated: the deviations include the refractive index "
-          "of the air (about 271 um per metre of travel at 20 degC, 101325 Pa, "
-          "50 %RH); --air-compensation edlen corrects them from the air's temperature, "
-          "pressure and humidity" +
-          (air.empty() ? std::string(".") : "; air as recorded: " + air + "."));
+          "Air refraction NOT compensated (" + n.air_decision +
+          "): the deviations include the refractive index of the air (about 271 um per metre of "
+          "travel at 20 degC, 101325 Pa, 50 %RH); --air-compensation edlen corrects them from "
+          "the air's temperature, pressure and humidity" +
+          recorded);
       break;
     case AirCompensation::Unstated:
       out.push_back(
-          "Air refraction: the file does not say whether the instrument compensated "
-          "it; weilgen corrected nothing (--air-compensation instrument|edlen|none or "
-          "the header key air_compensation states it)" +
-          (air.empty() ? std::string(".") : "; air as recorded: " + air + "."));
+          "Air refraction: " + n.air_decision +
+          "; weilgen corrected nothing (--air-compensation instrument|edlen|none or the header "
+          "key air_compensation states it)" +
+          recorded);
       break;
   }
   return out;
@@ -363,15 +365,23 @@ nlohmann::json iso230_2_json(const std::string& data, const Iso230_2StudyResult&
     j["normalisation"] = {
         {"reference_temperature_C", n.reference_temperature_C},
         {"datum_mm", json_number(n.datum_mm)},
+        {"mode", to_string(n.mode)},
+        {"warnings", n.warnings},
         {"material",
          {{"applied", n.material_applied},
+          {"instrument_state",
+           n.material_compensation.empty() ? json() : json(n.material_compensation)},
+          {"decision", n.material_decision},
+          {"expansion_source", n.expansion_origin.empty() ? json() : json(n.expansion_origin)},
           {"expansion_ppm_per_K", json_number(n.expansion_ppm_per_K)},
           {"temperature_source", n.material_source.empty() ? json() : json(n.material_source)},
           {"temperature_C", range_json(n.material_temperature_C)},
           {"correction_um", range_json(n.material_correction_um)}}},
         {"air",
          {{"compensation", to_string(n.air)},
+          {"instrument_state", to_string(n.air_in_file)},
           {"applied", n.air_applied},
+          {"decision", n.air_decision},
           {"equation", n.air_applied ? json("modified Edlen equation, Birch & Downs, Metrologia 30 "
                                             "(1993) 155 and 31 (1994) 315")
                                      : json()},
