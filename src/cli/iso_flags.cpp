@@ -48,7 +48,9 @@ po::options_description iso_options(IsoFlags& f) {
       "tolerances in the deviation unit: a band +-T ('10'), figure limits ('A=12,R=6,B=4') or "
       "both ('10,A=12'); verdicts in the text, JSON and report")(
       "report", po::value<std::string>(&f.report),
-      "write the test report as one self-contained HTML file (charts inline)");
+      "write the test report as one self-contained HTML file (charts inline)")(
+      "iso-only",
+      "only the figures ISO 230-2 defines: no Student-t set, no drift-eliminated evaluation");
   return o;
 }
 
@@ -57,6 +59,7 @@ void apply_iso_flags(const IsoFlags& f, const po::variables_map& vm, Iso230_2Stu
   if (lower(f.format) != "auto") imp.format = parse_instrument_format(f.format);
   NormalisationOptions& n = s.normalisation;
   n.mode = parse_normalise_mode(f.normalise);
+  s.iso_only = vm.count("iso-only") > 0;
   if (vm.count("expansion")) n.expansion_ppm_per_K = f.expansion_ppm_per_K;
   if (vm.count("wavelength")) n.wavelength_nm = f.wavelength_nm;
   if (vm.count("air-index-assumed")) n.assumed_index = f.air_index_assumed;

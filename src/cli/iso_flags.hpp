@@ -22,7 +22,7 @@ struct IsoFlags {
 // --format, --normalise, --expansion, --material-temperature, --air-compensation,
 // --air-temperature,
 // --air-pressure, --air-humidity, --wavelength, --air-index-assumed, --datum, --tolerance,
-// --report.
+// --report, --iso-only.
 boost::program_options::options_description iso_options(IsoFlags& flags);
 
 // The flags into the study's options and the import's (std::invalid_argument naming the flag);

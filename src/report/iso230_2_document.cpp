@@ -78,14 +78,24 @@ void add_cycles(LinePlot& p, const std::vector<std::vector<double>>& x, const st
   }
 }
 
+// The mean as a line and mean ± k s as a shaded band under it.
 void add_band(LinePlot& p, const std::vector<double>& mean, const std::vector<double>& s, double k,
-              const std::string& label) {
-  std::vector<double> lo, hi;
+              const std::string& label, const std::string& s_name = "s") {
+  LineBand band{label + " +-" + format_number(k) + s_name, {}, {}, p.lines.size()};
   for (std::size_t i = 0; i < mean.size(); ++i)
-    lo.push_back(mean[i] - k * s[i]), hi.push_back(mean[i] + k * s[i]);
+    band.lo.push_back(mean[i] - k * s[i]), band.hi.push_back(mean[i] + k * s[i]);
+  p.bands.push_back(band);
   p.lines.emplace_back(label, mean);
-  p.lines.emplace_back(label + " +" + format_number(k) + "s", hi);
-  p.lines.emplace_back(label + " -" + format_number(k) + "s", lo);
+}
+
+// The +-T lines of a band tolerance.
+void add_tolerance_rules(LinePlot& p, const std::vector<ToleranceCheck>& checks,
+                         const std::string& unit) {
+  for (const ToleranceCheck& c : checks)
+    if (c.name == "band") {
+      p.rules.push_back({"tolerance +-" + format_number(c.limit) + " " + unit, c.limit});
+      p.rules.push_back({"", -c.limit});
+    }
 }
 
 std::string range_text(const ValueRange& r, int decimals, const std::string& unit) {
@@ -184,16 +194,50 @@ std::vector<std::string> iso230_2_tolerance_statement(const Iso230_2StudyResult&
   if (res.tolerance.empty()) return out;
   const std::string u = res.columns.unit;
   std::vector<std::string> failed;
+  bool with_u = false;
   for (const ToleranceCheck& c : res.tolerance) {
     std::ostringstream l;
     l << "  " << std::left << std::setw(8) << (c.name == "band" ? std::string("|x +- 2s|") : c.name)
-      << std::right << std::setw(10) << fmt(c.value) << " " << u << (c.pass ? " <= " : " >  ")
-      << std::setw(8) << format_number(c.limit) << " " << u << "  " << (c.pass ? "pass" : "FAIL");
+      << std::right << std::setw(10) << fmt(c.value) << " " << u;
+    if (std::isfinite(c.U)) {
+      with_u = true;
+      l << " +- " << std::setw(6) << fmt(c.U) << " (U)";
+    }
+    l << (c.pass ? " <= " : " >  ") << std::setw(8) << format_number(c.limit) << " " << u << "  "
+      << (c.decision == Decision::Conforms         ? "pass"
+          : c.decision == Decision::DoesNotConform ? "FAIL"
+                                                   : "not proven");
     out.push_back(l.str());
-    if (!c.pass) failed.push_back(c.name);
+    if (c.decision == Decision::DoesNotConform) failed.push_back(c.name);
   }
-  out.push_back(failed.empty() ? "  verdict: PASS (the classical ISO 230-2 figures, k = 2)"
-                               : "  verdict: FAIL (" + join(failed) + " out of tolerance)");
+  out.push_back(with_u ? "  decided on the classical ISO 230-2 figures (k = 2) with their "
+                         "expanded uncertainty U (ISO 14253-1)"
+                       : "  decided on the classical ISO 230-2 figures (k = 2) without their "
+                         "uncertainty (--uncertainty gives it)");
+  switch (res.verdict) {
+    case Decision::Conforms:
+      out.push_back("  verdict: PASS");
+      break;
+    case Decision::DoesNotConform:
+      out.push_back("  verdict: FAIL (" + join(failed) + " out of tolerance)");
+      break;
+    case Decision::NotProven:
+      out.push_back("  verdict: NOT PROVEN (" + res.verdict_reason + ")");
+      break;
+  }
+  return out;
+}
+
+std::vector<std::string> iso230_2_conformance_statement(const Iso230_2StudyResult& res) {
+  if (res.conformance.empty())
+    return {
+        "The run meets the test conditions of ISO 230-2:2014 that weilgen checks (targets, "
+        "5 bidirectional cycles, air compensated, temperature corrected or stated)."};
+  std::vector<std::string> out = {
+      "NOT to ISO 230-2:2014: the figures are evaluated after the standard, but the run does not "
+      "meet its test conditions:"};
+  for (const ConformanceIssue& i : res.conformance)
+    out.push_back("- " + i.check + ": " + i.message);
   return out;
 }
 
@@ -211,6 +255,9 @@ std::string iso230_2_text(const std::string& data, const Iso230_2StudyResult& re
   o << "weilgen iso230-2: " << data << ", axis " << cols.axis << " (deviation " << cols.deviation
     << "), " << m << " target" << (m == 1 ? "" : "s") << ", " << runs.cycles[kUp].size()
     << " cycles up, " << runs.cycles[kDown].size() << " cycles down\n\n";
+  o << (res.iso_conforming() ? "Conformance\n" : "Conformance: NOT to ISO 230-2\n");
+  for (const auto& line : iso230_2_conformance_statement(res)) o << "  " << line << "\n";
+  o << "\n";
   o << "Normalisation and air (ISO 230-2:2014, ISO 1)\n";
   for (const auto& line : iso230_2_normalisation_statement(res)) o << "  " << line << "\n";
   o << "\n";
@@ -243,14 +290,14 @@ std::string iso230_2_text(const std::string& data, const Iso230_2StudyResult& re
                       {"A up", "unidirectional accuracy +", &IsoFigures::A_up},
                       {"A down", "unidirectional accuracy -", &IsoFigures::A_down},
                       {"A", "bidirectional accuracy", &IsoFigures::A}};
-  const IsoFigures* sets[4] = {&F, cr.student ? &*cr.student : nullptr,
-                               drift ? &drift->figures : nullptr,
-                               drift && drift->student ? &*drift->student : nullptr};
-  o << "\n"
-    << std::left << std::setw(46) << "Axis figures (" + u + ")" << std::right << std::setw(12)
-    << "classical" << std::setw(12) << "Student-t" << std::setw(12) << "drift-elim."
-    << std::setw(12) << "drift+t"
-    << "\n";
+  std::vector<const IsoFigures*> sets = {&F, cr.student ? &*cr.student : nullptr,
+                                         drift ? &drift->figures : nullptr,
+                                         drift && drift->student ? &*drift->student : nullptr};
+  std::vector<std::string> names = {"classical", "Student-t", "drift-elim.", "drift+t"};
+  if (res.iso_only) sets.resize(1), names.resize(1);  // only what ISO 230-2 defines
+  o << "\n" << std::left << std::setw(46) << "Axis figures (" + u + ")" << std::right;
+  for (const std::string& name : names) o << std::setw(12) << name;
+  o << "\n";
   for (const Row& r : rows) {
     o << "  " << std::left << std::setw(7) << r.name << std::setw(37) << r.what << std::right;
     for (const IsoFigures* s : sets) o << std::setw(12) << (s ? fmt(s->*(r.field)) : "-");
@@ -330,6 +377,8 @@ std::string iso230_2_text(const std::string& data, const Iso230_2StudyResult& re
     if (std::isfinite(C.rate_per_h))
       o << ", " << fmt(C.rate_per_h, 4) << " +- " << fmt(C.rate_per_h_se, 4) << " " << u << "/h";
     o << "\n";
+  } else if (res.iso_only) {
+    o << "\nDrift elimination and the Student-t set: off (--iso-only).\n";
   } else {
     o << "\nDrift elimination: needs at least 2 targets (skipped).\n";
   }
@@ -360,6 +409,13 @@ nlohmann::json iso230_2_json(const std::string& data, const Iso230_2StudyResult&
          {"positions_mm", P},
          {"coverage_factor", F.k_up}};
     j["source_format"] = source_format;
+    json issues = json::array();
+    for (const ConformanceIssue& i : res.conformance)
+      issues.push_back({{"check", i.check}, {"message", i.message}});
+    j["conformance"] = {{"iso230_2", res.iso_conforming()},
+                        {"issues", issues},
+                        {"statement", iso230_2_conformance_statement(res)}};
+    j["iso_only"] = res.iso_only;
     j["metadata"] = res.header_keys;
     const NormalisationResult& n = res.normalisation;
     j["normalisation"] = {
@@ -399,15 +455,17 @@ nlohmann::json iso230_2_json(const std::string& data, const Iso230_2StudyResult&
       j["tolerance"] = json();
     } else {
       json checks = json::array();
-      bool pass = true;
-      for (const ToleranceCheck& c : res.tolerance) {
+      for (const ToleranceCheck& c : res.tolerance)
         checks.push_back({{"name", c.name},
                           {"value_um", json_number(c.value)},
                           {"limit_um", json_number(c.limit)},
-                          {"pass", c.pass}});
-        pass = pass && c.pass;
-      }
-      j["tolerance"] = {{"checks", checks}, {"pass", pass}};
+                          {"U_um", json_number(c.U)},
+                          {"decision", to_string(c.decision)},
+                          {"pass", c.decision == Decision::Conforms}});
+      j["tolerance"] = {{"checks", checks},
+                        {"pass", res.verdict == Decision::Conforms},
+                        {"verdict", to_string(res.verdict)},
+                        {"reason", res.verdict_reason.empty() ? json() : json(res.verdict_reason)}};
     }
     if (drift) {
       const DriftResult& D = *drift;
@@ -510,6 +568,7 @@ std::vector<Panel> iso230_2_panels(const Iso230_2StudyResult& res) {
     LinePlot c2{"ISO 230-2: mean deviations and +-2s", xlabel, ylabel, P, {}};
     add_band(c2, F.mean_up, F.s_up, 2, "mean up");
     add_band(c2, F.mean_down, F.s_down, 2, "mean down");
+    add_tolerance_rules(c2, res.tolerance, u);
     panels.push_back(c2);
     if (drift) {
       const DriftResult& D = *drift;
@@ -520,8 +579,9 @@ std::vector<Panel> iso230_2_panels(const Iso230_2StudyResult& res) {
       add_cycles(c3, D.chart[kDown].shifted, "cycles down");
       panels.push_back(c3);
       LinePlot c4{"drift eliminated: chart from " + ref + ", +-2s*", xlabel, ylabel, P, {}};
-      add_band(c4, D.chart[kUp].value, D.chart[kUp].s, 2, "chart up");
-      add_band(c4, D.chart[kDown].value, D.chart[kDown].s, 2, "chart down");
+      add_band(c4, D.chart[kUp].value, D.chart[kUp].s, 2, "chart up", "s*");
+      add_band(c4, D.chart[kDown].value, D.chart[kDown].s, 2, "chart down", "s*");
+      add_tolerance_rules(c4, res.tolerance, u);
       panels.push_back(c4);
       BarChart c5{"s of adjacent differences (seed Fig. 10)", "s (" + u + ")", {}, {}};
       BarSeries su{"up", D.differences[kUp].s, {}, {}}, sd{"down", D.differences[kDown].s, {}, {}};

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <set>
 #include <sstream>
+#include <tuple>
 
 #include "weilgen/base/format.hpp"
 #include "weilgen/base/version.hpp"
@@ -61,6 +62,13 @@ std::string pretty(const std::string& s) {
 
 std::string unit_html(const std::string& u) { return pretty(u); }
 
+std::string decision_class(Decision d) {
+  return d == Decision::Conforms ? "pass" : d == Decision::DoesNotConform ? "fail" : "open";
+}
+std::string decision_text(Decision d) {
+  return d == Decision::Conforms ? "PASS" : d == Decision::DoesNotConform ? "FAIL" : "NOT PROVEN";
+}
+
 // One figures table (bidirectional, forward, reverse) with data attributes naming the JSON keys.
 std::string figures_table(const IsoFigures& F, const std::string& set, const std::string& u,
                           const std::vector<ToleranceCheck>* checks) {
@@ -90,7 +98,7 @@ std::string figures_table(const IsoFigures& F, const std::string& set, const std
     if (!checks || !key) return "";
     for (const auto& c : *checks)
       if (c.name == key)
-        return " <span class=\"" + std::string(c.pass ? "pass" : "fail") + "\">" +
+        return " <span class=\"" + decision_class(c.decision) + "\">" +
                (c.pass ? "\xE2\x89\xA4 " : "&gt; ") + format_number(c.limit) + "</span>";
     return "";
   };
@@ -243,6 +251,12 @@ table.meta td:first-child { background: #f6f8fb; width: 150px; }
 figure { margin: 8px 0; }
 figcaption { color: #555; font-size: 12px; margin-top: 2px; }
 .pass { color: #1a7f37; font-weight: bold; }
+.open { color: #a15c00; font-weight: bold; }
+.banner { border: 2px solid #c62828; background: #fdecea; padding: 6px 10px; margin: 10px 0; }
+.banner p { margin: 0 0 4px; font-weight: bold; color: #c62828; }
+.banner ul { margin: 0; padding-left: 20px; }
+.warnings { border: 1px solid #a15c00; background: #fff4e0; padding: 6px 10px; margin: 8px 0; }
+td.fill { min-width: 260px; }
 .fail { color: #c62828; font-weight: bold; }
 .verdict { font-size: 15px; margin: 8px 0; }
 ul.statements li { margin: 3px 0; }
@@ -277,24 +291,43 @@ std::string iso230_2_html(const std::string& data, const Iso230_2StudyResult& re
     << "<meta name=\"generator\" content=\"weilgen " << kVersion << "\">\n<title>ISO 230-2 "
     << h(cols.axis) << (machine.empty() ? "" : " \xE2\x80\x93 " + h(machine)) << "</title>\n<style>"
     << kStyle << "</style>\n</head>\n<body>\n<main>\n";
-  // ---- Heading and identification.
-  o << "<header><h1>Positioning accuracy and repeatability \xE2\x80\x93 ISO 230-2:2014</h1>"
+  // ---- Heading, conformance and identification.
+  o << "<header><h1 data-key=\"title\">Positioning accuracy and repeatability \xE2\x80\x93 "
+    << (res.iso_conforming() ? std::string("ISO 230-2:2014")
+                             : std::string("evaluated after ISO 230-2:2014, not to ISO 230-2"))
+    << "</h1>"
     << "<p class=\"sub\">Axis " << h(cols.axis)
     << (machine.empty() ? "" : " \xC2\xB7 " + h(machine))
     << (key("date").empty() ? "" : " \xC2\xB7 " + h(key("date"))) << "</p></header>\n";
+  if (!res.iso_conforming()) {
+    o << "<section id=\"conformance\" class=\"banner\"><p>Not to ISO 230-2:2014: the run does not "
+         "meet the standard's test conditions.</p><ul>\n";
+    for (const ConformanceIssue& i : res.conformance)
+      o << "<li data-check=\"" << h(i.check) << "\">" << h(pretty(i.message)) << "</li>\n";
+    o << "</ul></section>\n";
+  }
+  if (!res.normalisation.warnings.empty()) {
+    o << "<section id=\"warnings\" class=\"warnings\"><ul>\n";
+    for (const std::string& w : res.normalisation.warnings)
+      o << "<li>" << h(pretty(w)) << "</li>\n";
+    o << "</ul></section>\n";
+  }
   o << "<section id=\"identification\"><h2>Test identification</h2>\n<table class=\"meta\">\n";
-  auto meta_row = [&](const std::string& label, const std::string& value, const std::string& k) {
-    if (value.empty()) return;
-    o << "<tr><td>" << label << "</td><td" << (k.empty() ? "" : " data-key=\"" + k + "\"") << ">"
-      << h(value) << "</td></tr>\n";
+  // Rows a signed report needs are kept when the file leaves them empty: blank, to fill in.
+  auto meta_row = [&](const std::string& label, const std::string& value, const std::string& k,
+                      bool keep_blank = false) {
+    if (value.empty() && !keep_blank) return;
+    o << "<tr><td>" << label << "</td><td" << (k.empty() ? "" : " data-key=\"" + k + "\"")
+      << (value.empty() ? " class=\"fill\"" : "") << ">" << h(value) << "</td></tr>\n";
   };
-  const std::pair<const char*, const char*> known[] = {
-      {"machine", "Machine"},   {"serial", "Serial number"}, {"title", "Test"},
-      {"customer", "Customer"}, {"location", "Location"},    {"date", "Test date"},
-      {"operator", "Operator"}, {"instrument", "Instrument"}};
+  const std::tuple<const char*, const char*, bool> known[] = {
+      {"machine", "Machine", true},   {"serial", "Serial number", true},
+      {"title", "Test", false},       {"customer", "Customer", false},
+      {"location", "Location", true}, {"date", "Test date", true},
+      {"operator", "Operator", true}, {"instrument", "Instrument", true}};
   std::set<std::string> shown;
-  for (const auto& [k, label] : known) {
-    meta_row(label, key(k), k);
+  for (const auto& [k, label, blank] : known) {
+    meta_row(label, key(k), k, blank);
     shown.insert(k);
   }
   meta_row("Axis", cols.axis + " (deviation " + cols.deviation + ", " + pretty(u) + ")", "axis");
@@ -318,6 +351,8 @@ std::string iso230_2_html(const std::string& data, const Iso230_2StudyResult& re
                                                   "laser_wavelength_nm",
                                                   "air_index_assumed",
                                                   "datum_mm",
+                                                  "material_compensation",
+                                                  "deviation_unit",
                                                   "format"};
     if (!shown.count(k) && !handled.count(k)) meta_row(k, v, k);
   }
@@ -363,11 +398,16 @@ std::string iso230_2_html(const std::string& data, const Iso230_2StudyResult& re
   }
   o << "<section id=\"results\"><h2>Results</h2>\n";
   if (!res.tolerance.empty()) {
-    bool pass = true;
-    for (const auto& c : res.tolerance) pass = pass && c.pass;
+    const bool pass = res.verdict == Decision::Conforms;
+    bool with_u = false;
+    for (const auto& c : res.tolerance) with_u |= std::isfinite(c.U);
     o << "<p class=\"verdict\" data-key=\"tolerance_pass\" data-value=\""
       << (pass ? "true" : "false") << "\">Verdict against the tolerances: <span class=\""
-      << (pass ? "pass\">PASS" : "fail\">FAIL") << "</span> (classical figures, k = 2)</p>\n";
+      << decision_class(res.verdict) << "\">" << decision_text(res.verdict) << "</span> ("
+      << (with_u ? "classical figures, k = 2, with their expanded uncertainty, ISO 14253-1"
+                 : "classical figures, k = 2, without their uncertainty")
+      << (res.verdict_reason.empty() ? std::string() : "; " + h(pretty(res.verdict_reason)))
+      << ")</p>\n";
   }
   o << "<div class=\"pair\">\n<div><h3>ISO 230-2 evaluation (k = 2)</h3>\n"
     << figures_table(F, "classical", u, &res.tolerance) << "<figure>" << svg_chart(classical)
@@ -383,7 +423,7 @@ std::string iso230_2_html(const std::string& data, const Iso230_2StudyResult& re
          "2. "
          "Thermal drift between cycles is removed; drift within a pass is not.</figcaption>"
          "</figure>\n</div>\n";
-  } else {
+  } else if (!res.iso_only) {
     o << "<div><h3>Drift-eliminated evaluation</h3><p>Needs at least 2 targets.</p></div>\n";
   }
   o << "</div>\n";
@@ -397,14 +437,16 @@ std::string iso230_2_html(const std::string& data, const Iso230_2StudyResult& re
   }
   if (!res.tolerance.empty()) {
     o << "<table class=\"tolerance\"><thead><tr><th>Tolerance</th><th>Value (" << pretty(u)
-      << ")</th><th>Limit (" << pretty(u) << ")</th><th>Result</th></tr></thead><tbody>\n";
+      << ")</th><th>U (" << pretty(u) << ")</th><th>Limit (" << pretty(u)
+      << ")</th><th>Result</th></tr></thead><tbody>\n";
     for (const auto& c : res.tolerance)
       o << "<tr><td>"
         << (c.name == "band" ? std::string("every x\xCC\x84 \xC2\xB1 2s within \xC2\xB1 limit")
                              : h(c.name))
         << "</td><td class=\"num\" data-set=\"tolerance\" data-key=\"" << h(c.name) << "\">"
-        << num(c.value) << "</td><td class=\"num\">" << format_number(c.limit)
-        << "</td><td class=\"" << (c.pass ? "pass\">pass" : "fail\">FAIL") << "</td></tr>\n";
+        << num(c.value) << "</td><td class=\"num\">" << num(c.U) << "</td><td class=\"num\">"
+        << format_number(c.limit) << "</td><td class=\"" << decision_class(c.decision) << "\">"
+        << decision_text(c.decision) << "</td></tr>\n";
     o << "</tbody></table>\n";
   }
   o << "</section>\n";

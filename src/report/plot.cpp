@@ -131,6 +131,11 @@ void check(const LinePlot& l) {
                        std::to_string(l.x.size()) + " x values");
     }
   }
+  for (const LineBand& b : l.bands)
+    if (b.lo.size() != l.x.size() || b.hi.size() != l.x.size())
+      bad(l.title, "band \"" + b.label + "\" has not one lo and hi per x");
+  for (const LineRule& r : l.rules)
+    if (!std::isfinite(r.y)) bad(l.title, "rule \"" + r.label + "\" is not finite");
 }
 
 void check(const StyledLinePlot& l) {
@@ -345,6 +350,7 @@ void line_script(std::ostringstream& s, const fs::path& dir, int index, const Li
       d << "\t" << num(line.second[i]);
       all_nan = all_nan && !std::isfinite(line.second[i]);
     }
+    for (const LineBand& b : l.bands) d << "\t" << num(b.lo[i]) << "\t" << num(b.hi[i]);
     d << "\n";
   }
   write_data(data, d.str());
@@ -356,11 +362,24 @@ void line_script(std::ostringstream& s, const fs::path& dir, int index, const Li
   s << "set offsets graph 0.02, graph 0.02, graph 0.05, graph 0.05\n";
   if (all_nan) s << "set yrange [0:1]\n";
   s << "plot ";
-  for (std::size_t k = 0; k < l.lines.size(); ++k) {
-    s << (k == 0 ? gq(data.string()) : std::string("''")) << " using 1:" << k + 2 << " with "
-      << style_text(styles.empty() ? LineStyle::LinesPoints : styles[k]) << " title "
-      << gq(l.lines[k].first) << (k + 1 < l.lines.size() ? ", \\\n     " : "\n");
+  // Bands first, under the lines; their columns follow the lines' in the data file.
+  for (std::size_t k = 0; k < l.bands.size(); ++k) {
+    const std::size_t lo = l.lines.size() + 2 + 2 * k;
+    s << (k == 0 ? gq(data.string()) : std::string("''")) << " using 1:" << lo << ":" << lo + 1
+      << " with filledcurves fs transparent solid 0.18 noborder"
+      << (l.bands[k].line < l.lines.size() ? " lt " + std::to_string(l.bands[k].line + 1) : "")
+      << " title " << gq(l.bands[k].label) << ", \\\n     ";
   }
+  for (std::size_t k = 0; k < l.lines.size(); ++k) {
+    s << (k == 0 && l.bands.empty() ? gq(data.string()) : std::string("''")) << " using 1:" << k + 2
+      << " with " << style_text(styles.empty() ? LineStyle::LinesPoints : styles[k]) << " lt "
+      << k + 1 << " title " << gq(l.lines[k].first)
+      << (k + 1 < l.lines.size() || !l.rules.empty() ? ", \\\n     " : "\n");
+  }
+  for (std::size_t k = 0; k < l.rules.size(); ++k)
+    s << num(l.rules[k].y) << " with lines dt 2 lw 1.5 lc rgb '#000000' "
+      << (l.rules[k].label.empty() ? std::string("notitle") : "title " + gq(l.rules[k].label))
+      << (k + 1 < l.rules.size() ? ", \\\n     " : "\n");
 }
 
 bool find_on_path(const std::string& program) {

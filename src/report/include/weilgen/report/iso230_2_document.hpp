@@ -23,6 +23,9 @@ nlohmann::json iso230_2_json(const std::string& data, const Iso230_2StudyResult&
 std::vector<std::string> iso230_2_normalisation_statement(const Iso230_2StudyResult& result);
 // The tolerance verdicts, one line each, and the overall verdict ("" without tolerances).
 std::vector<std::string> iso230_2_tolerance_statement(const Iso230_2StudyResult& result);
+// Whether the run meets ISO 230-2's test conditions: one line, or a heading and one "- check:
+// why" line per condition not met.
+std::vector<std::string> iso230_2_conformance_statement(const Iso230_2StudyResult& result);
 // The per-target table as CSV, one row per target: target_mm, the classical k = 2 columns
 // (mean_up_um ... R_i_um, mean_bi_um, the band lower_up_um = x̄↑ − 2s↑ ... upper_down_um) and,
 // with a drift-eliminated evaluation, chart_up_um, s_star_up_um, chart_down_um, s_star_down_um
