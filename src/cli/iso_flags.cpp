@@ -50,7 +50,12 @@ po::options_description iso_options(IsoFlags& f) {
       "report", po::value<std::string>(&f.report),
       "write the test report as one self-contained HTML file (charts inline)")(
       "iso-only",
-      "only the figures ISO 230-2 defines: no Student-t set, no drift-eliminated evaluation");
+      "only the figures ISO 230-2 defines: no Student-t set, no drift-eliminated evaluation")(
+      "uncertainty", po::value<std::string>(&f.uncertainty),
+      "the measurement uncertainty of E, M, A, B, R (ISO 230-9, GUM, k = 2) and ISO 14253-1 "
+      "verdicts: auto (the instrument class from the air compensation), a class "
+      "(laser-compensated, laser-edlen, laser-manual, scale) or a budget file (YAML; "
+      "docs/iso230-2.md, 'Measurement uncertainty')");
   return o;
 }
 
@@ -77,6 +82,7 @@ void apply_iso_flags(const IsoFlags& f, const po::variables_map& vm, Iso230_2Stu
           parse_environment_source(vm[flag].as<std::string>(), quantity, std::string("--") + flag);
   n.validate();
   if (!f.tolerance.empty()) s.tolerance = parse_iso_tolerance(f.tolerance);
+  if (vm.count("uncertainty")) s.uncertainty = uncertainty_budget_from_flag(f.uncertainty);
   if (!f.report.empty()) {
     const std::string ext = lower(std::filesystem::path(f.report).extension().string());
     if (ext != ".html" && ext != ".htm")

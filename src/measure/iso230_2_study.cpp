@@ -182,6 +182,7 @@ void Iso230_2StudyOptions::validate() const {
     throw std::invalid_argument("--alpha must be in (0, 1)");
   if (!(target_tolerance_mm > 0)) throw std::invalid_argument("--target-tolerance must be > 0");
   normalisation.validate();
+  if (uncertainty) uncertainty->validate();
 }
 
 Iso230_2Study::Iso230_2Study(Iso230_2StudyOptions options) : options_(std::move(options)) {
@@ -210,7 +211,13 @@ Iso230_2StudyResult Iso230_2Study::run(const MeasurementTable& table) const {
                             "elimination"
                           : "--reference-position/--reference-cycle need >= 2 targets");
   }
+  if (options_.uncertainty)
+    r.uncertainty = Iso230_2Uncertainty(*options_.uncertainty)
+                        .run(r.runs, r.classical.figures, r.normalisation, r.columns.unit);
   r.tolerance = check_iso_tolerance(options_.tolerance, r.classical.figures);
+  if (r.uncertainty)
+    for (ToleranceCheck& c : r.tolerance)
+      if (const FigureUncertainty* f = r.uncertainty->figure(c.name)) c.U = f->U;
   r.conformance = iso230_2_conformance(r.runs, r.columns, r.normalisation);
   decide_iso_tolerance(r);
   return r;

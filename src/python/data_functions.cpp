@@ -80,10 +80,10 @@ std::string data_path(py::handle data, const char* what) {
 }
 
 py::object iso230_2(py::handle data, const py::kwargs& kwargs) {
-  const Keywords kw(
-      "iso230_2", kwargs,
-      {"axis", "column", "reference_position", "reference_cycle", "alpha", "target_tolerance",
-       "allow_unknown", "plot", "comp_table", "comp_type", "comp_units", "comp_source"});
+  const Keywords kw("iso230_2", kwargs,
+                    {"axis", "column", "reference_position", "reference_cycle", "alpha",
+                     "target_tolerance", "allow_unknown", "plot", "comp_table", "comp_type",
+                     "comp_units", "comp_source", "normalise", "iso_only", "uncertainty"});
   const std::string path = data_path(data, "data file");
   Iso230_2StudyOptions so;
   kw.set("axis", so.axis);
@@ -92,6 +92,13 @@ py::object iso230_2(py::handle data, const py::kwargs& kwargs) {
   kw.set("target_tolerance", so.target_tolerance_mm);
   if (auto p = kw.number("reference_position")) so.drift.reference_position_mm = *p;
   if (auto c = kw.integer("reference_cycle")) so.drift.reference_cycle = *c;
+  // --normalise, --iso-only, --uncertainty (issue 29's flags).
+  std::string normalise, uncertainty;
+  kw.set("normalise", normalise);
+  if (!normalise.empty()) so.normalisation.mode = parse_normalise_mode(normalise);
+  so.iso_only = kw.flag("iso_only");
+  kw.set("uncertainty", uncertainty);
+  if (!uncertainty.empty()) so.uncertainty = uncertainty_budget_from_flag(uncertainty);
   const Iso230_2Study study(so);  // validates
   ReadOptions ro;
   ro.allow_unknown = kw.flag("allow_unknown");

@@ -1,5 +1,6 @@
 #include "weilgen/report/iso230_2_document.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <sstream>
@@ -112,6 +113,47 @@ std::string with_source(const std::string& text, const std::string& source) {
 json range_json(const ValueRange& r) {
   if (r.empty()) return json();
   return {{"min", json_number(r.min)}, {"mean", json_number(r.mean)}, {"max", json_number(r.max)}};
+}
+
+json uncertainty_json(const UncertaintyResult& U) {
+  json figures = json::object();
+  for (const FigureUncertainty& f : U.figures)
+    figures[f.name] = {{"value_um", json_number(f.value)},
+                       {"u_um", json_number(f.u)},
+                       {"U_um", json_number(f.U)},
+                       {"monte_carlo",
+                        {{"u_um", json_number(f.mc_u)},
+                         {"low_um", json_number(f.mc_low)},
+                         {"high_um", json_number(f.mc_high)},
+                         {"validated", f.validated}}}};
+  json contributions = json::array();
+  for (const UncertaintyContribution& c : U.contributions) {
+    json sens = json::object(), part = json::object(), share = json::object();
+    for (const FigureUncertainty& f : U.figures) {
+      sens[f.name] = json_number(c.sensitivity.at(f.name));
+      const double p = c.contribution_um.at(f.name);
+      part[f.name] = json_number(p);
+      share[f.name] = json_number(f.u > 0 ? 100 * p * p / (f.u * f.u) : NAN);
+    }
+    contributions.push_back(
+        {{"name", c.name},
+         {"input", c.input},
+         {"distribution", c.kind == ContributionKind::TypeA ? "type A" : to_string(c.distribution)},
+         {"kind", to_string(c.kind)},
+         {"u", json_number(c.u)},
+         {"unit", c.unit},
+         {"sensitivity", sens},
+         {"contribution_um", part},
+         {"share_pct", share}});
+  }
+  return {{"method", "ISO 230-9 / GUM (JCGM 100:2008), Monte Carlo after GUM Supplement 1"},
+          {"class", U.instrument_class},
+          {"source", U.source},
+          {"coverage_factor", U.coverage_factor},
+          {"figures", figures},
+          {"contributions", contributions},
+          {"monte_carlo", {{"trials", U.trials}, {"seed", U.seed}, {"coverage", 0.95}}},
+          {"notes", U.notes}};
 }
 
 std::string air_readings(const NormalisationResult& n) {
@@ -228,6 +270,80 @@ std::vector<std::string> iso230_2_tolerance_statement(const Iso230_2StudyResult&
   return out;
 }
 
+const std::vector<std::string>& iso230_2_budget_figures() {
+  static const std::vector<std::string> f = {"E", "M", "A", "B", "R"};
+  return f;
+}
+
+std::vector<std::string> iso230_2_uncertainty_text(const Iso230_2StudyResult& res) {
+  std::vector<std::string> out;
+  if (!res.uncertainty) return out;
+  const UncertaintyResult& U = *res.uncertainty;
+  const std::string u = res.columns.unit;
+  std::vector<std::string> shown = iso230_2_budget_figures();
+  for (const ToleranceCheck& c : res.tolerance)
+    if (std::find(shown.begin(), shown.end(), c.name) == shown.end()) shown.push_back(c.name);
+  {
+    std::ostringstream l;
+    l << std::left << std::setw(10) << "  figure" << std::right << std::setw(10) << "value"
+      << std::setw(10) << "u" << std::setw(10) << "U" << std::setw(16) << "Monte Carlo u"
+      << "   95 % interval (" << U.trials << " trials)";
+    out.push_back(l.str());
+  }
+  for (const std::string& name : shown) {
+    const FigureUncertainty* f = U.figure(name);
+    if (!f) continue;
+    std::ostringstream l;
+    l << "  " << std::left << std::setw(8) << name << std::right << std::setw(10) << fmt(f->value)
+      << std::setw(10) << fmt(f->u) << std::setw(10) << fmt(f->U) << std::setw(16) << fmt(f->mc_u)
+      << "   "
+      << (std::isfinite(f->mc_low) ? fmt(f->mc_low) + " .. " + fmt(f->mc_high) + " " + u
+                                   : std::string("-"))
+      << (U.trials > 0 && !f->validated ? "  (*)" : "");
+    out.push_back(l.str());
+  }
+  bool unvalidated = false;
+  for (const std::string& name : shown)
+    if (const FigureUncertainty* f = U.figure(name)) unvalidated |= U.trials > 0 && !f->validated;
+  if (unvalidated)
+    out.push_back(
+        "  (*) the Monte Carlo u differs from the linearised u by more than 5 % (GUM Supplement "
+        "1, 8): an extreme of the figure switches between targets within the uncertainty, and "
+        "the Monte Carlo interval describes it better; the verdicts use U.");
+  for (const std::string& name : iso230_2_budget_figures()) {
+    const FigureUncertainty* f = U.figure(name);
+    out.push_back("");
+    out.push_back("  Budget of " + name + " = " + fmt(f->value) + " " + u + ": u = " + fmt(f->u) +
+                  " " + u + ", U = " + fmt(f->U) + " " + u +
+                  " (k = " + format_number(U.coverage_factor) + ")");
+    std::ostringstream h;
+    h << "    " << std::left << std::setw(36) << "contribution" << std::setw(22) << "distribution"
+      << std::right << std::setw(14) << "u(x)" << std::setw(12) << "c" << std::setw(10) << "|c| u"
+      << std::setw(9) << "share";
+    out.push_back(h.str());
+    for (const UncertaintyContribution& c : U.contributions) {
+      const double part = c.contribution_um.at(name);
+      std::ostringstream l;
+      l << "    " << std::left << std::setw(36) << c.name << std::setw(22)
+        << (c.kind == ContributionKind::TypeA ? std::string("type A")
+                                              : std::string(to_string(c.distribution)))
+        << std::right << std::setw(14)
+        << (std::isfinite(c.u) ? format_significant(c.u, 3) + " " + c.unit : std::string("-"))
+        << std::setw(12)
+        << (std::isfinite(c.sensitivity.at(name))
+                ? format_significant(c.sensitivity.at(name), 3) +
+                      (c.kind == ContributionKind::Scale ? " m" : "")
+                : std::string("-"))
+        << std::setw(10) << fmt(part) << std::setw(8)
+        << (f->u > 0 ? format_fixed(100 * part * part / (f->u * f->u), 1) : std::string("-"))
+        << "%";
+      out.push_back(l.str());
+    }
+  }
+  for (const std::string& note : U.notes) out.push_back("  note: " + note);
+  return out;
+}
+
 std::vector<std::string> iso230_2_conformance_statement(const Iso230_2StudyResult& res) {
   if (res.conformance.empty())
     return {
@@ -307,6 +423,12 @@ std::string iso230_2_text(const std::string& data, const Iso230_2StudyResult& re
   for (const IsoFigures* s : sets)
     o << std::setw(12) << (s ? fmt(s->k_up, 2) + "/" + fmt(s->k_down, 2) : std::string("-"));
   o << "\n";
+  if (res.uncertainty) {
+    o << "\nMeasurement uncertainty (" << u << "; ISO 230-9 and the GUM; class "
+      << res.uncertainty->instrument_class << ", budget: " << res.uncertainty->source
+      << "; Monte Carlo after GUM Supplement 1)\n";
+    for (const auto& line : iso230_2_uncertainty_text(res)) o << line << "\n";
+  }
   if (!res.tolerance.empty()) {
     o << "\nTolerances (" << u << ")\n";
     for (const auto& line : iso230_2_tolerance_statement(res)) o << line << "\n";
@@ -416,6 +538,7 @@ nlohmann::json iso230_2_json(const std::string& data, const Iso230_2StudyResult&
                         {"issues", issues},
                         {"statement", iso230_2_conformance_statement(res)}};
     j["iso_only"] = res.iso_only;
+    j["uncertainty"] = res.uncertainty ? uncertainty_json(*res.uncertainty) : json();
     j["metadata"] = res.header_keys;
     const NormalisationResult& n = res.normalisation;
     j["normalisation"] = {

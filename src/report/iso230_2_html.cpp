@@ -230,6 +230,79 @@ void environment_table(std::ostream& o, const NormalisationResult& n) {
   o << "</table>\n";
 }
 
+// The uncertainty of the figures and their budget (ISO 230-9, GUM; Monte Carlo after GUM
+// Supplement 1).
+void uncertainty_section(std::ostream& o, const Iso230_2StudyResult& res) {
+  const UncertaintyResult& U = *res.uncertainty;
+  const std::string u = pretty(res.columns.unit);
+  o << "<section id=\"uncertainty\"><h2>Measurement uncertainty</h2>\n<p>After ISO 230-9 and "
+       "the GUM: every contribution with its distribution and sensitivity, combined (u) and "
+       "expanded with k = "
+    << format_number(U.coverage_factor) << " (U); the same budget propagated by Monte Carlo "
+    << "(GUM Supplement 1, " << U.trials << " trials). Instrument class " << h(U.instrument_class)
+    << ", budget: " << h(U.source) << ".</p>\n";
+  o << "<table class=\"uncertainty\"><thead><tr><th>Figure</th><th>Value (" << u << ")</th><th>u ("
+    << u << ")</th><th>U (" << u << ")</th><th>Monte Carlo u (" << u << ")</th><th>95 % interval ("
+    << u << ")</th></tr></thead><tbody>\n";
+  std::vector<std::string> shown = iso230_2_budget_figures();
+  for (const ToleranceCheck& c : res.tolerance)
+    if (std::find(shown.begin(), shown.end(), c.name) == shown.end()) shown.push_back(c.name);
+  bool unvalidated = false;
+  for (const std::string& name : shown) {
+    const FigureUncertainty* f = U.figure(name);
+    if (!f) continue;
+    const bool flag = U.trials > 0 && !f->validated;
+    unvalidated |= flag;
+    o << "<tr><td>" << h(name) << "</td><td class=\"num\">" << num(f->value)
+      << "</td><td class=\"num\" data-uncertainty=\"" << h(name) << "\" data-field=\"u_um\">"
+      << num(f->u) << "</td><td class=\"num\" data-uncertainty=\"" << h(name)
+      << "\" data-field=\"U_um\">" << num(f->U) << "</td><td class=\"num\">" << num(f->mc_u)
+      << (flag ? " *" : "") << "</td><td class=\"num\">"
+      << (std::isfinite(f->mc_low) ? num(f->mc_low) + " \xE2\x80\xA6 " + num(f->mc_high)
+                                   : std::string("\xE2\x80\x93"))
+      << "</td></tr>\n";
+  }
+  o << "</tbody></table>\n";
+  if (unvalidated)
+    o << "<p class=\"note\">* The Monte Carlo u differs from the linearised one by more than 5 % "
+         "(GUM Supplement 1, 8): an extreme of the figure switches between targets within the "
+         "uncertainty, and the Monte Carlo interval describes it better; the verdicts use U.</p>\n";
+  o << "<table class=\"budget\"><thead><tr><th rowspan=\"2\">Contribution</th><th "
+       "rowspan=\"2\">Distribution</th><th rowspan=\"2\">u(x)</th>";
+  for (const std::string& f : iso230_2_budget_figures()) o << "<th colspan=\"2\">" << f << "</th>";
+  o << "</tr><tr>";
+  for (std::size_t k = 0; k < iso230_2_budget_figures().size(); ++k)
+    o << "<th>c</th><th>|c| u (" << u << "), share</th>";
+  o << "</tr></thead><tbody>\n";
+  for (const UncertaintyContribution& c : U.contributions) {
+    o << "<tr><td title=\"" << h(pretty(c.input)) << "\">" << h(c.name) << "</td><td>"
+      << (c.kind == ContributionKind::TypeA ? "type A" : to_string(c.distribution))
+      << "</td><td class=\"num\">"
+      << (std::isfinite(c.u) ? format_significant(c.u, 3) + " " + pretty(c.unit)
+                             : std::string("\xE2\x80\x93"))
+      << "</td>";
+    for (const std::string& name : iso230_2_budget_figures()) {
+      const double sens = c.sensitivity.at(name), part = c.contribution_um.at(name);
+      const double total = U.figure(name)->u;
+      o << "<td class=\"num\">"
+        << (std::isfinite(sens)
+                ? format_significant(sens, 3) + (c.kind == ContributionKind::Scale ? " m" : "")
+                : std::string("\xE2\x80\x93"))
+        << "</td><td class=\"num\" data-budget=\"" << h(name) << "\">" << num(part) << " ("
+        << (total > 0 ? format_fixed(100 * part * part / (total * total), 1) : std::string("0"))
+        << " %)</td>";
+    }
+    o << "</tr>\n";
+  }
+  o << "</tbody></table>\n";
+  if (!U.notes.empty()) {
+    o << "<ul class=\"statements\">\n";
+    for (const std::string& note : U.notes) o << "<li>" << h(pretty(note)) << "</li>\n";
+    o << "</ul>\n";
+  }
+  o << "</section>\n";
+}
+
 const char* kStyle = R"(
 body { font-family: Helvetica, Arial, sans-serif; font-size: 13px; color: #222; margin: 0;
        background: #fff; }
@@ -257,6 +330,8 @@ figcaption { color: #555; font-size: 12px; margin-top: 2px; }
 .banner ul { margin: 0; padding-left: 20px; }
 .warnings { border: 1px solid #a15c00; background: #fff4e0; padding: 6px 10px; margin: 8px 0; }
 td.fill { min-width: 260px; }
+table.budget { font-size: 11px; margin-top: 6px; }
+p.note { color: #555; font-size: 12px; }
 .fail { color: #c62828; font-weight: bold; }
 .verdict { font-size: 15px; margin: 8px 0; }
 ul.statements li { margin: 3px 0; }
@@ -450,6 +525,7 @@ std::string iso230_2_html(const std::string& data, const Iso230_2StudyResult& re
     o << "</tbody></table>\n";
   }
   o << "</section>\n";
+  if (res.uncertainty) uncertainty_section(o, res);
   // ---- Per target.
   o << "<section id=\"targets\"><h2>Per target (" << pretty(u) << ", k = 2)</h2>\n"
     << "<table class=\"targets\"><thead><tr><th>Target (" << pos_unit

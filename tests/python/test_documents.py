@@ -76,6 +76,19 @@ def test_iso230_2_equals_cli(cli):
     same_document(weilgen.iso230_2(data, alpha=0.05, reference_cycle=2), want)
 
 
+def test_iso230_2_normalise_iso_only_uncertainty_equal_cli(cli, tmp_path):
+    data = source("examples", "data", "iso230_2_small.csv")
+    budget = tmp_path / "budget.yaml"
+    budget.write_text("class: laser-compensated\neve_um: 0.4\nmonte_carlo_trials: 5000\n")
+    want = cli.json("iso230-2", data, "--normalise", "never", "--iso-only", "--uncertainty",
+                    str(budget))
+    doc = weilgen.iso230_2(data, normalise="never", iso_only=True, uncertainty=budget)
+    same_document(doc, want)
+    assert doc["student"] is None and doc["drift_eliminated"] is None
+    assert doc["normalisation"]["mode"] == "never"
+    assert doc["uncertainty"]["figures"]["E"]["U_um"] > 0
+
+
 def test_fit_pdge_equals_cli(cli):
     data = source("examples", "data", "line6d_x.csv")
     same_document(weilgen.fit_pdge(data), cli.json("fit-pdge", data))

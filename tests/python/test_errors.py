@@ -68,6 +68,10 @@ def test_bad_flags_carry_the_cli_message(cli):
                     "fit-pdge", data, "--rule", "max")
     raises_like_cli(cli, A, lambda: weilgen.iso230_2(data, comp_type=1),
                     "iso230-2", data, "--comp-type", "1")
+    raises_like_cli(cli, A, lambda: weilgen.iso230_2(data, normalise="sometimes"),
+                    "iso230-2", data, "--normalise", "sometimes")
+    raises_like_cli(cli, A, lambda: weilgen.iso230_2(data, uncertainty="lasr"),
+                    "iso230-2", data, "--uncertainty", "lasr")
     raises_like_cli(cli, A, lambda: weilgen.identify("vmc_3axis", data=POINTS, axis="X"),
                     "identify", "vmc_3axis", "--data", POINTS, "--axis", "X")
     raises_like_cli(cli, A, lambda: weilgen.identify("vmc_3axis", data=POINTS, comp_table=POINTS,

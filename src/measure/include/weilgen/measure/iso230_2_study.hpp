@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "weilgen/measure/iso230_2.hpp"
+#include "weilgen/measure/iso230_2_uncertainty.hpp"
 #include "weilgen/measure/measurement_csv.hpp"
 #include "weilgen/measure/normalisation.hpp"
 
@@ -70,6 +71,8 @@ struct Iso230_2StudyOptions {
   IsoTolerance tolerance;              // verdicts (none: no verdict)
   // Only the figures ISO 230-2 defines: no Student-t set and no drift elimination (--iso-only).
   bool iso_only = false;
+  // The uncertainty budget (--uncertainty); none: no uncertainty, tolerances compared as they are.
+  std::optional<UncertaintyBudget> uncertainty;
   // alpha in (0, 1), a target tolerance > 0, the normalisation's constants in range
   // (std::invalid_argument naming the flag).
   void validate() const;
@@ -81,10 +84,11 @@ struct Iso230_2StudyResult {
   NormalisationResult normalisation;  // what was corrected (possibly nothing), from what
   IsoRuns runs;
   Iso230_2Result classical;
-  std::optional<DriftResult> drift;           // none with fewer than 2 targets
-  std::vector<ToleranceCheck> tolerance;      // empty without --tolerance
-  std::vector<ConformanceIssue> conformance;  // empty: the run meets ISO 230-2's conditions
-  bool iso_only = false;                      // no Student-t set, no drift elimination
+  std::optional<DriftResult> drift;              // none with fewer than 2 targets
+  std::optional<UncertaintyResult> uncertainty;  // with a budget
+  std::vector<ToleranceCheck> tolerance;         // empty without --tolerance
+  std::vector<ConformanceIssue> conformance;     // empty: the run meets ISO 230-2's conditions
+  bool iso_only = false;                         // no Student-t set, no drift elimination
   // The overall decision on the tolerances (meaningful with checks): does not conform when one
   // check does not, else not proven when one is not or the air is not compensated, else
   // conforms; `verdict_reason` says why it is not proven.
