@@ -11,11 +11,14 @@
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <random>
 #include <sstream>
 
 #include "test_support.hpp"
+#include "weilgen/base/atomic_file.hpp"
 #include "weilgen/base/format.hpp"
+#include "weilgen/base/units.hpp"
 #include "weilgen/measure/ballbar.hpp"
 #include "weilgen/measure/ballbar_diagnosis.hpp"
 
@@ -296,4 +299,171 @@ TEST_CASE(
     }
   }
   std::ofstream(test::fresh_dir("ballbar_recovery") / "ballbar_recovery.md") << table.str();
+}
+
+namespace {
+
+// A trace file of `truth` (ccw and cw runs, a `dir` column), in the documented format.
+std::string trace_file(const Truth& truth, std::uint64_t seed, bool with_cw = true) {
+  std::mt19937_64 rng(seed);
+  const Circle c;
+  std::ostringstream s;
+  s << "# plane: XY\n# radius: 100 mm\n# feedrate: 1000 mm/min\nangle_deg,dr_um,dir\n";
+  for (int feed : {1, -1}) {
+    if (feed < 0 && !with_cw) break;
+    const BallbarTrace t = simulate(truth, c, feed, rng);
+    for (std::size_t k = 0; k < t.size(); ++k)
+      s << format_number(t.angle_deg[k]) << "," << format_number(t.dr_um[k]) << "," << feed << "\n";
+  }
+  return s.str();
+}
+
+}  // namespace
+
+TEST_CASE("ballbar CLI: a trace on its own, its documents, and refusals before any output") {
+  using nlohmann::json;
+  const auto dir = test::fresh_dir("ballbar_cli");
+  const std::string trace = (dir / "t.csv").string(), js = (dir / "t.json").string(),
+                    svg = (dir / "t.svg").string(), html = (dir / "t.html").string();
+  // The issue-29 machine: 6 um of backlash on X, 4 um on Y.
+  Truth truth;
+  truth.backlash[0] = 6;
+  truth.backlash[1] = 4;
+  write_file_atomically(trace, trace_file(truth, 5));
+  test::Run r = test::run(
+      test::cli("ballbar " + trace + " --json " + js + " --plot " + svg + " --report " + html));
+  REQUIRE(r.status == 0);
+  CHECK(r.out.find("ISO 230-4 (um)                                   ccw          cw") !=
+        std::string::npos);
+  CHECK(r.out.find("1  backlash X") != std::string::npos);
+  CHECK(r.out.find("2  backlash Y") != std::string::npos);
+  const json j = json::parse(test::read_text(js));
+  CHECK(j["verb"] == "ballbar");
+  CHECK(j["radius_mm"] == 100);
+  CHECK(j["feedrate_mm_min"] == 1000);
+  CHECK(j["centre"].is_null());
+  REQUIRE(j["runs"].size() == 2);
+  for (const json& run : j["runs"]) {
+    CHECK(run["G_minimum_zone_um"].get<double>() <= run["G_um"].get<double>());
+    CHECK(run["G_um"].get<double>() > 5);
+  }
+  CHECK(j["hysteresis_um"].get<double>() > 5);
+  const json& first = j["diagnosis"]["causes"][0];
+  CHECK(first["id"] == "backlash_X");
+  CHECK(first["size"].get<double>() == doctest::Approx(6).epsilon(0.1));
+  CHECK(j["diagnosis"]["causes"][1]["id"] == "backlash_Y");
+  CHECK(j["diagnosis"]["causes"][1]["size"].get<double>() == doctest::Approx(4).epsilon(0.1));
+  CHECK(j["diagnosis"]["clean"] == false);
+  // The polar plot: both directions, each run's minimum zone, the diagnosis annotated.
+  const std::string plot = test::read_text(svg);
+  CHECK(plot.rfind("<svg xmlns=\"http://www.w3.org/2000/svg\"", 0) == 0);
+  CHECK(plot.find("class=\"run\" data-run=\"ccw\"") != std::string::npos);
+  CHECK(plot.find("class=\"run\" data-run=\"cw\"") != std::string::npos);
+  std::size_t zones = 0;
+  for (std::size_t at = plot.find("class=\"zone\""); at != std::string::npos;
+       at = plot.find("class=\"zone\"", at + 1))
+    ++zones;
+  CHECK(zones == 4);
+  CHECK(plot.find("1. backlash X 5.") != std::string::npos);
+  // The report holds the plot and every figure of the JSON.
+  const std::string page = test::read_text(html);
+  CHECK(page.find(plot) != std::string::npos);
+  CHECK(page.find("<td class=\"num\" data-run=\"0\" data-key=\"G_um\">" +
+                  format_fixed(j["runs"][0]["G_um"].get<double>(), 3) + "<") != std::string::npos);
+  CHECK(page.find("data-cause=\"backlash_X\"><td class=\"rank\">1<") != std::string::npos);
+  for (const char* bad : {"<script", "<link", "<img", "src=", "href="})
+    CHECK(page.find(bad) == std::string::npos);
+
+  // One direction only: what needs both is said, not guessed.
+  write_file_atomically(trace, trace_file(truth, 6, false));
+  r = test::run(test::cli("ballbar " + trace + " --json " + js));
+  REQUIRE(r.status == 0);
+  CHECK(r.out.find("servo mismatch X-Y (not separable from the set-up and the causes before it on "
+                   "these runs (one direction only: it needs both))") != std::string::npos);
+  CHECK(r.out.find("circular hysteresis H: needs a ccw and a cw run") != std::string::npos);
+
+  // A noise-only trace reads clean.
+  write_file_atomically(trace, trace_file(Truth{}, 7));
+  r = test::run(test::cli("ballbar " + trace + " --json " + js));
+  REQUIRE(r.status == 0);
+  CHECK(r.out.find("clean: no cause stands out of the noise") != std::string::npos);
+  CHECK(json::parse(test::read_text(js))["diagnosis"]["clean"] == true);
+
+  // Refusals: bad flags exit 2, bad files exit 3, and nothing is written.
+  write_file_atomically(js, "keep\n");
+  for (const char* flags :
+       {"--plot x.png", "--report x.pdf", "--alpha 2", "--feedrate fast", "--feedrate 0",
+        "--pdge poly:3", "--min-contribution -1", "--plane XQ", "--radius -5"}) {
+    CAPTURE(flags);
+    r = test::run(test::cli("ballbar " + trace + " --json " + js + " " + flags));
+    CHECK(r.status == 2);
+    CHECK(test::read_text(js) == "keep\n");
+  }
+  CHECK(test::run(test::cli("ballbar " + trace + " --json " + trace)).status == 2);
+  const std::string bad = (dir / "bad.csv").string();
+  write_file_atomically(bad, "# plane: XY\nangle_deg,dr_um\n0,1\n10,2\n20,1\n");
+  r = test::run(test::cli("ballbar " + bad + " --json " + js));
+  CHECK(r.status == 3);
+  CHECK(r.out.find("bad.csv:2: ballbar: the header key '# radius:' is missing") !=
+        std::string::npos);
+  write_file_atomically(bad, "# plane: XY\n# radius: 100\nangle_deg,dr_um\n0,1\n10,2\n20,1\n");
+  r = test::run(test::cli("ballbar " + bad + " --json " + js));
+  CHECK(r.status == 3);
+  CHECK(
+      r.out.find("bad.csv: ballbar: run 1 has 3 distinct angles: the diagnosis needs at least 8") !=
+      std::string::npos);
+  write_file_atomically(bad,
+                        "# plane: XY\n# radius: 100\n# feedrate: fast\nangle_deg,dr_um\n0,1\n");
+  r = test::run(test::cli("ballbar " + bad + " --json " + js));
+  CHECK(r.status == 3);
+  CHECK(r.out.find("bad.csv:3: ballbar: '# feedrate: fast'") != std::string::npos);
+  CHECK(test::read_text(js) == "keep\n");
+}
+
+TEST_CASE("ballbar CLI with a machine: the circle against the machine, the model's terms") {
+  using nlohmann::json;
+  const auto dir = test::fresh_dir("ballbar_machine_cli");
+  const std::string js = (dir / "t.json").string();
+  const std::string data = std::string(WEILGEN_SOURCE_DIR) + "/examples/data/ballbar_xy.csv";
+  const test::Run r = test::run(test::cli("ballbar " + data + " --machine vmc_3axis --json " + js));
+  REQUIRE(r.status == 0);
+  const json j = json::parse(test::read_text(js));
+  CHECK(j["machine"] == "vmc_3axis");
+  CHECK(j["centre"]["X"] == 343.507);
+  // The synthetic example's squareness (docs/ballbar.md: -24.5 urad as the ballbar reads it)
+  // and, on vmc_3axis whose table carries X and Y, E_C0Y of the opposite sign would make it.
+  const json& sq = j["diagnosis"]["causes"][0];
+  CHECK(sq["id"] == "squareness");
+  CHECK(sq["size"].get<double>() == doctest::Approx(-24.5).epsilon(0.02));
+  bool c0y = false;
+  for (const json& t : sq["terms"])
+    if (t["term"] == "E_C0Y") {
+      c0y = true;
+      CHECK(t["per_unit"].get<double>() == doctest::Approx(-1).epsilon(1e-6));
+    }
+  CHECK(c0y);
+  // A circle the machine cannot run is refused with the header key's line.
+  const std::string bad = (dir / "far.csv").string();
+  std::string text = test::read_text(data);
+  text.replace(text.find("# radius: 100 mm"), 16, "# radius: 900 mm");
+  write_file_atomically(bad, text);
+  const test::Run far = test::run(test::cli("ballbar " + bad + " --machine vmc_3axis"));
+  CHECK(far.status == 3);
+  CHECK(far.out.find("ballbar: '# radius: 900 mm': the circle leaves the range of") !=
+        std::string::npos);
+}
+
+TEST_CASE("ballbar: feedrates with their units (base/units)") {
+  CHECK(parse_feedrate_mm_min("1000 mm/min", "f") == 1000);
+  CHECK(parse_feedrate_mm_min("1000", "f") == 1000);
+  CHECK(parse_feedrate_mm_min("20 mm/s", "f") == doctest::Approx(1200));
+  CHECK(parse_feedrate_mm_min("1.5 m/min", "f") == doctest::Approx(1500));
+  CHECK(parse_feedrate_mm_min("40 in/min", "f") == doctest::Approx(1016));
+  CHECK_THROWS_WITH_AS(parse_feedrate_mm_min("-5 mm/min", "--feedrate"),
+                       "--feedrate: \"-5 mm/min\": the feedrate must be > 0",
+                       std::invalid_argument);
+  CHECK_THROWS_WITH_AS(parse_feedrate_mm_min("5 mm", "--feedrate"),
+                       "--feedrate: \"5 mm\": a feedrate's unit is mm/min, mm/s, m/min or in/min",
+                       std::invalid_argument);
+  CHECK_THROWS_AS(parse_feedrate_mm_min("fast", "--feedrate"), std::invalid_argument);
 }

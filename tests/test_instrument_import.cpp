@@ -373,7 +373,7 @@ TEST_CASE("import slips: a leading 'Target No.' column, a title line, runs witho
   CHECK(mm.mapping[2] == "'Run 1' -> dx_um of cycle 1 (um, x 1000)");
 }
 
-TEST_CASE("import slips: a wide file's tidy output reads back; a degF sensor is named") {
+TEST_CASE("import slips: a wide file's tidy output reads back, a degF sensor is named") {
   // The tidy file an import writes keeps no '# format: wide' key: iso230-2 reads it as tidy.
   const ImportResult w = parse_instrument_text(kWideSmall, "w.csv");
   CHECK(w.table.header_keys.count("format") == 0);

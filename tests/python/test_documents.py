@@ -89,6 +89,20 @@ def test_iso230_2_normalise_iso_only_uncertainty_equal_cli(cli, tmp_path):
     assert doc["uncertainty"]["figures"]["E"]["U_um"] > 0
 
 
+def test_ballbar_equals_cli(cli, tmp_path):
+    data = source("examples", "data", "ballbar_xy.csv")
+    same_document(weilgen.ballbar(data), cli.json("ballbar", data))
+    svg, html = tmp_path / "p.svg", tmp_path / "r.html"
+    want = cli.json("ballbar", data, "--machine", "vmc_3axis", "--alpha", "0.05", "--feedrate",
+                    "300 mm/min")
+    doc = weilgen.ballbar(data, machine="vmc_3axis", alpha=0.05, feedrate="300 mm/min", plot=svg,
+                          report=html, quiet=True)
+    same_document(doc, want)
+    assert doc["diagnosis"]["causes"][0]["id"] == "squareness"
+    assert svg.read_text().startswith("<svg")
+    assert "ISO 230-4" in html.read_text()
+
+
 def test_fit_pdge_equals_cli(cli):
     data = source("examples", "data", "line6d_x.csv")
     same_document(weilgen.fit_pdge(data), cli.json("fit-pdge", data))

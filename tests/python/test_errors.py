@@ -72,6 +72,11 @@ def test_bad_flags_carry_the_cli_message(cli):
                     "iso230-2", data, "--normalise", "sometimes")
     raises_like_cli(cli, A, lambda: weilgen.iso230_2(data, uncertainty="lasr"),
                     "iso230-2", data, "--uncertainty", "lasr")
+    trace = source("examples", "data", "ballbar_xy.csv")
+    raises_like_cli(cli, A, lambda: weilgen.ballbar(trace, alpha=2),
+                    "ballbar", trace, "--alpha", "2")
+    raises_like_cli(cli, A, lambda: weilgen.ballbar(trace, plot="p.png"),
+                    "ballbar", trace, "--plot", "p.png")
     raises_like_cli(cli, A, lambda: weilgen.identify("vmc_3axis", data=POINTS, axis="X"),
                     "identify", "vmc_3axis", "--data", POINTS, "--axis", "X")
     raises_like_cli(cli, A, lambda: weilgen.identify("vmc_3axis", data=POINTS, comp_table=POINTS,
