@@ -144,10 +144,15 @@ TEST_CASE("uncertainty: the Monte Carlo of GUM Supplement 1 agrees with the budg
     CAPTURE(name);
     CAPTURE(f->u);
     CAPTURE(f->mc_u);
-    CHECK(f->mc_u == doctest::Approx(f->u).epsilon(0.05));
+    // docs/iso230-2.md quotes these numbers.
+    MESSAGE(std::string(name) << ": value " << f->value << ", u " << f->u << ", U " << f->U
+                              << ", Monte Carlo u " << f->mc_u << ", 95 % [" << f->mc_low << ", "
+                              << f->mc_high << "]");
+    CHECK(std::abs(f->mc_u / f->u - 1) <= 0.05);
     CHECK(f->validated);
-    // The 95 % interval's half-width against U = 2u.
-    CHECK((f->mc_high - f->mc_low) / 2 == doctest::Approx(f->U).epsilon(0.05));
+    // The 95 % interval's half-width against U = 2u: within 10 % (a budget of rectangular
+    // inputs has a 95 % interval narrower than +-2u; measured 2.5 to 5.2 % here).
+    CHECK(std::abs((f->mc_high - f->mc_low) / 2 / f->U - 1) <= 0.10);
   }
   // The same inputs give the same draws.
   const Iso230_2StudyResult again =

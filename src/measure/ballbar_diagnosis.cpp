@@ -265,9 +265,9 @@ BallbarDiagnosisResult BallbarDiagnosis::run(const BallbarDiagnosisInput& in) co
   };
   searched(Kind::Spike, "reversal_spike", "reversal spike", widths);
   // Cyclic error C (µm amplitude) of pitch p (mm): d = C cos(2π x/p + φ); pitches from what
-  // the sampling resolves (2.5 steps of the axis at its fastest) to the radius.
+  // the sampling resolves (2.5 steps of the axis at its fastest) to the diameter.
   std::vector<double> pitches;
-  for (double p = std::max(1.0, 2.5 * R * step_deg * kPi / 180); p <= R; p *= 1.01)
+  for (double p = std::max(1.0, 2.5 * R * step_deg * kPi / 180); p <= 2 * R; p *= 1.01)
     pitches.push_back(p);
   searched(Kind::Cyclic, "cyclic", "cyclic error", pitches);
 
