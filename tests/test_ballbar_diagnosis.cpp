@@ -467,3 +467,22 @@ TEST_CASE("ballbar: feedrates with their units (base/units)") {
                        std::invalid_argument);
   CHECK_THROWS_AS(parse_feedrate_mm_min("fast", "--feedrate"), std::invalid_argument);
 }
+
+TEST_CASE("identify --predict: every measured run of a trace is labelled with its direction") {
+  using nlohmann::json;
+  const auto dir = test::fresh_dir("ballbar_predict_labels");
+  const std::string js = (dir / "p.json").string();
+  const std::string data = std::string(WEILGEN_SOURCE_DIR) + "/examples/data/";
+  const test::Run r =
+      test::run(test::cli("identify vmc_3axis --data " + data + "vmc_3axis_points.csv --predict " +
+                          data + "ballbar_xy.csv --quiet --json " + js));
+  REQUIRE(r.status == 0);
+  CHECK(r.out.find("  measured ccw 1  G ") != std::string::npos);
+  CHECK(r.out.find("  measured cw 1   G ") != std::string::npos);
+  const json j = json::parse(test::read_text(js));
+  const json& compared = j["predictions"][0]["compared"];
+  REQUIRE(compared.size() == 2);
+  CHECK(compared[0]["feed"] == "ccw");
+  CHECK(compared[1]["feed"] == "cw");
+  CHECK(compared[1]["cycle"] == 1);
+}

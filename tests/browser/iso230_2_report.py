@@ -19,7 +19,7 @@ import tempfile
 
 from PIL import Image
 
-WIDTH, HEIGHT = 1240, 3200
+WIDTH, HEIGHT = 1240, 4000
 
 
 def fail(why):
@@ -83,15 +83,16 @@ def main():
     html = os.path.join(out_dir, "iso230_2_report.html")
     png = os.path.join(out_dir, "iso230_2_report.png")
     dom, img, last = rendered(
-        [weilgen, "iso230-2", data, "--tolerance", "15,A=30", "--report", html], html, png,
-        WIDTH, HEIGHT)
+        [weilgen, "iso230-2", data, "--tolerance", "20,A=30", "--uncertainty", "auto", "--report",
+         html], html, png, WIDTH, HEIGHT)
 
     # The DOM the browser built.
-    for what, n in (("<svg", 3), ("<table", 5)):
+    for what, n in (("<svg", 3), ("<table", 7)):
         if dom.count(what) < n:
             fail("rendered DOM has %d '%s', expected >= %d" % (dom.count(what), what, n))
     for needle in ("Positioning accuracy and repeatability", "Drift-eliminated evaluation",
-                   "VMC 850 (synthetic)", "Normalised to 20", "Tested by"):
+                   "VMC 850 (synthetic)", "Normalised to 20", "Measurement uncertainty",
+                   "expansion coefficient", "Tested by"):
         if needle not in dom:
             fail("rendered DOM lacks '%s'" % needle)
 
