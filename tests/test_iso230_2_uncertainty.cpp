@@ -269,3 +269,27 @@ TEST_CASE("uncertainty: budget files, classes and the CLI") {
   REQUIRE(r.status == 0);
   CHECK(json::parse(test::read_text(js))["uncertainty"]["source"] == "defaults");
 }
+
+TEST_CASE("uncertainty: a rotary axis, its scale error per radian of rotation") {
+  // C at 0, 90, 180 deg; the means rise with the angle, so E runs from 0 to 180 deg: a scale
+  // error of 1 urad/rad (k = 2) contributes 0.5 urad/rad * pi rad.
+  std::string text = "# axis: C\nC,dir,cycle,dc_urad\n";
+  for (int j = 1; j <= 3; ++j)
+    for (int d : {1, -1})
+      for (int i = 0; i <= 2; ++i)
+        text += std::to_string(90 * i) + "," + std::to_string(d) + "," + std::to_string(j) + "," +
+                format_number(10.0 * i + 0.1 * j) + "\n";
+  UncertaintyBudget b;
+  b.values = {{"instrument_ppm", 1}, {"resolution_um", 0}, {"monte_carlo_trials", 0}};
+  Iso230_2StudyOptions o;
+  o.uncertainty = b;
+  const Iso230_2StudyResult r = Iso230_2Study(o).run(parse_measurements(text, "c.csv"));
+  const UncertaintyContribution* laser = contribution(*r.uncertainty, "instrument calibration");
+  REQUIRE(laser);
+  CHECK(laser->unit == "urad/rad");
+  CHECK(laser->sensitivity.at("E") == doctest::Approx(3.14159265358979).epsilon(1e-6));
+  CHECK(laser->contribution_um.at("E") == doctest::Approx(0.5 * 3.14159265358979).epsilon(1e-6));
+  // No air, material or set-up contributions for an angle; the note says so.
+  CHECK(contribution(*r.uncertainty, "air refraction not compensated") == nullptr);
+  CHECK(r.uncertainty->notes.back().rfind("A rotary axis:", 0) == 0);
+}

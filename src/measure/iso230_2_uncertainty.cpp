@@ -301,7 +301,9 @@ UncertaintyResult Iso230_2Uncertainty::run(const IsoRuns& runs, const IsoFigures
   const double travel = m ? P.back() - P.front() : 0;
   // Per unit of a scale error (µm/m): the travel from the datum in m.
   std::vector<double> per_scale(m);
-  for (std::size_t i = 0; i < m; ++i) per_scale[i] = (P[i] - n.datum_mm) * 1e-3;
+  // A rotary axis' targets are in deg and its scale error in µrad/rad: the rotation in rad.
+  for (std::size_t i = 0; i < m; ++i)
+    per_scale[i] = (P[i] - n.datum_mm) * (linear ? 1e-3 : 3.14159265358979323846 / 180);
 
   std::vector<UncertaintyContribution> C;
   auto add = [&](const std::string& name, const std::string& input, BudgetDistribution d,
@@ -318,7 +320,7 @@ UncertaintyResult Iso230_2Uncertainty::run(const IsoRuns& runs, const IsoFigures
   };
   const double sqrt3 = std::sqrt(3.0), sqrt12 = std::sqrt(12.0);
   const std::string scale_unit = linear ? "um/m" : "urad/rad";
-  add("instrument calibration", num(in["instrument_ppm"]) + " um/m (k = 2)",
+  add("instrument calibration", num(in["instrument_ppm"]) + " " + scale_unit + " (k = 2)",
       BudgetDistribution::Normal, ContributionKind::Scale, in["instrument_ppm"] / 2, scale_unit);
   add("instrument, constant part", num(in["instrument_um"]) + " " + unit + " (k = 2)",
       BudgetDistribution::Normal, ContributionKind::PerMean, in["instrument_um"] / 2, unit);
