@@ -57,10 +57,10 @@ std::string ballbar_polar_svg(const BallbarStudy& st) {
     return std::make_pair(cx + r * std::cos(t), cy - r * std::sin(t));
   };
   std::ostringstream o;
-  o << "<svg xmlns=\"http://www.w3.org/2000/svg\" id=\"ballbar-polar\" width=\"980\" "
+  o << "<svg xmlns=\"http://www.w3.org/2000/svg\" id=\"ballbar-polar\" width=\"1090\" "
        "height=\"740\" "
-       "viewBox=\"0 0 980 740\" font-family=\"Helvetica, Arial, sans-serif\" font-size=\"12\">\n";
-  o << "<rect width=\"980\" height=\"740\" fill=\"#ffffff\"/>\n";
+       "viewBox=\"0 0 1090 740\" font-family=\"Helvetica, Arial, sans-serif\" font-size=\"12\">\n";
+  o << "<rect width=\"1090\" height=\"740\" fill=\"#ffffff\"/>\n";
   o << "<text x=\"" << px(cx)
     << "\" y=\"22\" text-anchor=\"middle\" font-size=\"15\" "
        "font-weight=\"bold\">Ballbar "
