@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "weilgen/analysis/ballbar_model.hpp"
+#include "weilgen/base/constants.hpp"
 #include "weilgen/base/error.hpp"
 #include "weilgen/base/output_paths.hpp"
 #include "weilgen/base/text.hpp"
@@ -16,8 +17,6 @@
 namespace weilgen {
 
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 BallbarDiagnosisOptions diagnosis_options(const BallbarRequest& rq) {
   BallbarDiagnosisOptions o;

@@ -52,4 +52,12 @@ std::string format_literal(double v) {
   return s;
 }
 
+std::string format_literal17(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  std::string s(buf);
+  if (s.find_first_of(".en") == std::string::npos) s += ".0";
+  return s;
+}
+
 }  // namespace weilgen

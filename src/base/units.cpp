@@ -7,13 +7,12 @@
 #include <stdexcept>
 #include <vector>
 
+#include "weilgen/base/constants.hpp"
 #include "weilgen/base/expr.hpp"
 #include "weilgen/base/text.hpp"
 
 namespace weilgen {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 struct NamedUnit {
   const char* name;

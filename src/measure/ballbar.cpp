@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "weilgen/base/constants.hpp"
 #include "weilgen/base/format.hpp"
 #include "weilgen/base/text.hpp"
 #include "weilgen/base/units.hpp"
@@ -14,8 +15,6 @@
 namespace weilgen {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // Angles closer than this (deg) are the same point of the circle.
 constexpr double kSameAngleDeg = 1e-9;
 

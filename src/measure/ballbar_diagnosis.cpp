@@ -9,14 +9,12 @@
 #include <functional>
 #include <stdexcept>
 
+#include "weilgen/base/constants.hpp"
 #include "weilgen/base/format.hpp"
 
 namespace weilgen {
 
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 using Eigen::Index;
 using Eigen::MatrixXd;

@@ -3,12 +3,12 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "weilgen/base/constants.hpp"
 #include "weilgen/base/format.hpp"
 
 namespace weilgen {
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kMmPerInch = 25.4;
 }  // namespace
 

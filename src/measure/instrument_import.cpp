@@ -13,6 +13,7 @@
 #include <tuple>
 
 #include "weilgen/base/atomic_file.hpp"
+#include "weilgen/base/constants.hpp"
 #include "weilgen/base/error.hpp"
 #include "weilgen/base/format.hpp"
 #include "weilgen/base/text.hpp"
@@ -23,7 +24,6 @@ namespace weilgen {
 
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 const char* const kDegree = "\xC2\xB0";   // °
 const char* const kOrdinal = "\xC2\xBA";  // º, often typed for °
 
@@ -241,7 +241,7 @@ MeasurementTable tidy_from_wide(const Wide& w) {
 
 enum class Quantity {
   Target,
-  Index,  // a running number of the target ("Target No."): checked, not carried
+  TargetNumber,  // a running number of the target ("Target No."): checked, not carried
   Direction,
   Deviation,
   AirT,
@@ -367,7 +367,7 @@ CartoColumn classify_carto(const Cell& cell) {
     }
   }
   if (c.run == 0 && is_target_name(name)) c.q = Quantity::Target;
-  if (c.run == 0 && unit.empty() && is_index_name(name)) c.q = Quantity::Index;
+  if (c.run == 0 && unit.empty() && is_index_name(name)) c.q = Quantity::TargetNumber;
   if (c.run == 0 && (name == "direction" || name == "dir")) c.q = Quantity::Direction;
   if (name == "air temperature" || name == "air temp") c.q = Quantity::AirT;
   if (name == "air pressure" || name == "pressure" || name == "barometric pressure")
@@ -687,7 +687,7 @@ ImportResult parse_carto(const std::vector<Line>& lines, const std::string& file
           ++targets;
           cv = target_unit(c.unit, rotary, where);
           break;
-        case Quantity::Index:
+        case Quantity::TargetNumber:
           break;
         case Quantity::Direction:
           has_direction = true;
@@ -778,7 +778,7 @@ ImportResult parse_carto(const std::vector<Line>& lines, const std::string& file
       case Quantity::Time:
         tidy = "t_s";
         break;
-      case Quantity::Index:
+      case Quantity::TargetNumber:
         res.mapping.push_back("'" + c.header + "' -> (the target's number: checked, not carried)");
         break;
       case Quantity::Unknown:
@@ -832,7 +832,7 @@ ImportResult parse_carto(const std::vector<Line>& lines, const std::string& file
           throw InputError(SourceLoc{file, L.no, cell.column}, "a value under no column name");
         continue;
       }
-      if (cols[i].q == Quantity::Index) {
+      if (cols[i].q == Quantity::TargetNumber) {
         double number = 0;
         if (!cell.text.empty() &&
             !(parse_number(cell.text, false, number) && number == std::floor(number)))

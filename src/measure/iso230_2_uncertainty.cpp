@@ -12,6 +12,7 @@
 #include <random>
 #include <stdexcept>
 
+#include "weilgen/base/constants.hpp"
 #include "weilgen/base/error.hpp"
 #include "weilgen/base/format.hpp"
 #include "weilgen/base/text.hpp"
@@ -22,8 +23,6 @@
 namespace weilgen {
 
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 struct Key {
   const char* name;
@@ -125,8 +124,6 @@ double draw(Normal& g, BudgetDistribution d, double u) {
   }
   return g() * u;
 }
-
-std::string num(double v) { return format_significant(v, 3); }
 
 }  // namespace
 
@@ -303,7 +300,7 @@ UncertaintyResult Iso230_2Uncertainty::run(const IsoRuns& runs, const IsoFigures
   std::vector<double> per_scale(m);
   // A rotary axis' targets are in deg and its scale error in µrad/rad: the rotation in rad.
   for (std::size_t i = 0; i < m; ++i)
-    per_scale[i] = (P[i] - n.datum_mm) * (linear ? 1e-3 : 3.14159265358979323846 / 180);
+    per_scale[i] = (P[i] - n.datum_mm) * (linear ? 1e-3 : kPi / 180);
 
   std::vector<UncertaintyContribution> C;
   auto add = [&](const std::string& name, const std::string& input, BudgetDistribution d,
@@ -320,11 +317,13 @@ UncertaintyResult Iso230_2Uncertainty::run(const IsoRuns& runs, const IsoFigures
   };
   const double sqrt3 = std::sqrt(3.0), sqrt12 = std::sqrt(12.0);
   const std::string scale_unit = linear ? "um/m" : "urad/rad";
-  add("instrument calibration", num(in["instrument_ppm"]) + " " + scale_unit + " (k = 2)",
+  add("instrument calibration",
+      format_significant(in["instrument_ppm"], 3) + " " + scale_unit + " (k = 2)",
       BudgetDistribution::Normal, ContributionKind::Scale, in["instrument_ppm"] / 2, scale_unit);
-  add("instrument, constant part", num(in["instrument_um"]) + " " + unit + " (k = 2)",
+  add("instrument, constant part",
+      format_significant(in["instrument_um"], 3) + " " + unit + " (k = 2)",
       BudgetDistribution::Normal, ContributionKind::PerMean, in["instrument_um"] / 2, unit);
-  add("resolution", num(in["resolution_um"]) + " " + unit + " (full width)",
+  add("resolution", format_significant(in["resolution_um"], 3) + " " + unit + " (full width)",
       BudgetDistribution::Rectangular, ContributionKind::PerMean, in["resolution_um"] / sqrt12,
       unit);
   if (linear && laser) {
@@ -346,21 +345,26 @@ UncertaintyResult Iso230_2Uncertainty::run(const IsoRuns& runs, const IsoFigures
     const bool compensated = n.air_applied || n.air == AirCompensation::Instrument;
     if (compensated) {
       add("air temperature sensor",
-          num(in["air_temperature_C"]) + " degC x " + num(dT) + " um/(m K)",
+          format_significant(in["air_temperature_C"], 3) + " degC x " + format_significant(dT, 3) +
+              " um/(m K)",
           BudgetDistribution::Rectangular, ContributionKind::Scale,
           in["air_temperature_C"] * dT / sqrt3, scale_unit);
       add("air pressure sensor",
-          num(in["air_pressure_Pa"]) + " Pa x " + num(dp * 1e3) + " um/(m kPa)",
+          format_significant(in["air_pressure_Pa"], 3) + " Pa x " +
+              format_significant(dp * 1e3, 3) + " um/(m kPa)",
           BudgetDistribution::Rectangular, ContributionKind::Scale,
           in["air_pressure_Pa"] * dp / sqrt3, scale_unit);
-      add("air humidity sensor", num(in["air_humidity_pct"]) + " %RH x " + num(dh) + " um/(m %RH)",
+      add("air humidity sensor",
+          format_significant(in["air_humidity_pct"], 3) + " %RH x " + format_significant(dh, 3) +
+              " um/(m %RH)",
           BudgetDistribution::Rectangular, ContributionKind::Scale,
           in["air_humidity_pct"] * dh / sqrt3, scale_unit);
-      add("Edlen equation", num(in["edlen_ppm"]) + " um/m (k = 3)", BudgetDistribution::Normal,
-          ContributionKind::Scale, in["edlen_ppm"] / 3, scale_unit);
+      add("Edlen equation", format_significant(in["edlen_ppm"], 3) + " um/m (k = 3)",
+          BudgetDistribution::Normal, ContributionKind::Scale, in["edlen_ppm"] / 3, scale_unit);
     } else {
       const double index = air_refractivity(air, n.wavelength_nm) * 1e6;
-      add("air refraction not compensated", num(index) + " um/m (the index of the air)",
+      add("air refraction not compensated",
+          format_significant(index, 3) + " um/m (the index of the air)",
           BudgetDistribution::Rectangular, ContributionKind::Scale, index / sqrt3, scale_unit);
       r.notes.push_back(
           "The air's refractive index is not compensated: the budget counts the whole index as "
@@ -375,13 +379,15 @@ UncertaintyResult Iso230_2Uncertainty::run(const IsoRuns& runs, const IsoFigures
     const double offset = known ? std::abs(n.material_temperature_C.mean - 20) : kNaN;
     if (normalised) {
       add("material temperature sensor",
-          num(in["material_temperature_C"]) + " degC x " + num(alpha) + " um/(m K)",
+          format_significant(in["material_temperature_C"], 3) + " degC x " +
+              format_significant(alpha, 3) + " um/(m K)",
           BudgetDistribution::Rectangular, ContributionKind::Scale,
           in["material_temperature_C"] * alpha / sqrt3, scale_unit);
       if (known)
         add("expansion coefficient",
-            num(100 * in["expansion_relative"]) + " % of " + num(alpha) + " um/(m K) x " +
-                num(offset) + " K",
+            format_significant(100 * in["expansion_relative"], 3) + " % of " +
+                format_significant(alpha, 3) + " um/(m K) x " + format_significant(offset, 3) +
+                " K",
             BudgetDistribution::Rectangular, ContributionKind::Scale,
             in["expansion_relative"] * alpha * offset / sqrt3, scale_unit);
       else
@@ -389,7 +395,8 @@ UncertaintyResult Iso230_2Uncertainty::run(const IsoRuns& runs, const IsoFigures
             "No material temperature recorded: the expansion coefficient's uncertainty "
             "(proportional to T - 20 degC) is not in the budget.");
     } else if (known) {
-      add("expansion not corrected", num(alpha) + " um/(m K) x " + num(offset) + " K",
+      add("expansion not corrected",
+          format_significant(alpha, 3) + " um/(m K) x " + format_significant(offset, 3) + " K",
           BudgetDistribution::Rectangular, ContributionKind::Scale, alpha * offset / sqrt3,
           scale_unit);
       r.notes.push_back(
@@ -404,7 +411,8 @@ UncertaintyResult Iso230_2Uncertainty::run(const IsoRuns& runs, const IsoFigures
     if (travel > 0 && in["misalignment_mm"] > 0) {
       const double phi = in["misalignment_mm"] / travel;
       add("cosine error (beam misalignment)",
-          num(in["misalignment_mm"]) + " mm over " + format_number(travel) + " mm",
+          format_significant(in["misalignment_mm"], 3) + " mm over " + format_number(travel) +
+              " mm",
           BudgetDistribution::OneSided, ContributionKind::Scale, phi * phi / 2 * 1e6 / sqrt12,
           scale_unit);
     }
@@ -412,11 +420,15 @@ UncertaintyResult Iso230_2Uncertainty::run(const IsoRuns& runs, const IsoFigures
       const double change = n.air_refractivity.count > 1
                                 ? n.air_refractivity.max - n.air_refractivity.min
                                 : dT * 1e-6 * in["dead_path_air_change_C"];
-      add("dead path", num(in["dead_path_mm"]) + " mm x " + num(change * 1e6) + " um/m",
+      add("dead path",
+          format_significant(in["dead_path_mm"], 3) + " mm x " +
+              format_significant(change * 1e6, 3) + " um/m",
           BudgetDistribution::Rectangular, ContributionKind::PerMean,
           in["dead_path_mm"] * change * 1e3 / 2 / sqrt3, unit);
     }
-    add("Abbe error", num(in["abbe_offset_mm"]) + " mm x " + num(in["abbe_angle_urad"]) + " urad",
+    add("Abbe error",
+        format_significant(in["abbe_offset_mm"], 3) + " mm x " +
+            format_significant(in["abbe_angle_urad"], 3) + " urad",
         BudgetDistribution::Rectangular, ContributionKind::PerTarget,
         in["abbe_offset_mm"] * in["abbe_angle_urad"] * 1e-3 / 2 / sqrt3, unit);
   } else if (!linear) {
@@ -424,7 +436,8 @@ UncertaintyResult Iso230_2Uncertainty::run(const IsoRuns& runs, const IsoFigures
         "A rotary axis: the budget holds the instrument, the resolution, the environmental "
         "variation and the run's repeatability.");
   }
-  add("environmental variation (EVE)", num(in["eve_um"]) + " " + unit + " (range)",
+  add("environmental variation (EVE)",
+      format_significant(in["eve_um"], 3) + " " + unit + " (range)",
       BudgetDistribution::Rectangular, ContributionKind::PerMean, in["eve_um"] / 2 / sqrt3, unit);
   {
     UncertaintyContribution a;

@@ -6,6 +6,7 @@
 #include <functional>
 #include <stdexcept>
 
+#include "weilgen/base/constants.hpp"
 #include "weilgen/base/error.hpp"
 #include "weilgen/base/format.hpp"
 #include "weilgen/base/text.hpp"
@@ -13,8 +14,6 @@
 namespace weilgen {
 
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 struct Limits {
   double lo, hi;

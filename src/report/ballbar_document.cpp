@@ -15,8 +15,6 @@ namespace {
 
 using nlohmann::json;
 
-std::string fmt(double v, int decimals = 3) { return format_fixed(v, decimals); }
-
 // The largest G (LSQ centre) of the runs: what a cause's share is of.
 double largest_g(const BallbarStudy& st) {
   double g = 0;
@@ -25,10 +23,10 @@ double largest_g(const BallbarStudy& st) {
 }
 
 std::string size_text(const BallbarCause& c) {
-  std::string s = fmt(c.size, c.unit == "um" ? 2 : 1) + " +- " + fmt(c.se, c.unit == "um" ? 2 : 1) +
-                  " " + c.unit;
+  std::string s = format_fixed(c.size, c.unit == "um" ? 2 : 1) + " +- " +
+                  format_fixed(c.se, c.unit == "um" ? 2 : 1) + " " + c.unit;
   if (std::isfinite(c.detail))
-    s += ", " + c.detail_name + " " + fmt(c.detail, c.detail_unit == "ms" ? 3 : 1) + " " +
+    s += ", " + c.detail_name + " " + format_fixed(c.detail, c.detail_unit == "ms" ? 3 : 1) + " " +
          c.detail_unit;
   return s;
 }
@@ -72,23 +70,24 @@ std::string ballbar_text(const BallbarStudy& st) {
     if (name == "centre offset first") name = "centre offset " + c.first;
     if (name == "centre offset second") name = "centre offset " + c.second;
     o << "  " << std::left << std::setw(38) << name << std::right;
-    for (const BallbarRun& r : d.runs) o << std::setw(12) << fmt(row.get(r.evaluation));
+    for (const BallbarRun& r : d.runs) o << std::setw(12) << format_fixed(row.get(r.evaluation), 3);
     o << "\n";
   }
   o << "  " << std::left << std::setw(38) << "points / coverage (deg)" << std::right;
   for (const BallbarRun& r : d.runs)
     o << std::setw(12)
-      << (std::to_string(r.evaluation.points) + "/" + fmt(r.evaluation.coverage_deg, 0));
+      << (std::to_string(r.evaluation.points) + "/" + format_fixed(r.evaluation.coverage_deg, 0));
   o << "\n";
   if (std::isfinite(d.hysteresis_um))
-    o << "  circular hysteresis H (first ccw against first cw run): " << fmt(d.hysteresis_um)
-      << " um\n";
+    o << "  circular hysteresis H (first ccw against first cw run): "
+      << format_fixed(d.hysteresis_um, 3) << " um\n";
   else
     o << "  circular hysteresis H: needs a ccw and a cw run\n";
 
   o << "\nDiagnosis (least squares on every run, each run's centre and radius free; residual "
-    << fmt(d.residual_rms_um) << " um rms; significance: partial F test, family-wise alpha "
-    << format_number(d.alpha) << ")\n";
+    << format_fixed(d.residual_rms_um, 3)
+    << " um rms; significance: partial F test, family-wise alpha " << format_number(d.alpha)
+    << ")\n";
   const double g = largest_g(st);
   std::size_t rank = 0;
   for (const BallbarCause& k : d.causes)
@@ -99,16 +98,17 @@ std::string ballbar_text(const BallbarStudy& st) {
           << std::setw(14) << "contribution" << std::setw(8) << "share" << std::setw(10) << "p"
           << "\n";
       o << std::setw(6) << ++rank << "  " << std::left << std::setw(26) << k.name << std::setw(34)
-        << size_text(k) << std::right << std::setw(11) << fmt(k.contribution_um) << " um"
-        << std::setw(7) << (g > 0 ? fmt(100 * k.contribution_um / g, 0) : "-") << "%"
-        << std::setw(10) << p_text(k.p_value) << "\n";
+        << size_text(k) << std::right << std::setw(11) << format_fixed(k.contribution_um, 3)
+        << " um" << std::setw(7) << (g > 0 ? format_fixed(100 * k.contribution_um / g, 0) : "-")
+        << "%" << std::setw(10) << p_text(k.p_value) << "\n";
       for (const BallbarCauseTerm& t : st.terms)
         if (t.cause == k.id && t.per_unit != 0)
           o << "          " << st.machine << ": as " << t.term << " alone, " << t.term << " = "
             << format_significant(k.size / t.per_unit, 4) << " " << t.unit << "\n";
     }
   if (rank == 0)
-    o << "  clean: no cause stands out of the noise (" << fmt(d.residual_rms_um) << " um rms)\n";
+    o << "  clean: no cause stands out of the noise (" << format_fixed(d.residual_rms_um, 3)
+      << " um rms)\n";
   std::vector<std::string> quiet, inseparable;
   for (const BallbarCause& k : d.causes) {
     if (!k.separable) {

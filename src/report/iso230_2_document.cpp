@@ -65,7 +65,6 @@ json differences_json(const AdjacentDifferences& D, const std::vector<double>& p
 }
 
 // Table cells: fixed decimals (3 unless said), "-" when not computed.
-std::string fmt(double v, int decimals = 3) { return format_fixed(v, decimals); }
 
 std::string dir_label(int d) { return d > 0 ? "+1" : "-1"; }
 
@@ -101,9 +100,10 @@ void add_tolerance_rules(LinePlot& p, const std::vector<ToleranceCheck>& checks,
 
 std::string range_text(const ValueRange& r, int decimals, const std::string& unit) {
   if (r.empty()) return "-";
-  if (r.max - r.min < 0.5 * std::pow(10.0, -decimals)) return fmt(r.mean, decimals) + " " + unit;
-  return fmt(r.min, decimals) + " .. " + fmt(r.max, decimals) + " " + unit + " (mean " +
-         fmt(r.mean, decimals) + ")";
+  if (r.max - r.min < 0.5 * std::pow(10.0, -decimals))
+    return format_fixed(r.mean, decimals) + " " + unit;
+  return format_fixed(r.min, decimals) + " .. " + format_fixed(r.max, decimals) + " " + unit +
+         " (mean " + format_fixed(r.mean, decimals) + ")";
 }
 
 std::string with_source(const std::string& text, const std::string& source) {
@@ -240,10 +240,10 @@ std::vector<std::string> iso230_2_tolerance_statement(const Iso230_2StudyResult&
   for (const ToleranceCheck& c : res.tolerance) {
     std::ostringstream l;
     l << "  " << std::left << std::setw(8) << (c.name == "band" ? std::string("|x +- 2s|") : c.name)
-      << std::right << std::setw(10) << fmt(c.value) << " " << u;
+      << std::right << std::setw(10) << format_fixed(c.value, 3) << " " << u;
     if (std::isfinite(c.U)) {
       with_u = true;
-      l << " +- " << std::setw(6) << fmt(c.U) << " (U)";
+      l << " +- " << std::setw(6) << format_fixed(c.U, 3) << " (U)";
     }
     l << (c.pass ? " <= " : " >  ") << std::setw(8) << format_number(c.limit) << " " << u << "  "
       << (c.decision == Decision::Conforms         ? "pass"
@@ -294,11 +294,12 @@ std::vector<std::string> iso230_2_uncertainty_text(const Iso230_2StudyResult& re
     const FigureUncertainty* f = U.figure(name);
     if (!f) continue;
     std::ostringstream l;
-    l << "  " << std::left << std::setw(8) << name << std::right << std::setw(10) << fmt(f->value)
-      << std::setw(10) << fmt(f->u) << std::setw(10) << fmt(f->U) << std::setw(16) << fmt(f->mc_u)
-      << "   "
-      << (std::isfinite(f->mc_low) ? fmt(f->mc_low) + " .. " + fmt(f->mc_high) + " " + u
-                                   : std::string("-"))
+    l << "  " << std::left << std::setw(8) << name << std::right << std::setw(10)
+      << format_fixed(f->value, 3) << std::setw(10) << format_fixed(f->u, 3) << std::setw(10)
+      << format_fixed(f->U, 3) << std::setw(16) << format_fixed(f->mc_u, 3) << "   "
+      << (std::isfinite(f->mc_low)
+              ? format_fixed(f->mc_low, 3) + " .. " + format_fixed(f->mc_high, 3) + " " + u
+              : std::string("-"))
       << (U.trials > 0 && !f->validated ? "  (*)" : "");
     out.push_back(l.str());
   }
@@ -313,9 +314,9 @@ std::vector<std::string> iso230_2_uncertainty_text(const Iso230_2StudyResult& re
   for (const std::string& name : iso230_2_budget_figures()) {
     const FigureUncertainty* f = U.figure(name);
     out.push_back("");
-    out.push_back("  Budget of " + name + " = " + fmt(f->value) + " " + u + ": u = " + fmt(f->u) +
-                  " " + u + ", U = " + fmt(f->U) + " " + u +
-                  " (k = " + format_number(U.coverage_factor) + ")");
+    out.push_back("  Budget of " + name + " = " + format_fixed(f->value, 3) + " " + u +
+                  ": u = " + format_fixed(f->u, 3) + " " + u + ", U = " + format_fixed(f->U, 3) +
+                  " " + u + " (k = " + format_number(U.coverage_factor) + ")");
     std::ostringstream h;
     h << "    " << std::left << std::setw(36) << "contribution" << std::setw(22) << "distribution"
       << std::right << std::setw(14) << "u(x)" << std::setw(12) << "c" << std::setw(10) << "|c| u"
@@ -334,7 +335,7 @@ std::vector<std::string> iso230_2_uncertainty_text(const Iso230_2StudyResult& re
                 ? format_significant(c.sensitivity.at(name), 3) +
                       (c.kind == ContributionKind::Scale ? " m" : "")
                 : std::string("-"))
-        << std::setw(10) << fmt(part) << std::setw(8)
+        << std::setw(10) << format_fixed(part, 3) << std::setw(8)
         << (f->u > 0 ? format_fixed(100 * part * part / (f->u * f->u), 1) : std::string("-"))
         << "%";
       out.push_back(l.str());
@@ -383,11 +384,12 @@ std::string iso230_2_text(const std::string& data, const Iso230_2StudyResult& re
     << "R_i up" << std::setw(9) << "R_i dn" << std::setw(9) << "R_i" << std::setw(10) << "mean bi"
     << "\n";
   for (std::size_t i = 0; i < m; ++i)
-    o << std::setw(12) << format_number(P[i]) << std::setw(10) << fmt(F.mean_up[i]) << std::setw(10)
-      << fmt(F.mean_down[i]) << std::setw(9) << fmt(F.s_up[i]) << std::setw(9) << fmt(F.s_down[i])
-      << std::setw(9) << fmt(F.B_i[i]) << std::setw(9) << fmt(F.R_i_up[i]) << std::setw(9)
-      << fmt(F.R_i_down[i]) << std::setw(9) << fmt(F.R_i[i]) << std::setw(10) << fmt(F.mean_bi[i])
-      << "\n";
+    o << std::setw(12) << format_number(P[i]) << std::setw(10) << format_fixed(F.mean_up[i], 3)
+      << std::setw(10) << format_fixed(F.mean_down[i], 3) << std::setw(9)
+      << format_fixed(F.s_up[i], 3) << std::setw(9) << format_fixed(F.s_down[i], 3) << std::setw(9)
+      << format_fixed(F.B_i[i], 3) << std::setw(9) << format_fixed(F.R_i_up[i], 3) << std::setw(9)
+      << format_fixed(F.R_i_down[i], 3) << std::setw(9) << format_fixed(F.R_i[i], 3)
+      << std::setw(10) << format_fixed(F.mean_bi[i], 3) << "\n";
 
   struct Row {
     const char* name;
@@ -416,12 +418,14 @@ std::string iso230_2_text(const std::string& data, const Iso230_2StudyResult& re
   o << "\n";
   for (const Row& r : rows) {
     o << "  " << std::left << std::setw(7) << r.name << std::setw(37) << r.what << std::right;
-    for (const IsoFigures* s : sets) o << std::setw(12) << (s ? fmt(s->*(r.field)) : "-");
+    for (const IsoFigures* s : sets)
+      o << std::setw(12) << (s ? format_fixed(s->*(r.field), 3) : "-");
     o << "\n";
   }
   o << std::left << std::setw(46) << "  coverage factor k (up/down)" << std::right;
   for (const IsoFigures* s : sets)
-    o << std::setw(12) << (s ? fmt(s->k_up, 2) + "/" + fmt(s->k_down, 2) : std::string("-"));
+    o << std::setw(12)
+      << (s ? format_fixed(s->k_up, 2) + "/" + format_fixed(s->k_down, 2) : std::string("-"));
   o << "\n";
   if (res.uncertainty) {
     o << "\nMeasurement uncertainty (" << u << "; ISO 230-9 and the GUM; class "
@@ -453,20 +457,23 @@ std::string iso230_2_text(const std::string& data, const Iso230_2StudyResult& re
         return s.str();
       };
       o << std::setw(20) << (format_number(P[q]) + ".." + format_number(P[q + 1])) << std::setw(10)
-        << fmt(D.differences[kUp].mean[q]) << std::setw(9) << fmt(D.differences[kUp].s[q])
-        << std::setw(10) << pv(kUp) << std::setw(10) << fmt(D.differences[kDown].mean[q])
-        << std::setw(9) << fmt(D.differences[kDown].s[q]) << std::setw(10) << pv(kDown) << "\n";
+        << format_fixed(D.differences[kUp].mean[q], 3) << std::setw(9)
+        << format_fixed(D.differences[kUp].s[q], 3) << std::setw(10) << pv(kUp) << std::setw(10)
+        << format_fixed(D.differences[kDown].mean[q], 3) << std::setw(9)
+        << format_fixed(D.differences[kDown].s[q], 3) << std::setw(10) << pv(kDown) << "\n";
     }
-    o << "  s of differences / s of positions: up " << fmt(D.s_ratio[kUp]) << ", down "
-      << fmt(D.s_ratio[kDown]) << " (sqrt 2 = 1.414 without drift)\n";
+    o << "  s of differences / s of positions: up " << format_fixed(D.s_ratio[kUp], 3) << ", down "
+      << format_fixed(D.s_ratio[kDown], 3) << " (sqrt 2 = 1.414 without drift)\n";
     o << "\n"
       << std::setw(12) << "target mm" << std::setw(11) << "chart up" << std::setw(9) << "s* up"
       << std::setw(11) << "chart dn" << std::setw(9) << "s* dn"
       << "\n";
     for (std::size_t i = 0; i < m; ++i)
-      o << std::setw(12) << format_number(P[i]) << std::setw(11) << fmt(D.chart[kUp].value[i])
-        << std::setw(9) << fmt(D.chart[kUp].s[i]) << std::setw(11) << fmt(D.chart[kDown].value[i])
-        << std::setw(9) << fmt(D.chart[kDown].s[i]) << "\n";
+      o << std::setw(12) << format_number(P[i]) << std::setw(11)
+        << format_fixed(D.chart[kUp].value[i], 3) << std::setw(9)
+        << format_fixed(D.chart[kUp].s[i], 3) << std::setw(11)
+        << format_fixed(D.chart[kDown].value[i], 3) << std::setw(9)
+        << format_fixed(D.chart[kDown].s[i], 3) << "\n";
     o << "\nAnomaly test (F test of each difference's variance against the same-parity others,\n"
          "Bonferroni over "
       << D.tests << " tests, alpha " << format_number(D.alpha) << "): ";
@@ -476,8 +483,8 @@ std::string iso230_2_text(const std::string& data, const Iso230_2StudyResult& re
       o << "\n";
       for (const auto& a : D.anomalous_differences)
         o << "  dir " << dir_label(a.direction) << ": " << format_number(P[a.from]) << ".."
-          << format_number(P[a.to]) << " mm, s " << fmt(a.s) << " " << u << ", F " << fmt(a.F, 2)
-          << ", p " << std::setprecision(3) << a.p_value << "\n";
+          << format_number(P[a.to]) << " mm, s " << format_fixed(a.s, 3) << " " << u << ", F "
+          << format_fixed(a.F, 2) << ", p " << std::setprecision(3) << a.p_value << "\n";
       for (const auto& a : D.anomalous_positions)
         o << "  anomalous position: " << cols.axis << "=" << format_number(P[a.target])
           << " mm (target " << a.target + 1 << "), dir " << dir_label(a.direction) << "\n";
@@ -490,14 +497,16 @@ std::string iso230_2_text(const std::string& data, const Iso230_2StudyResult& re
       << "\n";
     for (std::size_t c = 0; c < C.cycles.size(); ++c) {
       o << std::setw(8) << C.cycles[c];
-      if (!C.time_h.empty()) o << std::setw(9) << fmt(C.time_h[c], 3);
-      o << std::setw(10) << fmt(C.offset_up[c]) << std::setw(10) << fmt(C.offset_down[c])
-        << std::setw(10) << fmt(C.offset[c]) << "\n";
+      if (!C.time_h.empty()) o << std::setw(9) << format_fixed(C.time_h[c], 3);
+      o << std::setw(10) << format_fixed(C.offset_up[c], 3) << std::setw(10)
+        << format_fixed(C.offset_down[c], 3) << std::setw(10) << format_fixed(C.offset[c], 3)
+        << "\n";
     }
-    o << "  drift rate: " << fmt(C.rate_per_cycle, 4) << " +- " << fmt(C.rate_per_cycle_se, 4)
-      << " " << u << "/cycle";
+    o << "  drift rate: " << format_fixed(C.rate_per_cycle, 4) << " +- "
+      << format_fixed(C.rate_per_cycle_se, 4) << " " << u << "/cycle";
     if (std::isfinite(C.rate_per_h))
-      o << ", " << fmt(C.rate_per_h, 4) << " +- " << fmt(C.rate_per_h_se, 4) << " " << u << "/h";
+      o << ", " << format_fixed(C.rate_per_h, 4) << " +- " << format_fixed(C.rate_per_h_se, 4)
+        << " " << u << "/h";
     o << "\n";
   } else if (res.iso_only) {
     o << "\nDrift elimination and the Student-t set: off (--iso-only).\n";

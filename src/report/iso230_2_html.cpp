@@ -20,7 +20,6 @@ const char* const kUpColour = "#1f77b4";    // forward (↑)
 const char* const kDownColour = "#d62728";  // reverse (↓)
 
 std::string h(const std::string& s) { return xml_escape(s); }
-std::string num(double v, int decimals = 3) { return format_fixed(v, decimals); }
 
 std::string unit_html(const std::string& u) { return pretty(u); }
 
@@ -67,7 +66,7 @@ std::string figures_table(const IsoFigures& F, const std::string& set, const std
   auto cell = [&](const char* key, double IsoFigures::*f) {
     if (!key) return std::string("<td class=\"num na\">\xE2\x80\x93</td>");
     return "<td class=\"num\"><span data-set=\"" + set + "\" data-key=\"" + key + "_um\">" +
-           num(F.*f) + "</span>" + limit_of(key) + "</td>";
+           format_fixed(F.*f, 3) + "</span>" + limit_of(key) + "</td>";
   };
   std::ostringstream o;
   o << "<table class=\"figures\"><thead><tr><th>Figure (" << unit_html(u)
@@ -78,7 +77,8 @@ std::string figures_table(const IsoFigures& F, const std::string& set, const std
       << cell(r.bi, r.f_bi) << cell(r.up, r.f_up) << cell(r.down, r.f_down) << "</tr>\n";
   }
   o << "<tr class=\"k\"><td>Coverage factor</td><td class=\"sym\">k</td><td></td><td class=\"num\">"
-    << num(F.k_up, 2) << "</td><td class=\"num\">" << num(F.k_down, 2) << "</td></tr>\n";
+    << format_fixed(F.k_up, 2) << "</td><td class=\"num\">" << format_fixed(F.k_down, 2)
+    << "</td></tr>\n";
   o << "</tbody></table>\n";
   return o.str();
 }
@@ -158,7 +158,8 @@ void environment_table(std::ostream& o, const NormalisationResult& n) {
     std::string source;
   };
   const std::string air_source =
-      n.air_applied ? "Edl\xC3\xA9n (Birch & Downs), " + num(n.wavelength_nm, 3) + " nm" : "";
+      n.air_applied ? "Edl\xC3\xA9n (Birch & Downs), " + format_fixed(n.wavelength_nm, 3) + " nm"
+                    : "";
   const Row rows[] = {
       {"Material temperature", n.material_temperature_C, 1, 2,
        "\xC2\xB0"
@@ -175,7 +176,7 @@ void environment_table(std::ostream& o, const NormalisationResult& n) {
       {"Air correction \xCE\xB4<sub>air</sub>", n.air_correction_um, 1, 3, "\xC2\xB5m", ""},
       {"Expansion correction \xCE\xB4<sub>T</sub>", n.material_correction_um, 1, 3, "\xC2\xB5m",
        n.material_applied
-           ? "\xCE\xB1 = " + num(n.expansion_ppm_per_K, 2) + " \xC2\xB5m/(m\xC2\xB7K)"
+           ? "\xCE\xB1 = " + format_fixed(n.expansion_ppm_per_K, 2) + " \xC2\xB5m/(m\xC2\xB7K)"
            : ""}};
   bool any = false;
   for (const Row& r : rows) any |= !r.v.empty();
@@ -186,7 +187,7 @@ void environment_table(std::ostream& o, const NormalisationResult& n) {
     if (r.v.empty()) continue;
     o << "<tr><td>" << r.name << "</td>";
     for (double v : {r.v.min, r.v.mean, r.v.max})
-      o << "<td class=\"num\">" << num(v * r.scale, r.decimals) << "</td>";
+      o << "<td class=\"num\">" << format_fixed(v * r.scale, r.decimals) << "</td>";
     o << "<td>" << r.unit << "</td><td>" << h(r.source) << "</td></tr>\n";
   }
   o << "</table>\n";
@@ -215,13 +216,14 @@ void uncertainty_section(std::ostream& o, const Iso230_2StudyResult& res) {
     if (!f) continue;
     const bool flag = U.trials > 0 && !f->validated;
     unvalidated |= flag;
-    o << "<tr><td>" << h(name) << "</td><td class=\"num\">" << num(f->value)
+    o << "<tr><td>" << h(name) << "</td><td class=\"num\">" << format_fixed(f->value, 3)
       << "</td><td class=\"num\" data-uncertainty=\"" << h(name) << "\" data-field=\"u_um\">"
-      << num(f->u) << "</td><td class=\"num\" data-uncertainty=\"" << h(name)
-      << "\" data-field=\"U_um\">" << num(f->U) << "</td><td class=\"num\">" << num(f->mc_u)
-      << (flag ? " *" : "") << "</td><td class=\"num\">"
-      << (std::isfinite(f->mc_low) ? num(f->mc_low) + " \xE2\x80\xA6 " + num(f->mc_high)
-                                   : std::string("\xE2\x80\x93"))
+      << format_fixed(f->u, 3) << "</td><td class=\"num\" data-uncertainty=\"" << h(name)
+      << "\" data-field=\"U_um\">" << format_fixed(f->U, 3) << "</td><td class=\"num\">"
+      << format_fixed(f->mc_u, 3) << (flag ? " *" : "") << "</td><td class=\"num\">"
+      << (std::isfinite(f->mc_low)
+              ? format_fixed(f->mc_low, 3) + " \xE2\x80\xA6 " + format_fixed(f->mc_high, 3)
+              : std::string("\xE2\x80\x93"))
       << "</td></tr>\n";
   }
   o << "</tbody></table>\n";
@@ -250,7 +252,8 @@ void uncertainty_section(std::ostream& o, const Iso230_2StudyResult& res) {
         << (std::isfinite(sens)
                 ? format_significant(sens, 3) + (c.kind == ContributionKind::Scale ? " m" : "")
                 : std::string("\xE2\x80\x93"))
-        << "</td><td class=\"num\" data-budget=\"" << h(name) << "\">" << num(part) << " ("
+        << "</td><td class=\"num\" data-budget=\"" << h(name) << "\">" << format_fixed(part, 3)
+        << " ("
         << (total > 0 ? format_fixed(100 * part * part / (total * total), 1) : std::string("0"))
         << " %)</td>";
     }
@@ -426,10 +429,10 @@ std::string iso230_2_html(const std::string& data, const Iso230_2StudyResult& re
   if (res.classical.student) {
     const IsoFigures& S = *res.classical.student;
     o << "<p>With the Student-t coverage factor for " << runs.cycles[kUp].size()
-      << " cycles (k = " << num(S.k_up, 2) << " / " << num(S.k_down, 2)
-      << "): A = <span data-set=\"student\" data-key=\"A_um\">" << num(S.A) << "</span> "
-      << pretty(u) << ", R = <span data-set=\"student\" data-key=\"R_um\">" << num(S.R)
-      << "</span> " << pretty(u) << ".</p>\n";
+      << " cycles (k = " << format_fixed(S.k_up, 2) << " / " << format_fixed(S.k_down, 2)
+      << "): A = <span data-set=\"student\" data-key=\"A_um\">" << format_fixed(S.A, 3)
+      << "</span> " << pretty(u) << ", R = <span data-set=\"student\" data-key=\"R_um\">"
+      << format_fixed(S.R, 3) << "</span> " << pretty(u) << ".</p>\n";
   }
   if (!res.tolerance.empty()) {
     o << "<table class=\"tolerance\"><thead><tr><th>Tolerance</th><th>Value (" << pretty(u)
@@ -440,9 +443,9 @@ std::string iso230_2_html(const std::string& data, const Iso230_2StudyResult& re
         << (c.name == "band" ? std::string("every x\xCC\x84 \xC2\xB1 2s within \xC2\xB1 limit")
                              : h(c.name))
         << "</td><td class=\"num\" data-set=\"tolerance\" data-key=\"" << h(c.name) << "\">"
-        << num(c.value) << "</td><td class=\"num\">" << num(c.U) << "</td><td class=\"num\">"
-        << format_number(c.limit) << "</td><td class=\"" << decision_class(c.decision) << "\">"
-        << decision_text(c.decision) << "</td></tr>\n";
+        << format_fixed(c.value, 3) << "</td><td class=\"num\">" << format_fixed(c.U, 3)
+        << "</td><td class=\"num\">" << format_number(c.limit) << "</td><td class=\""
+        << decision_class(c.decision) << "\">" << decision_text(c.decision) << "</td></tr>\n";
     o << "</tbody></table>\n";
   }
   o << "</section>\n";
@@ -461,7 +464,7 @@ std::string iso230_2_html(const std::string& data, const Iso230_2StudyResult& re
   for (std::size_t i = 0; i < m; ++i) {
     auto td = [&](const char* k, double v) {
       return "<td class=\"num\" data-set=\"classical\" data-key=\"" + std::string(k) +
-             "\" data-index=\"" + std::to_string(i) + "\">" + num(v) + "</td>";
+             "\" data-index=\"" + std::to_string(i) + "\">" + format_fixed(v, 3) + "</td>";
     };
     o << "<tr><td class=\"num\">" << format_number(P[i]) << "</td>"
       << td("mean_up_um", F.mean_up[i]) << td("mean_down_um", F.mean_down[i])
@@ -469,9 +472,10 @@ std::string iso230_2_html(const std::string& data, const Iso230_2StudyResult& re
       << td("R_i_up_um", F.R_i_up[i]) << td("R_i_down_um", F.R_i_down[i]) << td("R_i_um", F.R_i[i])
       << td("mean_bi_um", F.mean_bi[i]);
     if (D)
-      o << "<td class=\"num\">" << num(D->chart[kUp].value[i]) << "</td><td class=\"num\">"
-        << num(D->chart[kUp].s[i]) << "</td><td class=\"num\">" << num(D->chart[kDown].value[i])
-        << "</td><td class=\"num\">" << num(D->chart[kDown].s[i]) << "</td>";
+      o << "<td class=\"num\">" << format_fixed(D->chart[kUp].value[i], 3)
+        << "</td><td class=\"num\">" << format_fixed(D->chart[kUp].s[i], 3)
+        << "</td><td class=\"num\">" << format_fixed(D->chart[kDown].value[i], 3)
+        << "</td><td class=\"num\">" << format_fixed(D->chart[kDown].s[i], 3) << "</td>";
     o << "</tr>\n";
   }
   o << "</tbody></table></section>\n";
@@ -491,11 +495,11 @@ std::string iso230_2_html(const std::string& data, const Iso230_2StudyResult& re
     cyc.width = 760;
     cyc.height = 300;
     o << "<section id=\"drift\"><h2>Thermal drift</h2>\n<figure>" << svg_chart(cyc)
-      << "</figure>\n<p>Drift rate " << num(C.rate_per_cycle, 4) << " \xC2\xB1 "
-      << num(C.rate_per_cycle_se, 4) << " " << pretty(u) << " per cycle";
+      << "</figure>\n<p>Drift rate " << format_fixed(C.rate_per_cycle, 4) << " \xC2\xB1 "
+      << format_fixed(C.rate_per_cycle_se, 4) << " " << pretty(u) << " per cycle";
     if (std::isfinite(C.rate_per_h))
-      o << ", " << num(C.rate_per_h, 4) << " \xC2\xB1 " << num(C.rate_per_h_se, 4) << " "
-        << pretty(u) << "/h";
+      o << ", " << format_fixed(C.rate_per_h, 4) << " \xC2\xB1 " << format_fixed(C.rate_per_h_se, 4)
+        << " " << pretty(u) << "/h";
     o << " (within-group least squares, standard error). Anomaly test (F test of each adjacent "
          "difference, Bonferroni over "
       << D->tests << " tests, \xCE\xB1 = " << format_number(D->alpha) << "): ";

@@ -3,6 +3,7 @@
 #include <memory>
 
 #include "effects.hpp"
+#include "weilgen/base/constants.hpp"
 #include "weilgen/base/text.hpp"
 
 namespace weilgen::gap_detail {
@@ -39,7 +40,7 @@ void add_reversal(const EffectContext& ctx, std::vector<Candidate>& out) {
     const std::string& u = index[k] < d.axis_units.size() ? d.axis_units[index[k]] : "mm";
     const bool rotary = u == "deg" || u == "rad";
     // B in µm (linear, axis in mm) or µrad (rotary): the axis moves by B in its own unit.
-    per_unit.push_back(rotary ? (u == "deg" ? 1e-6 * 180 / 3.14159265358979323846 : 1e-6)
+    per_unit.push_back(rotary ? (u == "deg" ? 1e-6 * 180 / kPi : 1e-6)
                               : (u == "um"  ? 1.0
                                  : u == "m" ? 1e-6
                                             : 1e-3));

@@ -18,5 +18,8 @@ std::string format_significant(double v, int digits);
 // A C++ double literal: the shortest decimal (1 to 17 digits) that reads back as v, with ".0"
 // appended when it would otherwise read as an integer (generated code).
 std::string format_literal(double v);
+// A C++ double literal with all 17 significant digits ("-400.0", "0.0028541741934906256"): the
+// identified parameter header, whose readers compare it with a stated tolerance.
+std::string format_literal17(double v);
 
 }  // namespace weilgen
