@@ -7,6 +7,7 @@
 #include "weilgen/analysis/gap_request.hpp"
 #include "weilgen/analysis/identify_request.hpp"
 #include "weilgen/base/atomic_file.hpp"
+#include "weilgen/measure/instrument_import.hpp"
 #include "weilgen/measure/iso230_2_study.hpp"
 #include "weilgen/measure/pdge_fit_study.hpp"
 #include "weilgen/report/ballbar_document.hpp"
@@ -106,23 +107,26 @@ py::object iso230_2(py::handle data, const py::kwargs& kwargs) {
   kw.set("uncertainty", uncertainty);
   if (!uncertainty.empty()) so.uncertainty = uncertainty_budget_from_flag(uncertainty);
   const Iso230_2Study study(so);  // validates
-  ReadOptions ro;
-  ro.allow_unknown = kw.flag("allow_unknown");
+  // Laser exports too (format auto, as the CLI's default): their compensation state counts.
+  ImportOptions io;
+  io.read.allow_unknown = kw.flag("allow_unknown");
+  io.axis = so.axis;
   std::string plot;
   kw.set("plot", plot);
   if (!plot.empty()) check_plot_target(plot);
   const CompTableCall comp(kw, false, {{"data file", path}});
   Messages messages(true);
   const nlohmann::json doc = without_gil([&] {
-    const MeasurementTable table = read_measurements(path, ro);
-    for (const auto& w : table.warnings) messages.warn()(w);
-    const Iso230_2StudyResult r = study.run(table);
+    const ImportResult imported = read_instrument_file(path, io);
+    for (const auto& w : imported.table.warnings) messages.warn()(w);
+    const Iso230_2StudyResult r = study.run(imported.table);
+    for (const auto& w : r.normalisation.warnings) messages.warn()(w);
     const CompTable comp_table =
         comp.path.empty() ? CompTable{} : comp_table_from_iso(r, comp.options.table);
     if (!plot.empty())
       write_plot(plot, iso230_2_panels(r), "ISO 230-2, " + r.columns.axis + ": " + path);
     comp.write(comp_table);
-    return iso230_2_json(path, r);
+    return iso230_2_json(path, r, to_string(imported.format));
   });
   messages.issue();
   return to_python(doc);

@@ -87,6 +87,12 @@ def test_iso230_2_normalise_iso_only_uncertainty_equal_cli(cli, tmp_path):
     assert doc["student"] is None and doc["drift_eliminated"] is None
     assert doc["normalisation"]["mode"] == "never"
     assert doc["uncertainty"]["figures"]["E"]["U_um"] > 0
+    # A laser export: its compensation state decides, as on the CLI.
+    carto = source("examples", "data", "carto_x.csv")
+    doc = weilgen.iso230_2(carto, uncertainty="laser-compensated")
+    same_document(doc, cli.json("iso230-2", carto, "--uncertainty", "laser-compensated"))
+    assert doc["source_format"] == "carto"
+    assert doc["normalisation"]["material"]["instrument_state"] == "none"
 
 
 def test_ballbar_equals_cli(cli, tmp_path):
