@@ -14,6 +14,11 @@ po::options_description iso_options(IsoFlags& f) {
   o.add_options()("format", po::value<std::string>(&f.format)->default_value(f.format),
                   "the data file's layout: auto, tidy, carto (Renishaw XL-80/CARTO wide CSV) or "
                   "wide (docs/data-format.md, 'Instrument files')")(
+      "normalise", po::value<std::string>(&f.normalise)->default_value(f.normalise),
+      "corrections the instrument may already have applied: auto (never one the file says the "
+      "instrument applied; docs/iso230-2.md, 'Instrument compensation state'), force (normalise "
+      "to 20 degC with the coefficient given, and allow --air-compensation edlen, whatever the "
+      "file says) or never (no correction by weilgen)")(
       "expansion", ranged(&f.expansion_ppm_per_K, NumberRange::closed(-100, 100)),
       "expansion coefficient of the machine's material, um/(m K) = ppm/K: normalise the "
       "deviations to 20 degC (default: header key expansion_ppm_per_K, else none)")(
@@ -41,7 +46,14 @@ po::options_description iso_options(IsoFlags& f) {
       "tolerances in the deviation unit: a band +-T ('10'), figure limits ('A=12,R=6,B=4') or "
       "both ('10,A=12'); verdicts in the text, JSON and report")(
       "report", po::value<std::string>(&f.report),
-      "write the test report as one self-contained HTML file (charts inline)");
+      "write the test report as one self-contained HTML file (charts inline)")(
+      "iso-only",
+      "only the figures ISO 230-2 defines: no Student-t set, no drift-eliminated evaluation")(
+      "uncertainty", po::value<std::string>(&f.uncertainty),
+      "the measurement uncertainty of E, M, A, B, R (ISO 230-9, GUM, k = 2) and ISO 14253-1 "
+      "verdicts: auto (the instrument class from the air compensation), a class "
+      "(laser-compensated, laser-edlen, laser-manual, scale) or a budget file (YAML; "
+      "docs/iso230-2.md, 'Measurement uncertainty')");
   return o;
 }
 
@@ -49,6 +61,8 @@ void apply_iso_flags(const IsoFlags& f, const po::variables_map& vm, Iso230_2Stu
                      ImportOptions& imp) {
   Iso230_2Flags w;
   w.format = f.format;
+  w.normalise = f.normalise;
+  w.iso_only = vm.count("iso-only") > 0;
   const auto number = [&](const char* flag, double value) {
     return vm.count(flag) ? std::optional<double>(value) : std::nullopt;
   };
@@ -64,6 +78,7 @@ void apply_iso_flags(const IsoFlags& f, const po::variables_map& vm, Iso230_2Stu
   w.air_temperature = text("air-temperature");
   w.air_pressure = text("air-pressure");
   w.air_humidity = text("air-humidity");
+  w.uncertainty = text("uncertainty");
   w.tolerance = f.tolerance;
   w.report = f.report;
   w.apply(s, imp);

@@ -5,12 +5,16 @@
 #include <tuple>
 
 #include "weilgen/base/text.hpp"
+#include "weilgen/measure/iso230_2_uncertainty.hpp"
+#include "weilgen/measure/normalisation.hpp"
 
 namespace weilgen {
 
 void Iso230_2Flags::apply(Iso230_2StudyOptions& s, ImportOptions& imp) const {
   if (lower(format) != "auto") imp.format = parse_instrument_format(format);
   NormalisationOptions& n = s.normalisation;
+  n.mode = parse_normalise_mode(normalise);
+  s.iso_only = iso_only;
   if (expansion_ppm_per_K) n.expansion_ppm_per_K = *expansion_ppm_per_K;
   if (wavelength_nm) n.wavelength_nm = *wavelength_nm;
   if (air_index_assumed) n.assumed_index = *air_index_assumed;
@@ -29,6 +33,7 @@ void Iso230_2Flags::apply(Iso230_2StudyOptions& s, ImportOptions& imp) const {
     if (*text) *source = parse_environment_source(**text, quantity, flag);
   n.validate();
   if (!tolerance.empty()) s.tolerance = parse_iso_tolerance(tolerance);
+  if (uncertainty) s.uncertainty = uncertainty_budget_from_flag(*uncertainty);
   if (!report.empty()) {
     const std::string ext = lower(std::filesystem::path(report).extension().string());
     if (ext != ".html" && ext != ".htm")

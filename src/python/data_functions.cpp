@@ -3,6 +3,7 @@
 // documents are the ones the verbs use.
 #include "binding.hpp"
 #include "weilgen/analysis/axis_comp_table.hpp"
+#include "weilgen/analysis/ballbar_request.hpp"
 #include "weilgen/analysis/gap_request.hpp"
 #include "weilgen/analysis/identify_request.hpp"
 #include "weilgen/base/atomic_file.hpp"
@@ -11,6 +12,7 @@
 #include "weilgen/measure/iso230_2_flags.hpp"
 #include "weilgen/measure/iso230_2_study.hpp"
 #include "weilgen/measure/pdge_fit_study.hpp"
+#include "weilgen/report/ballbar_document.hpp"
 #include "weilgen/report/comp_table_document.hpp"
 #include "weilgen/report/gap_document.hpp"
 #include "weilgen/report/identify_document.hpp"
@@ -35,31 +37,16 @@ std::vector<const char*> with_model(std::initializer_list<const char*> own) {
 // The keywords of each function: the flags of its verb (tests/python/test_parity.py compares
 // them with `weilgen <verb> --flags-json`).
 const std::vector<const char*>& iso230_2_keywords() {
-  static const std::vector<const char*> v = {"axis",
-                                             "column",
-                                             "reference_position",
-                                             "reference_cycle",
-                                             "alpha",
-                                             "target_tolerance",
-                                             "allow_unknown",
-                                             "csv",
-                                             "plot",
-                                             "comp_table",
-                                             "comp_type",
-                                             "comp_units",
-                                             "comp_source",
-                                             "format",
-                                             "expansion",
-                                             "material_temperature",
-                                             "air_compensation",
-                                             "air_temperature",
-                                             "air_pressure",
-                                             "air_humidity",
-                                             "wavelength",
-                                             "air_index_assumed",
-                                             "datum",
-                                             "tolerance",
-                                             "report"};
+  // One line per group of flags (clang-format would put one name per line).
+  // clang-format off
+  static const std::vector<const char*> v = {
+      "axis", "column", "reference_position", "reference_cycle", "alpha", "target_tolerance",
+      "allow_unknown", "csv", "plot",
+      "comp_table", "comp_type", "comp_units", "comp_source",
+      "format", "normalise", "expansion", "material_temperature", "air_compensation",
+      "air_temperature", "air_pressure", "air_humidity", "wavelength", "air_index_assumed",
+      "datum", "tolerance", "report", "iso_only", "uncertainty"};
+  // clang-format on
   return v;
 }
 const std::vector<const char*>& fit_pdge_keywords() {
@@ -86,6 +73,11 @@ const std::vector<const char*>& identify_keywords() {
        "comp_table", "comp_type", "comp_units", "axis", "comp_points", "comp_at"});
   return v;
 }
+const std::vector<const char*>& ballbar_keywords() {
+  static const std::vector<const char*> v =
+      with_model({"machine", "feedrate", "alpha", "min_contribution", "pdge", "plot", "report"});
+  return v;
+}
 const std::vector<const char*>& gap_keywords() {
   static const std::vector<const char*> v = with_model(
       {"data", "holdout", "effects", "at", "pdge", "alpha", "threads", "csv", "report", "plot"});
@@ -99,12 +91,9 @@ std::string output(const Keywords& kw, const char* name) {
   return path;
 }
 
-// The keywords identify and gap share: the machine and model keywords, --allow-unknown and the
-// circle --plane --centre --radius --feed (centre also as a dict: {"X": 250, "Y": 0}); the
-// readers' warnings go to `messages`.
-void measurement_keywords(py::handle machine, const Keywords& kw, MeasurementRequest& rq,
-                          Messages& messages) {
-  model_request(machine, kw, rq.model, rq.opened);
+// The ballbar circle --plane --centre --radius --feed (centre also as a dict: {"X": 250,
+// "Y": 0}), --allow-unknown, and the readers' warnings to `messages`.
+void circle_keywords(const Keywords& kw, MeasurementRequest& rq, Messages& messages) {
   rq.allow_unknown = kw.flag("allow_unknown");
   kw.set("plane", rq.circle.plane);
   const std::vector<std::string> centre = kw.items("centre", true);
@@ -112,6 +101,13 @@ void measurement_keywords(py::handle machine, const Keywords& kw, MeasurementReq
   kw.set("radius", rq.circle.radius);
   kw.set("feed", rq.circle.feed);
   rq.warn = messages.warn();
+}
+
+// The keywords identify and gap share: the machine and model keywords and circle_keywords.
+void measurement_keywords(py::handle machine, const Keywords& kw, MeasurementRequest& rq,
+                          Messages& messages) {
+  model_request(machine, kw, rq.model, rq.opened);
+  circle_keywords(kw, rq, messages);
 }
 
 // --comp-table FILE and its flags (docs/controllers.md), checked like the CLI checks them:
@@ -162,6 +158,9 @@ py::object iso230_2(py::handle data, const py::kwargs& kwargs) {
   if (auto c = kw.integer("reference_cycle")) so.drift.reference_cycle = *c;
   Iso230_2Flags flags;
   kw.set("format", flags.format);
+  kw.set("normalise", flags.normalise);
+  flags.iso_only = kw.flag("iso_only");
+  flags.uncertainty = kw.text("uncertainty");
   flags.expansion_ppm_per_K = kw.number("expansion");
   flags.material_temperature = kw.text("material_temperature");
   flags.air_compensation = kw.text("air_compensation");
@@ -189,6 +188,7 @@ py::object iso230_2(py::handle data, const py::kwargs& kwargs) {
     const ImportResult imported = read_instrument_file(path, io);
     for (const auto& w : imported.table.warnings) messages.warn()(w);
     const Iso230_2StudyResult r = study.run(imported.table);
+    for (const auto& w : r.normalisation.warnings) messages.warn()(w);
     const std::string format = to_string(imported.format);
     const CompTable comp_table =
         comp.path.empty() ? CompTable{} : comp_table_from_iso(r, comp.options.table);
@@ -320,6 +320,38 @@ py::object gap(py::handle machine, const py::kwargs& kwargs) {
   return to_python(doc, errors);
 }
 
+// weilgen ballbar (issue 29): a trace on its own, or through a machine's model (machine=).
+py::object ballbar(py::handle trace, const py::kwargs& kwargs) {
+  const Keywords kw("ballbar", kwargs, ballbar_keywords());
+  BallbarRequest rq;
+  Messages messages(kw.flag("quiet"));
+  rq.trace = data_path(trace, "trace file");
+  if (kwargs.contains("machine") && !kwargs["machine"].is_none()) {
+    model_request(kwargs["machine"], kw, rq.model, rq.opened);
+  } else {
+    for (const char* k : {"order", "engine", "compiler", "param", "pdge"})
+      if (kw.given(k))
+        throw std::invalid_argument(kw.flag_name(k) + ": the model's terms need machine=");
+    rq.model.log = messages.log();
+  }
+  circle_keywords(kw, rq, messages);
+  kw.set("feedrate", rq.feedrate);
+  kw.set("alpha", rq.alpha);
+  kw.set("min_contribution", rq.min_contribution_um);
+  if (kw.given("pdge")) rq.pdge = kw.items("pdge", false);
+  const std::string plot = output(kw, "plot"), report = output(kw, "report");
+  rq.validate();
+  rq.check_outputs("", plot, report);
+  const nlohmann::json doc = run_analysis([&] {
+    const BallbarStudy st = run_ballbar(rq);
+    if (!plot.empty()) write_file_atomically(plot, ballbar_polar_svg(st));
+    if (!report.empty()) write_file_atomically(report, ballbar_html(st));
+    return ballbar_json(st);
+  });
+  messages.issue();
+  return to_python(doc);
+}
+
 }  // namespace
 
 void register_data_functions(py::module_& m) {
@@ -334,6 +366,7 @@ void register_data_functions(py::module_& m) {
   add("fit_pdge", &fit_pdge, "data", fit_pdge_keywords());
   add("identify", &identify, "machine", identify_keywords());
   add("gap", &gap, "machine", gap_keywords());
+  add("ballbar", &ballbar, "trace", ballbar_keywords());
 }
 
 }  // namespace weilgen::python

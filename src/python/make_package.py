@@ -66,6 +66,8 @@ def annotation(flag):
         return "Optional[float]"
     if kind == "whole":
         return "Optional[int]"
+    if name == "machine":  # ballbar's --machine: a name, a file or a weilgen.Model
+        return "Optional[_Machine]"
     if kind == "repeatable" or name in STRUCTURED_TEXT:
         return "Optional[_Items]"
     return "Optional[_Text]" if flag["name"] in PATHS else "Optional[_Value]"
@@ -76,6 +78,8 @@ def type_words(flag):
         return ("str, os.PathLike or list (the flag repeated)" if flag["name"] in PATHS
                 else "str, dict or list (the flag repeated)")
     if flag["kind"] == "text":
+        if flag["name"] == "machine":
+            return "str, os.PathLike or weilgen.Model"
         if flag["name"] in PATHS:
             return "str or os.PathLike"
         return "str, dict, list or tuple" if python_name(flag["name"]) in STRUCTURED_TEXT else "str"

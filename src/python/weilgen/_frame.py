@@ -11,6 +11,7 @@ _DEFAULT = {
     "allocate": "steps",
     "iso230-2": "targets",
     "fit-pdge": "fits",
+    "ballbar": "runs",
     "identify": "parameters",
     "gap": "effects",
     "generate": "files",

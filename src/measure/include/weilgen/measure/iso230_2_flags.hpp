@@ -14,6 +14,9 @@ namespace weilgen {
 
 struct Iso230_2Flags {
   std::string format = "auto";                      // --format
+  std::string normalise = "auto";                   // --normalise: auto, force or never
+  bool iso_only = false;                            // --iso-only
+  std::optional<std::string> uncertainty;           // --uncertainty: auto, a class or a budget file
   std::optional<double> expansion_ppm_per_K;        // --expansion, ppm/K
   std::optional<std::string> material_temperature;  // --material-temperature: degC or columns
   std::optional<std::string> air_compensation;      // --air-compensation
