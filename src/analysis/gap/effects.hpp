@@ -88,9 +88,12 @@ struct Candidate {
   bool determined_part = false;
 };
 
-// The library's candidates that apply to the data (e.g. reversal needs a direction column).
+// The library's candidates that apply to the data (e.g. reversal needs a direction column);
+// the library is the table in effects.cpp.
 std::vector<Candidate> effect_candidates(const EffectContext& ctx,
                                          const std::vector<std::string>& names);
+// Whether the greedy search may accept the effect again (a second sensor or lag).
+bool effect_repeatable(const std::string& name);
 
 // One family of the library each (effect_*.cpp): appends its candidate, if the data allow it.
 void add_thermal(const EffectContext& ctx, std::vector<Candidate>& out);
