@@ -619,8 +619,9 @@ class SummaryReporter : public benchmark::ConsoleReporter {
     ConsoleReporter::Finalize();
     std::ostringstream main, extra;
     for (const auto& [machine, n] : machines_) {
+      const std::string& key = machine;  // clang < 16 cannot capture a structured binding
       const auto get = [&](const std::string& what) {
-        const auto it = cpu_ns_.find(machine + "/" + what);
+        const auto it = cpu_ns_.find(key + "/" + what);
         return it == cpu_ns_.end() ? 0.0 : it->second;
       };
       const double dev = get("generated_dev"), coeff = get("generated_coeff"),

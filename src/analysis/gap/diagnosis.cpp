@@ -399,10 +399,12 @@ class GapSearch {
     if (!R_.explanation.empty() && R_.verdict.names(R_.explanation.front().name))
       check_lack_of_fit(R_, opt_, share_, lof_after_ ? *lof_after_ : lack_of_fit(*e_, data_),
                         base_full_sse_);
-    for (const auto& [name, why] : passed_over_)
+    for (const auto& [name, why] : passed_over_) {
+      const std::string& passed = name;  // clang < 16 cannot capture a structured binding
       if (std::none_of(R_.explanation.begin(), R_.explanation.end(),
-                       [&](const EffectFit& f) { return f.name == name; }))
+                       [&](const EffectFit& f) { return f.name == passed; }))
         R_.verdict.reason += "; " + why;
+    }
   }
 
   // The accepted effects' own regions lead the list: where the named cause acts, in the output
