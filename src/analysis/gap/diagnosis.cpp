@@ -127,40 +127,48 @@ LackOfFit lack_of_fit(const Engine& e, const GapData& d, const MatrixXd* extra =
   }
   worst.reference_sse = ref_sse;
   constexpr std::size_t kBins = 6;
-  for (const auto& [name, v] : coords) {
-    std::vector<double> levels = v;
-    std::sort(levels.begin(), levels.end());
-    levels.erase(std::unique(levels.begin(), levels.end()), levels.end());
-    std::vector<double> edges;  // bin b holds values below edges[b]
-    if (levels.size() <= kBins) {
-      for (std::size_t l = 1; l < levels.size(); ++l) edges.push_back(levels[l]);
-    } else {
-      std::vector<double> sorted = v;
-      std::sort(sorted.begin(), sorted.end());
-      for (std::size_t b = 1; b < kBins; ++b) edges.push_back(sorted[b * n / kBins]);
-      edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
-    }
-    const Index nb = static_cast<Index>(edges.size() + 1);
-    // A free offset per deviation output and bin, as each observation sees it: its own output,
-    // or a ballbar's dr the offset's radial part (a step in y moves the circle's centre, which a
-    // free offset of dr per bin, averaging out over each circle, would not see).
-    constexpr int kOffsets = 6;
-    MatrixXd G = MatrixXd::Zero(static_cast<Index>(n), nb * kOffsets);
-    for (std::size_t i = 0; i < n; ++i) {
-      const auto b = std::upper_bound(edges.begin(), edges.end(), v[i]) - edges.begin();
-      for (int o = 0; o < kOffsets; ++o)
-        G(static_cast<Index>(i), o * nb + b) = observation_weight(obs[i], o);
-    }
-    std::vector<Index> seen;  // the outputs' bins that hold observations
-    for (Index c = 0; c < G.cols(); ++c)
-      if (G.col(c).any()) seen.push_back(c);
-    G = G(Eigen::all, seen).eval();
-    if (extra && extra->cols() > 0) {
-      MatrixXd EG(G.rows(), extra->cols() + G.cols());
-      EG << *extra, G;
-      G = std::move(EG);
-    }
-    const JointFit f = joint_fit(*e.factors, e.A, e.y, G);
+  // Each coordinate's joint fit on its own (in parallel), the p-values compared in order.
+  std::vector<std::optional<JointFit>> fits(coords.size());
+  parallel_blocks(
+      coords.size(), 1, e.threads, [&](std::size_t ci, std::size_t, std::size_t, unsigned) {
+        const std::vector<double>& v = coords[ci].second;
+        std::vector<double> levels = v;
+        std::sort(levels.begin(), levels.end());
+        levels.erase(std::unique(levels.begin(), levels.end()), levels.end());
+        std::vector<double> edges;  // bin b holds values below edges[b]
+        if (levels.size() <= kBins) {
+          for (std::size_t l = 1; l < levels.size(); ++l) edges.push_back(levels[l]);
+        } else {
+          std::vector<double> sorted = v;
+          std::sort(sorted.begin(), sorted.end());
+          for (std::size_t b = 1; b < kBins; ++b) edges.push_back(sorted[b * n / kBins]);
+          edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+        }
+        const Index nb = static_cast<Index>(edges.size() + 1);
+        // A free offset per deviation output and bin, as each observation sees it: its own output,
+        // or a ballbar's dr the offset's radial part (a step in y moves the circle's centre, which
+        // a free offset of dr per bin, averaging out over each circle, would not see).
+        constexpr int kOffsets = 6;
+        MatrixXd G = MatrixXd::Zero(static_cast<Index>(n), nb * kOffsets);
+        for (std::size_t i = 0; i < n; ++i) {
+          const auto b = std::upper_bound(edges.begin(), edges.end(), v[i]) - edges.begin();
+          for (int o = 0; o < kOffsets; ++o)
+            G(static_cast<Index>(i), o * nb + b) = observation_weight(obs[i], o);
+        }
+        std::vector<Index> seen;  // the outputs' bins that hold observations
+        for (Index c = 0; c < G.cols(); ++c)
+          if (G.col(c).any()) seen.push_back(c);
+        G = G(Eigen::all, seen).eval();
+        if (extra && extra->cols() > 0) {
+          MatrixXd EG(G.rows(), extra->cols() + G.cols());
+          EG << *extra, G;
+          G = std::move(EG);
+        }
+        fits[ci] = joint_fit(*e.factors, e.A, e.y, G);
+      });
+  for (std::size_t c = 0; c < coords.size(); ++c) {
+    const std::string& name = coords[c].first;
+    const JointFit& f = *fits[c];
     const double q = static_cast<double>(f.rank) - static_cast<double>(ref_rank);
     const double d2 = static_cast<double>(n) - static_cast<double>(f.rank);
     if (q <= 0 || d2 <= 0 || !(f.sse > 0)) continue;
@@ -434,6 +442,7 @@ GapResult GapDiagnosis::diagnose(const Model& model, const ErrorParameterisation
   ctx.data = &data;
   ctx.model = &model;
   ctx.param = &param_;
+  ctx.threads = options_.threads;
   auto chain = std::make_shared<NumericChain>(model.description());
   chain->set_parameters(model.parameters());
   ctx.chain = chain;
