@@ -6,6 +6,7 @@
 #include <string>
 
 #include "sobol_detail.hpp"
+#include "splitmix64.hpp"
 #include "weilgen/base/parallel.hpp"
 #include "weilgen/uq/sobol_indices.hpp"
 
@@ -47,10 +48,8 @@ std::uint32_t bounded(std::mt19937_64& rng, std::uint32_t n) {
 
 std::uint64_t sobol_replicate_seed(std::uint64_t seed, std::size_t r, std::size_t replicates) {
   if (replicates == 1) return seed;
-  std::uint64_t z = seed + 0x9e3779b97f4a7c15ULL * (r + 1);
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  z ^= z >> 31;
+  std::uint64_t state = seed + 0x9e3779b97f4a7c15ULL * r;  // splitmix64 steps to + (r + 1) γ
+  const std::uint64_t z = splitmix64(state);
   return z != 0 ? z : 1;
 }
 
