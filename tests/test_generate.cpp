@@ -351,6 +351,20 @@ TEST_CASE("CLI: show prints closed forms in text, LaTeX, JSON and the seed's not
   CHECK(l.out.find("E_{XX}") != std::string::npos);
   const Run j = run(cli("show gantry_grinder --format json"));
   CHECK(j.out.find("\"closed_form\"") != std::string::npos);
+  // Python syntax: the text form with * and ** (the Python package evaluates it against the
+  // model, tests/python/test_closed_form.py).
+  const Run y = run(cli("show five_axis_ac --format sympy --output dx"));
+  CHECK(y.status == 0);
+  CHECK(y.out.rfind("dx = cos(c)*E_XX + cos(a)*sin(c)*E_YX", 0) == 0);
+  CHECK(y.out.find("·") == std::string::npos);
+  CHECK(y.out.find('^') == std::string::npos);
+  // The flag table of every verb (the Python package's keywords): --order is a whole number
+  // from 1, --format defaults to text.
+  const Run f = run(cli("show --flags-json"));
+  CHECK(f.status == 0);
+  CHECK(f.out.find("\"name\": \"format\"") != std::string::npos);
+  CHECK(f.out.find("\"default\": \"text\"") != std::string::npos);
+  CHECK(f.out.find("\"text\": \"a whole number from 1 to ") != std::string::npos);
   CHECK(run(cli("--help")).status == 0);
   for (const char* verb : {"generate", "show", "list"})
     CHECK(run(cli(std::string(verb) + " --help")).status == 0);

@@ -213,7 +213,7 @@ void add_higher_order(const EffectContext& ctx, std::vector<Candidate>& out) {
   c.describe = [](const Variant&, const VectorXd& coef, EffectFit& fit) {
     fit.params["scale"] = coef[0];
     fit.summary = "second- and higher-order products of the identified errors (scale " +
-                  num(coef[0], 3) +
+                  format_short(coef[0], 3) +
                   " of the exact kinematics' nonlinear part; regenerate at "
                   "algebra order 2)";
   };
@@ -384,7 +384,8 @@ void add_missing_error(const EffectContext& ctx, std::vector<Candidate>& out) {
                     "file)";
     } else if (!mi.pdge) {
       fit.params[mi.name] = coef[0];
-      fit.summary = mi.name + " = " + num(coef[0], 3) + " " + unit + " (not in the machine file)";
+      fit.summary =
+          mi.name + " = " + format_short(coef[0], 3) + " " + unit + " (not in the machine file)";
     } else {
       // Over the positions measured, not the whole travel: the data say nothing beyond them.
       std::size_t a = 0;
@@ -397,8 +398,9 @@ void add_missing_error(const EffectContext& ctx, std::vector<Candidate>& out) {
       for (int k = 0; k <= 40; ++k)
         peak = std::max(peak, std::abs(mi.basis.value(coef.data(), lo + (hi - lo) * k / 40.0)));
       fit.params[mi.name + "_peak"] = peak;
-      fit.summary = mi.name + "(" + mi.coordinate + ") up to " + num(peak, 3) + " " + unit +
-                    " over the measured " + mi.coordinate + " " + num(lo, 4) + " .. " + num(hi, 4) +
+      fit.summary = mi.name + "(" + mi.coordinate + ") up to " + format_short(peak, 3) + " " +
+                    unit + " over the measured " + mi.coordinate + " " + format_short(lo, 4) +
+                    " .. " + format_short(hi, 4) +
                     (a < d.axis_units.size() ? " " + d.axis_units[a] : "") + " (" +
                     mi.basis.name() + "; " + absorbed + "not in the machine file)";
     }
@@ -452,14 +454,14 @@ void add_tool_offset(const EffectContext& ctx, std::vector<Candidate>& out) {
   c.describe = [pname, base](const Variant&, const VectorXd& coef, EffectFit& fit) {
     fit.params["offset_mm"] = coef[0];
     fit.params[pname + "_mm"] = base + coef[0];
-    fit.summary = "tool offset " + num(coef[0], 3) + " mm (" + pname + " " + num(base, 4) + " -> " +
-                  num(base + coef[0], 4) + " mm)";
+    fit.summary = "tool offset " + format_short(coef[0], 3) + " mm (" + pname + " " +
+                  format_short(base, 4) + " -> " + format_short(base + coef[0], 4) + " mm)";
     // The column is nearly in the model's span on a machine whose rotations are only its small
     // angular errors: then a tiny remainder, scaled up hundreds of metres, fits whatever shape
     // is left (a step). No tool set-up error is that large.
     if (!(std::abs(coef[0]) <= kMaxToolOffsetMm)) {
       fit.distinguishable = false;
-      fit.indistinct_reason = "its size (" + num(coef[0], 3) +
+      fit.indistinct_reason = "its size (" + format_short(coef[0], 3) +
                               " mm) is no tool's: a remainder of " +
                               "the column outside the model's errors imitates the gap";
     }

@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 
+#include "weilgen/analysis/per_output_rms.hpp"
 #include "weilgen/base/parallel.hpp"
 
 namespace weilgen::gap_detail {
@@ -207,25 +208,21 @@ Evaluated evaluate_one(const Candidate& c, const ScoringContext& sc,
   const VectorXd& base_r = *sc.base_r;
   const VectorXd& base_h = *sc.base_h;
   Gap before, afterg;
-  std::array<double, kObservationKinds> sb{}, sa{};
-  std::array<std::size_t, kObservationKinds> no{};
+  PerOutputRms<kObservationKinds> rms_before, rms_after;
   const auto& obs = e.data.points.observations;
   for (Index i = 0; i < e.y.size(); ++i) {
     if (!std::isfinite(best.heldout[i])) continue;
     const auto o = static_cast<std::size_t>(obs[static_cast<std::size_t>(i)].output);
-    sb[o] += base_r[i] * base_r[i];
-    sa[o] += best.heldout[i] * best.heldout[i];
-    ++no[o];
+    rms_before.add(o, base_r[i]);
+    rms_after.add(o, best.heldout[i]);
     before.ss += base_r[i] * base_r[i];
     afterg.ss += best.heldout[i] * best.heldout[i];
     before.expected += sc.s2 * (1 + base_h[i]);
     ++before.n;
   }
   best.heldout_sse = afterg.ss;
-  for (std::size_t o = 0; o < kObservationKinds; ++o) {
-    best.fit.rms_before[o] = no[o] ? std::sqrt(sb[o] / static_cast<double>(no[o])) : kNaN;
-    best.fit.rms_after[o] = no[o] ? std::sqrt(sa[o] / static_cast<double>(no[o])) : kNaN;
-  }
+  best.fit.rms_before = rms_before.rms_per_output();
+  best.fit.rms_after = rms_after.rms_per_output();
   const double nn = static_cast<double>(before.n);
   best.fit.heldout_rms_before_um = std::sqrt(before.ss / nn);
   best.fit.heldout_rms_after_um = std::sqrt(afterg.ss / nn);
