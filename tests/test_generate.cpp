@@ -172,7 +172,17 @@ int main(int argc, char** argv) {
   const std::string loop_header = gen::emit_cpp_header(o2, "machines/five_axis_ac.yaml", 0);
   REQUIRE(loop_header.find("kHigherTable.size(); k += 3) {\n      at +=") != std::string::npos);
   write_file_atomically((loop_dir / "five_axis_ac_o2.hpp").string(), loop_header);
-  for (const fs::path& include : {dir, loop_dir}) {
+  // And with MonomialCoefficients in parts of 40 statements (the form of a long one, emit_cpp.hpp
+  // SplitLimits): temporaries shared between parts, each part with its own inputs.
+  const fs::path split_dir = dir / "split";
+  fs::create_directories(split_dir);
+  const std::string split_header =
+      gen::emit_cpp_header(o2, "machines/five_axis_ac.yaml", gen::kMaxNestedHigherTerms, {0, 40});
+  REQUIRE(split_header.find("MonomialCoefficientsPart2<Scalar>(axes, params, _s.data()") !=
+          std::string::npos);
+  REQUIRE(split_header.find("  _s[0] = ") != std::string::npos);
+  write_file_atomically((split_dir / "five_axis_ac_o2.hpp").string(), split_header);
+  for (const fs::path& include : {dir, loop_dir, split_dir}) {
     CAPTURE(include.string());
     // Beside the header: a quoted include looks in the driver's directory first.
     write_file_atomically((include / "driver.cpp").string(), driver);

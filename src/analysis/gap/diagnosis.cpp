@@ -209,6 +209,7 @@ class GapSearch {
     ctx_.data = &data_;
     ctx_.model = &model_;
     ctx_.param = &param_;
+    ctx_.threads = opt_.threads;
     auto chain = std::make_shared<NumericChain>(model_.description());
     chain->set_parameters(model_.parameters());
     ctx_.chain = chain;

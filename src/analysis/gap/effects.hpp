@@ -31,6 +31,9 @@ struct EffectContext {
   // The axes' motion errors with their sensitivities (axis_errors(ctx, 6)), shared by the shape
   // effects; computed on first use.
   mutable std::shared_ptr<const std::vector<AxisError>> shaped_errors;
+  // axis_jacobians(ctx), shared by the reversal and thermal effects; computed on first use.
+  mutable std::shared_ptr<const std::vector<Eigen::MatrixXd>> jacobians;
+  unsigned threads = 1;  // for the loops over poses and candidate errors (GapOptions::threads)
 };
 
 struct Variant {

@@ -1,8 +1,10 @@
 // The lack of fit of a model on all data (docs/gap.md, "Lack of fit").
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "verdict.hpp"
+#include "weilgen/base/parallel.hpp"
 
 namespace weilgen::gap_detail {
 
@@ -79,14 +81,22 @@ LackOfFit lack_of_fit(const Engine& e, const GapData& d, const MatrixXd* extra) 
     ref_rank = f.rank, ref_sse = f.sse;
   }
   worst.reference_sse = ref_sse;
-  for (const auto& [name, v] : coords) {
-    MatrixXd G = bin_offsets(d, v, bin_edges(v));
-    if (extra && extra->cols() > 0) {
-      MatrixXd EG(G.rows(), extra->cols() + G.cols());
-      EG << *extra, G;
-      G = std::move(EG);
-    }
-    const JointFit f = joint_fit(*e.factors, e.A, e.y, G);
+  // Each coordinate's joint fit on its own (in parallel), the p-values compared in order.
+  std::vector<std::optional<JointFit>> fits(coords.size());
+  parallel_blocks(coords.size(), 1, e.threads,
+                  [&](std::size_t c, std::size_t, std::size_t, unsigned) {
+                    const std::vector<double>& v = coords[c].second;
+                    MatrixXd G = bin_offsets(d, v, bin_edges(v));
+                    if (extra && extra->cols() > 0) {
+                      MatrixXd EG(G.rows(), extra->cols() + G.cols());
+                      EG << *extra, G;
+                      G = std::move(EG);
+                    }
+                    fits[c] = joint_fit(*e.factors, e.A, e.y, G);
+                  });
+  for (std::size_t c = 0; c < coords.size(); ++c) {
+    const std::string& name = coords[c].first;
+    const JointFit& f = *fits[c];
     const double q = static_cast<double>(f.rank) - static_cast<double>(ref_rank);
     const double d2 = static_cast<double>(n) - static_cast<double>(f.rank);
     if (q <= 0 || d2 <= 0 || !(f.sse > 0)) continue;
