@@ -192,7 +192,8 @@ TEST_CASE("identify --comp-table --axis: a positioning error alone is the table 
        {std::tuple<std::string, std::string, std::string, std::string>{"vmc_3axis", "X", "E_XX",
                                                                        "Y=-120,Z=-60"},
         {"five_axis_ac", "C", "E_CC", "X=40,Z=-100,Y=30,A=20"}}) {
-    CAPTURE(machine);
+    const std::string& machine_name = machine;  // clang < 16 cannot capture a structured binding
+    CAPTURE(machine_name);
     const std::shared_ptr<Model> model = test::builtin_model(machine);
     const Description& d = model->description();
     const ErrorParameterisation param(d, PdgeBasisChoice{});

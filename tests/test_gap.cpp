@@ -1372,7 +1372,9 @@ TEST_CASE("gap: a step that an effect of the library only imitates is unexplaine
   // acceptance (free offsets per output in bins of time and of every axis) finds the structure
   // the named effect leaves along time or an axis.
   int named = 0, seen = 0;
-  for (const auto& [seed, r] : step_in_time_results()) {
+  for (const auto& seed_result : step_in_time_results()) {
+    const auto& seed = seed_result.first;  // clang < 16 cannot capture a structured binding
+    const auto& r = seed_result.second;
     INFO("seed " << seed << ": " << r.verdict.str() << ": " << r.verdict.reason);
     // (`none` is allowed here: the held-out gap alone can sit at the floor; the baseline's lack
     // of fit, tested below, is what sees the step then.)
@@ -1414,7 +1416,9 @@ TEST_CASE("gap: a step in time that the folds cannot predict is still seen (lack
   // floor; on all data the model cannot follow the step (lack of fit along time), so the gap is
   // significant, no candidate of the library removes it whole, and the verdict is unexplained.
   int unexplained = 0, heldout_blind = 0;
-  for (const auto& [seed, r] : step_in_time_results()) {
+  for (const auto& seed_result : step_in_time_results()) {
+    const auto& seed = seed_result.first;  // clang < 16 cannot capture a structured binding
+    const auto& r = seed_result.second;
     INFO("seed " << seed << ": " << r.verdict.str() << ": " << r.verdict.reason << " (held-out p "
                  << r.baseline.p_value << ", lack of fit p " << r.baseline_lack_of_fit_p << ")");
     CHECK(r.baseline_lack_of_fit_p < 1e-6);

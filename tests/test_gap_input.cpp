@@ -399,8 +399,10 @@ TEST_CASE(
 // effects remove only 11 % of the excess". The accepted effect stands when nothing significant
 // remains (decide_verdict).
 TEST_CASE("gap verdict: an effect accepted without a significant baseline gap is not unexplained") {
-  for (const auto& [b, seed] : std::vector<std::pair<double, std::uint32_t>>{
+  for (const auto& b_seed : std::vector<std::pair<double, std::uint32_t>>{
            {0.2, 202}, {0.3, 200}, {0.3, 203}, {0.4, 203}}) {
+    const double b = b_seed.first;  // a plain pair: clang < 16 cannot capture a structured binding
+    const std::uint32_t seed = b_seed.second;
     const double size = b;
     const GapResult r =
         diagnose(diagonal(seed, 5, [size](double dir, double) { return size * dir; }), "vmc_3axis",
