@@ -1,4 +1,4 @@
-// weilgen allocate: tolerance allocation by the grinder seed's step procedure (tighten the most
+// weilgen allocate: tolerance allocation by Wang & Yuan 2021's step procedure (tighten the most
 // reliability-sensitive errors step by step until the targets hold) and a cost-aware optimum
 // (min sum w_i / sigma_i subject to the same targets). The study is analysis/allocation_study,
 // the documents report/allocation_document; docs/reliability.md.

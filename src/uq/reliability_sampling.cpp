@@ -1,6 +1,6 @@
-// The seed's axis-orthogonal importance sampling (eqs. 23-28). Work is cut into fixed blocks of
-// lines with one random stream per block and per-block partial results combined in block order:
-// bit-identical for any thread count.
+// Wang & Yuan 2021's axis-orthogonal importance sampling (eqs. 23-28). Work is cut into fixed
+// blocks of lines with one random stream per block and per-block partial results combined in block
+// order: bit-identical for any thread count.
 #include <algorithm>
 #include <boost/math/tools/toms748_solve.hpp>
 #include <cmath>

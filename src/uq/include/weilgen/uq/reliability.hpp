@@ -5,7 +5,7 @@
 //   Exact               linear response, Normal inputs: r ~ N(m, s^2), closed form.
 //   Form                HL-RF with an Armijo step (improved HL-RF) in standard normal space, one
 //                       design point per failure side (plus a mirror lobe when one exists).
-//   ImportanceSampling  the seed's axis-orthogonal importance sampling (eqs. 23-28): lines
+//   ImportanceSampling  Wang & Yuan 2021's axis-orthogonal importance sampling (eqs. 23-28): lines
 //                       parallel to the design direction alpha, a 1-D root per line,
 //                       P_f = mean Phi(-h). Exact with zero variance for a linear limit state.
 //   MonteCarlo          crude sampling, Wilson interval.
@@ -33,10 +33,10 @@ enum class LimitKind { TwoSided, Upper };
 enum class ReliabilityMethod { Auto, Exact, Form, ImportanceSampling, MonteCarlo };
 
 // How the non-exact methods compute dR/dmu and dR/dsigma: from the FORM design points (the
-// seed's eqs. 31-33, generalised), or, for ImportanceSampling, by differentiating the sampling
-// estimate itself (each line's root h moves by -(dg/dtheta) / (dg/ds)), which is consistent with
-// the IS reliability also for curved limit states; it needs dr/dx at every root (2 n extra
-// evaluations per root without a gradient or linear form). MonteCarlo always uses FORM.
+// Wang & Yuan 2021, eqs. 31-33, generalised), or, for ImportanceSampling, by differentiating the
+// sampling estimate itself (each line's root h moves by -(dg/dtheta) / (dg/ds)), which is
+// consistent with the IS reliability also for curved limit states; it needs dr/dx at every root (2
+// n extra evaluations per root without a gradient or linear form). MonteCarlo always uses FORM.
 enum class SensitivityMethod { Form, Sampling };
 
 // "auto", "exact", "form", "is", "mc".
