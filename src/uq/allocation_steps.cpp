@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "allocation_detail.hpp"
 #include "weilgen/uq/allocation.hpp"
 
 namespace weilgen {

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <limits>
 
+#include "reliability_detail.hpp"
 #include "weilgen/base/constants.hpp"
 #include "weilgen/base/parallel.hpp"
 #include "weilgen/uq/reliability.hpp"

@@ -7,6 +7,9 @@
   - every src/cli/verb_*.cpp has at most 200 lines;
   - the codegen layer's CMake file links no NLopt and no Eigen;
   - nothing under src/ includes another layer's internal headers ("../", "src/");
+  - a layer's internal headers (beside its .cpp files, e.g. src/uq/reliability_detail.hpp) are
+    included only from their own folder: never from a public header (include/weilgen/...) nor
+    from tests/, bench/, fuzz/ or examples/;
   - no doctest case name in tests/*.cpp contains ';' (CMake splits the name at it, and CTest
     then runs no test of that case).
 
@@ -31,6 +34,47 @@ ALLOWED = {
 }
 INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"')
 TEST_CASE = re.compile(r'^\s*TEST_CASE\("((?:[^"\\]|\\.)*)"')
+
+
+# Tests that check a layer's internals directly, each with its reason.
+WHITE_BOX_TESTS = {
+    "tests/test_gap_engine.cpp": "the gap diagnosis' least-squares engine against dense least "
+                                 "squares, below the public diagnosis",
+}
+
+
+def internal_includes_outside_src(root, src):
+    """Includes of a layer's internal header (by name or by path) from tests, benchmarks,
+    fuzzers and examples."""
+    internal = set()
+    for layer in os.listdir(src):
+        layer_dir = os.path.join(src, layer)
+        if os.path.isdir(layer_dir):
+            for dirpath, _, files in os.walk(layer_dir):
+                if os.sep + "include" not in dirpath[len(layer_dir):]:
+                    internal |= {f for f in files if f.endswith((".hpp", ".h"))}
+    problems = []
+    for top in ("tests", "bench", "fuzz", "examples"):
+        for dirpath, _, files in os.walk(os.path.join(root, top)):
+            for f in files:
+                if not f.endswith((".cpp", ".hpp", ".h")):
+                    continue
+                path = os.path.join(dirpath, f)
+                rel = os.path.relpath(path, root)
+                with open(path, encoding="utf-8", errors="replace") as fh:
+                    for number, line in enumerate(fh, 1):
+                        m = INCLUDE.match(line)
+                        if not m or m.group(1).startswith("weilgen/"):
+                            continue
+                        target = m.group(1)
+                        local = os.path.exists(os.path.join(dirpath, target))
+                        if rel in WHITE_BOX_TESTS:
+                            continue
+                        if "src/" in target or (not local and
+                                                os.path.basename(target) in internal):
+                            problems.append(f"{rel}:{number}: includes '{target}', a layer's "
+                                            "internal header: use the public weilgen/<layer>/...")
+    return problems
 
 
 def main(root):
@@ -64,6 +108,9 @@ def main(root):
                     if not m:
                         continue
                     target = m.group(1)
+                    if "/include/weilgen/" in path and not target.startswith("weilgen/"):
+                        problems.append(f"{rel}:{number}: a public header includes '{target}': "
+                                        "internal headers stay beside their .cpp files")
                     if target.startswith("../") or target.startswith("src/"):
                         problems.append(f"{rel}:{number}: includes '{target}' by path: use the "
                                         "layer's public header weilgen/<layer>/...")
@@ -74,6 +121,7 @@ def main(root):
                             problems.append(f"{rel}:{number}: {layer} may not include {to} "
                                             f"('{target}'; allowed: "
                                             f"{', '.join(sorted(ALLOWED[layer])) or 'none'})")
+    problems += internal_includes_outside_src(root, src)
     cmake = os.path.join(src, "codegen", "CMakeLists.txt")
     with open(cmake, encoding="utf-8") as fh:
         text = "\n".join(l.split("#")[0] for l in fh.read().split("\n"))  # without comments
