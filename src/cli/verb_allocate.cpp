@@ -63,7 +63,7 @@ int verb_allocate(const Args& args) {
   add_study_options(opts, f, true);
   po::variables_map vm;
   if (auto stop = parse_args<std::string>("allocate", args, opts, "machine", 1, vm)) return *stop;
-  if (vm.count("machine")) f.machine = vm["machine"].as<std::string>();
+  if (vm.count("machine")) f.request.machine = vm["machine"].as<std::string>();
   AllocationStudyOptions ao;
   ao.min_target = min_target;
   ao.mean_target = mean_target;
