@@ -27,7 +27,7 @@ json read_json(const std::string& path) {
   return json::parse(text);
 }
 
-// Table 1 of the grinder seed (standard deviations; mm and rad).
+// Table 1 of Wang & Yuan 2021 (standard deviations; mm and rad).
 double grinder_sigma(const std::string& e) {
   static const std::map<std::string, double> s = {
       {"E_XX", 0.05 / 6},    {"E_YX", 0.05 / 6},    {"E_ZX", 0.05 / 6},     {"E_AX", 0.03 / 6000},
@@ -361,7 +361,8 @@ TEST_CASE("allocate CLI: the seed's x-direction procedure, and its saved toleran
                         json_path + " --save-tolerances " + tol));
   REQUIRE(r.status == 0);
   const json j = read_json(json_path);
-  // The raw (per-unit) ranking picks exactly the seed's errors: eps_yx, eps_zx, eps_zz, S_xy.
+  // The raw (per-unit) ranking picks exactly Wang & Yuan 2021's errors: eps_yx, eps_zx, eps_zz,
+  // S_xy.
   std::set<std::string> chosen;
   for (const auto& e : j["chosen"]) chosen.insert(e.get<std::string>());
   CHECK(chosen == std::set<std::string>{"E_BX", "E_CX", "E_CZ", "E_C0X"});

@@ -346,7 +346,8 @@ TEST_CASE("CLI: show prints closed forms in text, LaTeX, JSON and the seed's not
   CHECK(t.out.rfind("dx = -E_XX", 0) == 0);
   CHECK(t.out.find("dy") == std::string::npos);
   const Run a = run(cli("show vmc_3axis --notation alias --output dx"));
-  CHECK(a.out.find("- z·Sxz") != std::string::npos);  // S_xz = -E_B0Z, as the seed prints it
+  CHECK(a.out.find("- z·Sxz") !=
+        std::string::npos);  // S_xz = -E_B0Z, as Zhang & Chen 2021 prints it
   const Run l = run(cli("show gantry_grinder --format latex"));
   CHECK(l.out.find("E_{XX}") != std::string::npos);
   const Run j = run(cli("show gantry_grinder --format json"));

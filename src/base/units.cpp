@@ -153,4 +153,36 @@ double parse_feedrate_mm_min(const std::string& text, const std::string& what) {
   return v;
 }
 
+namespace {
+
+// Lower-case ASCII, µ/μ as u, blanks and '_' dropped: "Deg_C" -> "degc", "° F" -> "°f".
+std::string unit_key(const std::string& unit) {
+  std::string key;
+  for (char c : ascii_unit(unit))
+    if (c != ' ' && c != '\t' && c != '_')
+      key += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return key;
+}
+
+}  // namespace
+
+AffineUnit parse_temperature_unit(const std::string& unit) {
+  static const std::string degree = "\xC2\xB0", ordinal = "\xC2\xBA";  // °, º (typed for °)
+  const std::string u = unit_key(unit);
+  if (u == "c" || u == "degc" || u == degree + "c" || u == ordinal + "c") return {1, 0};
+  if (u == "f" || u == "degf" || u == degree + "f") return {5.0 / 9, -160.0 / 9};
+  if (u == "k") return {1, -273.15};
+  throw std::invalid_argument("unit '" + unit + "' (expected degC, degF or K)");
+}
+
+AffineUnit parse_pressure_unit(const std::string& unit) {
+  const std::string u = unit_key(unit);
+  if (u == "pa") return {1, 0};
+  if (u == "hpa" || u == "mbar") return {100, 0};
+  if (u == "kpa") return {1000, 0};
+  if (u == "mmhg") return {133.322387415, 0};
+  if (u == "inhg") return {3386.38864, 0};
+  throw std::invalid_argument("unit '" + unit + "' (expected Pa, hPa, mbar, kPa, mmHg or inHg)");
+}
+
 }  // namespace weilgen

@@ -251,7 +251,8 @@ class Loader {
   // The six fields of a twist [ωx, ωy, ωz, vx, vy, vz] and its ω: numbers, a unit vector or zero.
   std::vector<Field> twist_fields(const Field& f, Vec3& w) const;
 
-  // ξ = [ωx, ωy, ωz, vx, vy, vz] (the seed's twists): ω numbers, v expressions over parameters.
+  // ξ = [ωx, ωy, ωz, vx, vy, vz] (Jiang et al. 2021's twists): ω numbers, v expressions over
+  // parameters.
   void read_twist(const Field& f, std::optional<JointType> declared, Joint& j) const;
 
   // ---- Points, derived quantities, output transform ---------------------------------------

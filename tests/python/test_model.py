@@ -1,6 +1,6 @@
 """weilgen.Model against the generated C++ headers (to 1e-12 of each output's
 largest value, bit for bit without FP contraction; through a program that includes them and
-nothing else) and against the reliability seed's closed form of the gantry grinder."""
+nothing else) and against Wang & Yuan 2021's closed form of the gantry grinder."""
 import glob
 import os
 import subprocess

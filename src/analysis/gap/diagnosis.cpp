@@ -136,8 +136,8 @@ class GapSearch {
     R_.parameters = param_.size();
     VectorXd values(static_cast<Index>(obs_.size()));
     for (std::size_t i = 0; i < obs_.size(); ++i) values[static_cast<Index>(i)] = obs_[i].value;
-    e_ = std::make_unique<Engine>(data_, design_matrix(model_, param_, data_.points), values,
-                                  opt_.threads);
+    e_ = std::make_unique<DesignLeastSquares>(data_, design_matrix(model_, param_, data_.points),
+                                              values, opt_.threads);
     e_->fit_full();
     R_.rank = e_->full_rank;
     e_->splits = make_splits(data_, scheme, R_.rank + 5);
@@ -344,7 +344,7 @@ class GapSearch {
     MatrixXd AE(e_->A.rows(), e_->A.cols() + x.columns.cols());
     AE << e_->A, x.columns;
     e_->A = AE;
-    e_->refit();
+    e_->fit_folds();
     lof_after_.reset();
     e_->heldout(cur_r_, cur_h_);
     const HeldoutCovariance cov(*e_, true);
@@ -445,7 +445,7 @@ class GapSearch {
   const GapData& data_;
   const std::vector<PointObservation>& obs_;
   GapResult R_;
-  std::unique_ptr<Engine> e_;  // the baseline, then with the accepted effects' columns
+  std::unique_ptr<DesignLeastSquares> e_;  // the baseline, then with the accepted effects' columns
   // The baseline's held-out residual and leverage, its covariance, its gap (all of it and the
   // part the folds can predict), its SSE on all data, block factors and rank.
   VectorXd r_, h_;

@@ -159,12 +159,12 @@ FoldFit fit_split(const BlockFactors& F, const MatrixXd& A, const VectorXd& y, c
   return f;
 }
 
-FoldFit fit_fold(const MatrixXd& A, const VectorXd& y, const Split& s, unsigned threads) {
+FoldFit fit_all_rows(const MatrixXd& A, const VectorXd& y, const Split& s, unsigned threads) {
   const auto F = factor_blocks(A, y, {s.train}, threads);
   return fit_split(*F, A, y, s, /*train_leverage=*/true);
 }
 
-void Engine::fit_full() {
+void DesignLeastSquares::fit_full() {
   const std::size_t n = static_cast<std::size_t>(y.size());
   factors = factor_blocks(A, y, {all_rows(n).train}, threads);
   full = fit_split(*factors, A, y, all_rows(n));
@@ -172,7 +172,7 @@ void Engine::fit_full() {
   full_rank = full.rank;
 }
 
-void Engine::fit_folds() {
+void DesignLeastSquares::fit_folds() {
   const std::size_t n = static_cast<std::size_t>(y.size());
   factors = factor_blocks(A, y, split_parts(splits, n), threads);
   folds.assign(splits.size(), FoldFit{});

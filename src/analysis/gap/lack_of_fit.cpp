@@ -70,7 +70,7 @@ MatrixXd bin_offsets(const GapData& d, const std::vector<double>& v,
 
 }  // namespace
 
-LackOfFit lack_of_fit(const Engine& e, const GapData& d, const MatrixXd* extra) {
+LackOfFit lack_of_fit(const DesignLeastSquares& e, const GapData& d, const MatrixXd* extra) {
   const std::size_t n = d.points.observations.size();
   const auto coords = varying_coordinates(d);
   LackOfFit worst;

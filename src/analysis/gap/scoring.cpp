@@ -36,8 +36,8 @@ struct Score {
 // The columns of a θ-dependent variant for the fit `ff` (on the rows `train`): at its θ, then
 // (theta_iterations) at the θ of the joint fit [A E] with those columns; a candidate's own
 // nonlinear refit instead when it has one.
-MatrixXd theta_columns(const Candidate& c, const Variant& v, const Engine& e, const FoldFit& ff,
-                       std::size_t np, const std::vector<std::size_t>& train) {
+MatrixXd theta_columns(const Candidate& c, const Variant& v, const DesignLeastSquares& e,
+                       const FoldFit& ff, std::size_t np, const std::vector<std::size_t>& train) {
   if (c.refit) return c.columns(v, c.refit(train, ff.theta, e.A, e.y));
   MatrixXd E = c.columns(v, split_theta(ff.theta, np));
   for (int it = 0; it < v.theta_iterations; ++it) {
@@ -55,7 +55,7 @@ using SplitColumns = std::vector<MatrixXd>;
 
 Score score(const Candidate& c, const Variant& v, const ScoringContext& sc, bool want_after,
             const SplitColumns* pre = nullptr) {
-  const Engine& e = *sc.engine;
+  const DesignLeastSquares& e = *sc.engine;
   Score s;
   const bool plain = is_plain(c, v);
   Projection shared, shared_exact;
@@ -95,7 +95,7 @@ Score score(const Candidate& c, const Variant& v, const ScoringContext& sc, bool
 // kBatchColumns columns at a time.
 void score_batch(const Candidate& c, std::size_t begin, std::size_t end, const ScoringContext& sc,
                  std::vector<double>& sse) {
-  const Engine& e = *sc.engine;
+  const DesignLeastSquares& e = *sc.engine;
   std::vector<MatrixXd> cols;
   Index width = 0;
   std::size_t first = begin;
@@ -124,7 +124,7 @@ void score_batch(const Candidate& c, std::size_t begin, std::size_t end, const S
 // `pre`: per variant, its θ-dependent columns when already computed (SplitColumns).
 Evaluated evaluate_one(const Candidate& c, const ScoringContext& sc,
                        const std::vector<double>* grid, const std::vector<SplitColumns>& pre) {
-  const Engine& e = *sc.engine;
+  const DesignLeastSquares& e = *sc.engine;
   Evaluated best;
   double best_train = INFINITY;
   bool have_after = false;
@@ -292,7 +292,7 @@ std::vector<Evaluated> evaluate_candidates(const std::vector<Candidate>& candida
   // candidates without refinement: one task per variant and split, so that a slow candidate's
   // splits (higher_order's refit of the exact chain) share the cores instead of running one
   // after the other on one of them.
-  const Engine& e = *sc.engine;
+  const DesignLeastSquares& e = *sc.engine;
   const std::size_t n = static_cast<std::size_t>(e.y.size()), ns = e.splits.size();
   std::vector<std::vector<SplitColumns>> pre(nc);
   struct Task {

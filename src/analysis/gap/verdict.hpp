@@ -60,7 +60,8 @@ struct LackOfFit {
 };
 
 // The engine's current model, with `extra` columns joined first (a candidate not yet accepted).
-LackOfFit lack_of_fit(const Engine& e, const GapData& d, const MatrixXd* extra = nullptr);
+LackOfFit lack_of_fit(const DesignLeastSquares& e, const GapData& d,
+                      const MatrixXd* extra = nullptr);
 
 // The accepted effects' share of the baseline's excess held-out sum of squares: over all
 // held-out residuals, and over the part each split can predict (HeldoutCovariance::estimable).

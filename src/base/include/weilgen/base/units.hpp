@@ -51,4 +51,20 @@ double parse_quantity(const std::string& text, const std::string& default_unit,
 // (mm/min); > 0. Throws std::invalid_argument "<what>: <why>".
 double parse_feedrate_mm_min(const std::string& text, const std::string& what);
 
+// An affine conversion to a base unit: value in the base unit = number * factor + offset.
+struct AffineUnit {
+  double factor = 1;
+  double offset = 0;
+  double to_base(double number) const { return number * factor + offset; }
+};
+
+// A temperature unit to °C: degC (C, °C, ºC), degF (F, °F), K. Case, blanks and '_' do not
+// matter; the empty unit is the caller's default. Throws std::invalid_argument
+// "unit '<unit>' (expected degC, degF or K)".
+AffineUnit parse_temperature_unit(const std::string& unit);
+
+// A pressure unit to Pa: Pa, hPa, mbar, kPa, mmHg, inHg (case, blanks and '_' do not matter).
+// Throws std::invalid_argument "unit '<unit>' (expected Pa, hPa, mbar, kPa, mmHg or inHg)".
+AffineUnit parse_pressure_unit(const std::string& unit);
+
 }  // namespace weilgen
