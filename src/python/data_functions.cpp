@@ -147,10 +147,10 @@ py::object fit_pdge(py::handle data, const py::kwargs& kwargs) {
 }
 
 py::object identify(py::handle machine, const py::kwargs& kwargs) {
-  const Keywords kw(
-      "identify", kwargs,
-      with_model({"data", "pdge", "fix", "rank_tol", "predict", "predict_out", "emit_params",
-                  "comp_table", "comp_type", "comp_units", "axis", "comp_points", "comp_at"}));
+  const Keywords kw("identify", kwargs,
+                    with_model({"data", "pdge", "fix", "rank_tol", "predict", "predict_out",
+                                "emit_params", "emit_params_json", "comp_table", "comp_type",
+                                "comp_units", "axis", "comp_points", "comp_at"}));
   IdentifyRequest rq;
   Messages messages(kw.flag("quiet"));
   measurement_keywords(machine, kw, rq, messages);
@@ -160,8 +160,9 @@ py::object identify(py::handle machine, const py::kwargs& kwargs) {
   rq.predict = kw.items("predict", false);
   kw.set("predict_out", rq.predict_out);
   kw.set("rank_tol", rq.rank_tolerance);
-  std::string emit;
+  std::string emit, emit_json;
   kw.set("emit_params", emit);
+  kw.set("emit_params_json", emit_json);
   rq.validate();
   std::vector<PathArg> inputs;
   for (const std::string& d : rq.data) inputs.push_back({"--data", d});
@@ -177,8 +178,10 @@ py::object identify(py::handle machine, const py::kwargs& kwargs) {
       write_file_atomically(
           rq.predict_out, prediction_csv(*run.predictions.back().points, run.model->description()));
     if (!emit.empty())
-      write_file_atomically(emit, params_header(*run.model, *run.param, run.result.theta,
-                                                identify_provenance(run.result)));
+      write_file_atomically(
+          emit, params_header(*run.model, *run.param, run.result, identify_provenance(run.result)));
+    if (!emit_json.empty())
+      write_file_atomically(emit_json, params_json(*run.model, *run.param, run.result));
     comp.write(comp_table);
     return identify_json(run);
   });
@@ -237,7 +240,7 @@ fit_pdge(data, *, basis, order, min_order, max_order, period, cv, folds, rule, c
   m.def("identify", &identify, py::arg("machine"),
         R"doc(weilgen identify: fit the error parameters to point measurements, and predict.
 
-identify(machine, *, data, pdge, fix, rank_tol, predict, predict_out, emit_params, comp_table,
+identify(machine, *, data, pdge, fix, rank_tol, predict, predict_out, emit_params, emit_params_json, comp_table,
          comp_type, comp_units, axis, comp_points, comp_at, plane, centre, radius, feed,
          allow_unknown, order, engine, compiler, param, quiet) -> dict:
 the document `weilgen identify --json` writes (docs/identify.md).)doc");
