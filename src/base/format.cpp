@@ -28,7 +28,10 @@ std::string format_fixed(double v, int decimals) {
   if (!std::isfinite(v)) return "-";
   std::ostringstream s;
   s << std::fixed << std::setprecision(decimals) << v;
-  return s.str();
+  std::string t = s.str();
+  // A value that rounds to zero prints without a sign: "-0.000" reads as a negative reading.
+  if (t[0] == '-' && t.find_first_of("123456789") == std::string::npos) t.erase(0, 1);
+  return t;
 }
 
 std::string format_significant(double v, int digits) {

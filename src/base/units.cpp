@@ -134,4 +134,26 @@ double parse_quantity(const std::string& text, const std::string& default_unit,
   return parse_quantity_unit(text, default_unit, what).value();
 }
 
+double parse_feedrate_mm_min(const std::string& text, const std::string& what) {
+  static const std::pair<const char*, double> units[] = {
+      {"mm/min", 1}, {"mm/s", 60}, {"m/min", 1000}, {"in/min", 25.4}, {"mm/sec", 60}};
+  const std::string t = trim(text);
+  std::string number = t;
+  double factor = 1;
+  for (const auto& [unit, f] : units) {
+    const std::string u = unit;
+    if (t.size() > u.size() && lower(t.substr(t.size() - u.size())) == u) {
+      number = trim(t.substr(0, t.size() - u.size()));
+      factor = f;
+      break;
+    }
+  }
+  const Quantity q = parse_quantity_unit(number, "mm", what);
+  if (q.unit_given)
+    fail(what, "\"" + abbreviated(t) + "\": a feedrate's unit is mm/min, mm/s, m/min or in/min");
+  const double v = q.number * factor;
+  if (!(v > 0)) fail(what, "\"" + abbreviated(t) + "\": the feedrate must be > 0");
+  return v;
+}
+
 }  // namespace weilgen

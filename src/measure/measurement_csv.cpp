@@ -166,6 +166,11 @@ SourceLoc MeasurementTable::cell(std::size_t row, const std::string& name) const
   return at;
 }
 
+SourceLoc MeasurementTable::header_cell(const std::string& name) const {
+  const auto it = header_columns.find(name);
+  return SourceLoc{file, header_line, it == header_columns.end() ? 0 : it->second};
+}
+
 const ColumnInfo& MeasurementTable::info_of(const std::string& name) const {
   for (std::size_t i = 0; i < columns.size(); ++i)
     if (columns[i] == name) return info[i];
@@ -375,6 +380,7 @@ MeasurementTable parse_measurements(const std::string& text, const std::string& 
         t.columns.push_back(name);
         t.info.push_back(std::move(info));
         t.values[name];
+        t.header_columns[name] = fields[i].column;
       }
       if (!unknown.empty() && !options.allow_unknown)
         throw fail(line_no, 0,

@@ -131,6 +131,11 @@ void check(const LinePlot& l) {
                        std::to_string(l.x.size()) + " x values");
     }
   }
+  for (const LineBand& b : l.bands)
+    if (b.lo.size() != l.x.size() || b.hi.size() != l.x.size())
+      bad(l.title, "band \"" + b.label + "\" has not one lo and hi per x");
+  for (const LineRule& r : l.rules)
+    if (!std::isfinite(r.y)) bad(l.title, "rule \"" + r.label + "\" is not finite");
 }
 
 void check(const StyledLinePlot& l) {
@@ -277,8 +282,9 @@ void heat_script(std::ostringstream& s, const fs::path& dir, int index, const He
     for (std::size_t ix = 0; ix < h.x.size(); ++ix) {
       const double z = h.z[iy * h.x.size() + ix];
       const double t = hi > lo ? (z - lo) / (hi - lo) : 0.5;
-      d << gnuplot_number(h.x[ix]) << "\t" << gnuplot_number(h.y[iy]) << "\t" << gnuplot_number(hx[ix]) << "\t" << gnuplot_number(hy[iy])
-        << "\t" << gnuplot_number(z) << "\t" << short_num(z) << "\t" << (t > 0.6 ? 1 : 0) << "\n";
+      d << gnuplot_number(h.x[ix]) << "\t" << gnuplot_number(h.y[iy]) << "\t"
+        << gnuplot_number(hx[ix]) << "\t" << gnuplot_number(hy[iy]) << "\t" << gnuplot_number(z)
+        << "\t" << short_num(z) << "\t" << (t > 0.6 ? 1 : 0) << "\n";
       xmin = std::min(xmin, h.x[ix] - hx[ix]);
       xmax = std::max(xmax, h.x[ix] + hx[ix]);
       ymin = std::min(ymin, h.y[iy] - hy[iy]);
@@ -345,6 +351,8 @@ void line_script(std::ostringstream& s, const fs::path& dir, int index, const Li
       d << "\t" << gnuplot_number(line.second[i]);
       all_nan = all_nan && !std::isfinite(line.second[i]);
     }
+    for (const LineBand& b : l.bands)
+      d << "\t" << gnuplot_number(b.lo[i]) << "\t" << gnuplot_number(b.hi[i]);
     d << "\n";
   }
   write_data(data, d.str());
@@ -356,11 +364,24 @@ void line_script(std::ostringstream& s, const fs::path& dir, int index, const Li
   s << "set offsets graph 0.02, graph 0.02, graph 0.05, graph 0.05\n";
   if (all_nan) s << "set yrange [0:1]\n";
   s << "plot ";
-  for (std::size_t k = 0; k < l.lines.size(); ++k) {
-    s << (k == 0 ? gq(data.string()) : std::string("''")) << " using 1:" << k + 2 << " with "
-      << style_text(styles.empty() ? LineStyle::LinesPoints : styles[k]) << " title "
-      << gq(l.lines[k].first) << (k + 1 < l.lines.size() ? ", \\\n     " : "\n");
+  // Bands first, under the lines; their columns follow the lines' in the data file.
+  for (std::size_t k = 0; k < l.bands.size(); ++k) {
+    const std::size_t lo = l.lines.size() + 2 + 2 * k;
+    s << (k == 0 ? gq(data.string()) : std::string("''")) << " using 1:" << lo << ":" << lo + 1
+      << " with filledcurves fs transparent solid 0.18 noborder"
+      << (l.bands[k].line < l.lines.size() ? " lt " + std::to_string(l.bands[k].line + 1) : "")
+      << " title " << gq(l.bands[k].label) << ", \\\n     ";
   }
+  for (std::size_t k = 0; k < l.lines.size(); ++k) {
+    s << (k == 0 && l.bands.empty() ? gq(data.string()) : std::string("''")) << " using 1:" << k + 2
+      << " with " << style_text(styles.empty() ? LineStyle::LinesPoints : styles[k]) << " lt "
+      << k + 1 << " title " << gq(l.lines[k].first)
+      << (k + 1 < l.lines.size() || !l.rules.empty() ? ", \\\n     " : "\n");
+  }
+  for (std::size_t k = 0; k < l.rules.size(); ++k)
+    s << gnuplot_number(l.rules[k].y) << " with lines dt 2 lw 1.5 lc rgb '#000000' "
+      << (l.rules[k].label.empty() ? std::string("notitle") : "title " + gq(l.rules[k].label))
+      << (k + 1 < l.rules.size() ? ", \\\n     " : "\n");
 }
 
 bool find_on_path(const std::string& program) {

@@ -11,6 +11,7 @@ std::string format_number(double v);
 // "%g" (6 significant digits): numbers inside messages.
 std::string format_short(double v);
 // Fixed-point with `decimals` digits after the point; "-" for NaN and infinities: table cells.
+// A value that rounds to zero has no sign ("0.000", never "-0.000").
 std::string format_fixed(double v, int decimals);
 // `digits` significant digits (std::setprecision); "-" for NaN and infinities: table cells.
 std::string format_significant(double v, int digits);
