@@ -7,6 +7,7 @@
 #include <map>
 #include <stdexcept>
 
+#include "weilgen/analysis/per_output_rms.hpp"
 #include "weilgen/analysis/study_spec.hpp"
 #include "weilgen/base/constants.hpp"
 #include "weilgen/base/format.hpp"
@@ -405,20 +406,16 @@ IdentifyResult Identification::run(const Model& model_, const ErrorParameterisat
   }
   R.unidentifiable = null_combinations(sv, cols);
 
-  std::array<double, 6> ss_before{}, ss_after{};
-  R.max_after.fill(0);
+  PerOutputRms<kObservationKinds> before, after;
   for (std::size_t i = 0; i < m; ++i) {
     const auto o = static_cast<std::size_t>(data.observations[i].output);
-    const double ri = r[static_cast<Eigen::Index>(i)];
-    ss_before[o] += data.observations[i].value * data.observations[i].value;
-    ss_after[o] += ri * ri;
-    R.max_after[o] = std::max(R.max_after[o], std::abs(ri));
+    before.add(o, data.observations[i].value);
+    after.add(o, r[static_cast<Eigen::Index>(i)]);
   }
   for (std::size_t o = 0; o < 6; ++o) {
-    const double n = static_cast<double>(R.count[o]);
-    R.rms_before[o] = n > 0 ? std::sqrt(ss_before[o] / n) : kNaN;
-    R.rms_after[o] = n > 0 ? std::sqrt(ss_after[o] / n) : kNaN;
-    if (n == 0) R.max_after[o] = kNaN;
+    R.rms_before[o] = before.rms(o);
+    R.rms_after[o] = after.rms(o);
+    R.max_after[o] = after.max_abs(o);
   }
   return R;
 }

@@ -36,6 +36,7 @@ struct BlockFactors {
   std::vector<MatrixXd> Q, R;
   std::vector<VectorXd> qty;  // Q_bᵀ y_b
   Index cols = 0;             // p
+  unsigned threads = 1;       // for the loops over the blocks (factor_blocks' `threads`)
 };
 
 // Factors A (rows × p) in blocks: each part of `parts` (observation indices) is cut into
