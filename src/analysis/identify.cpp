@@ -308,6 +308,15 @@ IdentifyResult Identification::run(const Model& model_, const ErrorParameterisat
   R.free_parameters = cols.size();
   R.observations = m;
   R.count = data.count;
+  const std::size_t na = desc.axes().size();
+  R.span_min.assign(na, kInf);
+  R.span_max.assign(na, -kInf);
+  for (const PointObservation& ob : data.observations)
+    for (std::size_t a = 0; a < na; ++a) {
+      const double v = data.poses[ob.row][a] + 0.0;  // + 0.0: a measured -0 is the position 0
+      R.span_min[a] = std::min(R.span_min[a], v);
+      R.span_max[a] = std::max(R.span_max[a], v);
+    }
 
   ModelData md(model_);
   VectorXd y(static_cast<Eigen::Index>(m));

@@ -25,10 +25,12 @@ const char* const kGreekMu = "\xCE\xBC";
 
 const std::vector<NamedUnit>& units() {
   static const std::vector<NamedUnit> u = {
-      {"mm", {1, false}},     {"um", {1e-3, false}},      {"nm", {1e-6, false}},
-      {"m", {1e3, false}},    {"rad", {1, true}},         {"mrad", {1e-3, true}},
-      {"urad", {1e-6, true}}, {"deg", {kPi / 180, true}}, {"arcsec", {kPi / 648000, true}},
-      {"mm/m", {1e-3, true}}, {"um/m", {1e-6, true}},
+      {"mm", {1, false}},         {"um", {1e-3, false}},
+      {"nm", {1e-6, false}},      {"m", {1e3, false}},
+      {"inch", {25.4, false}},    {"rad", {1, true}},
+      {"mrad", {1e-3, true}},     {"urad", {1e-6, true}},
+      {"deg", {kPi / 180, true}}, {"arcsec", {kPi / 648000, true}},
+      {"mm/m", {1e-3, true}},     {"um/m", {1e-6, true}},
   };
   return u;
 }
@@ -56,7 +58,8 @@ bool unit_char(char c) {
 std::string ascii_unit(const std::string& unit) { return ascii_micro(unit); }
 
 std::string known_units() {
-  return "lengths: mm, um, µm, nm, m; angles: rad, mrad, urad, µrad, deg, arcsec; slopes: mm/m, "
+  return "lengths: mm, um, µm, nm, m, inch; angles: rad, mrad, urad, µrad, deg, arcsec; slopes: "
+         "mm/m, "
          "um/m";
 }
 

@@ -23,6 +23,7 @@
 #include "weilgen/base/units.hpp"
 #include "weilgen/machine/derived.hpp"
 #include "weilgen/machine/iso_names.hpp"
+#include "weilgen/machine/linuxcnc.hpp"
 #include "weilgen/machine/model_key.hpp"
 #include "weilgen/machine/pdge_basis.hpp"
 
@@ -66,8 +67,10 @@ Description Loader::load(const YAML::Node& root) {
   }
   if (const Entry* e = top.find("algebra")) read_algebra(e->value);
   if (const Entry* e = top.find("pdge_basis")) read_pdge_basis(e->value);
+  if (const Entry* e = top.find("linuxcnc")) read_linuxcnc(e->value);
   d_.source_file = file_;
   check_derived(d_);
+  if (top.find("linuxcnc")) linuxcnc_mapping(d_);  // letters and joints used twice, gaps
   return std::move(d_);
 }
 

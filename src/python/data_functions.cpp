@@ -69,7 +69,8 @@ const std::vector<const char*>& fit_pdge_keywords() {
 }
 const std::vector<const char*>& identify_keywords() {
   static const std::vector<const char*> v = with_model(
-      {"data", "pdge", "fix", "rank_tol", "predict", "predict_out", "emit_params", "csv", "plot",
+      {"data", "pdge", "fix", "rank_tol", "predict", "predict_out", "emit_params", "emit_params_json", "csv",
+       "plot",
        "comp_table", "comp_type", "comp_units", "axis", "comp_points", "comp_at"});
   return v;
 }
@@ -248,7 +249,7 @@ py::object identify(py::handle machine, const py::kwargs& kwargs) {
   kw.set("predict_out", rq.predict_out);
   kw.set("rank_tol", rq.rank_tolerance);
   const std::string emit = output(kw, "emit_params"), csv = output(kw, "csv"),
-                    plot = output(kw, "plot");
+                    plot = output(kw, "plot"), emit_json = output(kw, "emit_params_json");
   rq.validate();
   std::vector<PathArg> inputs;
   for (const std::string& d : rq.data) inputs.push_back({"--data", d});
@@ -257,6 +258,7 @@ py::object identify(py::handle machine, const py::kwargs& kwargs) {
   check_output_paths(inputs, {{"--csv", csv},
                               {"--plot", plot},
                               {"--emit-params", emit},
+                              {"--emit-params-json", emit_json},
                               {"--predict-out", rq.predict_out},
                               {"--comp-table", comp.path}});
   if (!plot.empty()) check_plot_target(plot);
@@ -271,8 +273,10 @@ py::object identify(py::handle machine, const py::kwargs& kwargs) {
       write_file_atomically(
           rq.predict_out, prediction_csv(*run.predictions.back().points, run.model->description()));
     if (!emit.empty())
-      write_file_atomically(emit, params_header(*run.model, *run.param, run.result.theta,
+      write_file_atomically(emit, params_header(*run.model, *run.param, run.result,
                                                 identify_provenance(run.result)));
+    if (!emit_json.empty())
+      write_file_atomically(emit_json, params_json(*run.model, *run.param, run.result));
     if (!csv.empty()) write_file_atomically(csv, identify_csv(*run.model, *run.param, run.result));
     if (!plot.empty())
       write_plot(plot, identify_panels(*run.param, run.result),

@@ -14,9 +14,9 @@ struct UnitFactor {
   bool angle = false;
 };
 
-// Lengths: mm, um, µm, nm, m; angles: rad, mrad, urad, µrad, deg, arcsec; slopes (angles):
-// mm/m, um/m, µm/m (= 1e-3 rad, 1e-6 rad). µ may be written as the micro sign (U+00B5) or the
-// Greek mu (U+03BC). Throws std::invalid_argument naming the unit and the known ones.
+// Lengths: mm, um, µm, nm, m, inch (25.4 mm); angles: rad, mrad, urad, µrad, deg, arcsec; slopes
+// (angles): mm/m, um/m, µm/m (= 1e-3 rad, 1e-6 rad). µ may be written as the micro sign (U+00B5) or
+// the Greek mu (U+03BC). Throws std::invalid_argument naming the unit and the known ones.
 UnitFactor parse_unit(const std::string& unit);
 
 // The unit's name in ASCII as the table spells it: "µm" and "μm" -> "um", "µrad" -> "urad"
