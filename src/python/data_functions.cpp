@@ -68,10 +68,10 @@ const std::vector<const char*>& fit_pdge_keywords() {
   return v;
 }
 const std::vector<const char*>& identify_keywords() {
-  static const std::vector<const char*> v = with_model(
-      {"data", "pdge", "fix", "rank_tol", "predict", "predict_out", "emit_params", "emit_params_json", "csv",
-       "plot",
-       "comp_table", "comp_type", "comp_units", "axis", "comp_points", "comp_at"});
+  static const std::vector<const char*> v =
+      with_model({"data", "pdge", "fix", "rank_tol", "predict", "predict_out", "emit_params",
+                  "emit_params_json", "csv", "plot", "comp_table", "comp_type", "comp_units",
+                  "axis", "comp_points", "comp_at"});
   return v;
 }
 const std::vector<const char*>& ballbar_keywords() {
@@ -273,8 +273,8 @@ py::object identify(py::handle machine, const py::kwargs& kwargs) {
       write_file_atomically(
           rq.predict_out, prediction_csv(*run.predictions.back().points, run.model->description()));
     if (!emit.empty())
-      write_file_atomically(emit, params_header(*run.model, *run.param, run.result,
-                                                identify_provenance(run.result)));
+      write_file_atomically(
+          emit, params_header(*run.model, *run.param, run.result, identify_provenance(run.result)));
     if (!emit_json.empty())
       write_file_atomically(emit_json, params_json(*run.model, *run.param, run.result));
     if (!csv.empty()) write_file_atomically(csv, identify_csv(*run.model, *run.param, run.result));
