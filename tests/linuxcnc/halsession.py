@@ -105,6 +105,15 @@ class Session:
     def __enter__(self):
         return self
 
+    def readable(self, path):
+        """A copy of `path` that rtapi_app can open: it runs as RTAPI_UID (65534), which cannot
+        enter a clone under /root (mode 0700). In the session's directory, world-readable; gone
+        with the session."""
+        copy = os.path.join(self.fifo, os.path.basename(path))
+        shutil.copyfile(path, copy)
+        os.chmod(copy, 0o644)
+        return copy
+
     def install(self, component_dir):
         run(["make", "-C", component_dir, "install"])
         for so in os.listdir(component_dir):

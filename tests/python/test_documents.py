@@ -125,7 +125,7 @@ def test_fit_pdge_equals_cli(cli):
 def test_identify_equals_cli(cli, tmp_path):
     want = cli.json("identify", "vmc_3axis", "-q", "--data", POINTS, "--predict", BALLBAR,
                     "--predict", POINTS, "--emit-params", str(tmp_path / "cli.hpp"),
-                    "--emit-params-json", str(tmp_path / "cli.json"))
+                    "--emit-params-json", str(tmp_path / "cli_params.json"))
     got = weilgen.identify("vmc_3axis", quiet=True, data=POINTS, predict=[BALLBAR, POINTS],
                            emit_params=str(tmp_path / "module.hpp"),
                            emit_params_json=tmp_path / "module.json")
@@ -133,7 +133,7 @@ def test_identify_equals_cli(cli, tmp_path):
     assert got["rank"] == 46
     assert (tmp_path / "module.hpp").read_text() == (tmp_path / "cli.hpp").read_text()
     # The parameters a controller loads at run time (docs/controllers.md, params_file).
-    assert (tmp_path / "module.json").read_text() == (tmp_path / "cli.json").read_text()
+    assert (tmp_path / "module.json").read_text() == (tmp_path / "cli_params.json").read_text()
     params = json.loads((tmp_path / "module.json").read_text())
     assert params["machine"] == "vmc_3axis" and params["weilgen_params"] == 1
     want = cli.json("identify", "vmc_3axis", "-q", "--data", POINTS, "--pdge", "E_XX=fourier:2",
