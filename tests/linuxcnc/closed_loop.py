@@ -41,13 +41,7 @@ import sys
 sys.dont_write_bytecode = True  # a test writes nothing into the source tree
 import halsession  # noqa: E402
 
-failures = []
-
-
-def check(ok, what):
-    if not ok:
-        failures.append(what)
-        print("FAILED:", what)
+check = halsession.check
 
 
 # The simulated machines: the model's axes (kAxes order) with their travel, and how the physical
@@ -357,10 +351,7 @@ def main():
                 lines.append(text)
     with open(os.path.join(args.work, "summary.txt"), "w") as f:
         f.write("\n".join(lines) + "\n")
-    if failures:
-        print("linuxcnc_closed_loop: %d failure(s)" % len(failures))
-        sys.exit(1)
-    print("linuxcnc_closed_loop: ok")
+    halsession.finish("linuxcnc_closed_loop")
 
 
 if __name__ == "__main__":

@@ -24,6 +24,24 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 DRIVER = os.path.join(HERE, "hal_driver.py")
 
 
+failures = []  # what check() found wrong, in this process
+
+
+def check(ok, what):
+    """Records and prints a failure; the test goes on, finish() decides the exit code."""
+    if not ok:
+        failures.append(what)
+        print("FAILED:", what)
+
+
+def finish(test):
+    """Exit 1 with the count when a check failed, else print '<test>: ok'."""
+    if failures:
+        print("%s: %d failure(s)" % (test, len(failures)))
+        sys.exit(1)
+    print("%s: ok" % test)
+
+
 def unavailable(test, why):
     if os.environ.get("CI"):
         print("%s: %s, and CI is set: failing (scripts/install_deps.sh installs linuxcnc-uspace "

@@ -39,13 +39,7 @@ sys.dont_write_bytecode = True  # a test writes nothing into the source tree
 import halsession  # noqa: E402
 
 TOLERANCE = 1e-9  # mm (deg, inch)
-failures = []
-
-
-def check(ok, what):
-    if not ok:
-        failures.append(what)
-        print("FAILED:", what)
+check = halsession.check
 
 
 def reference(program, params, errors, targets):
@@ -463,10 +457,7 @@ def main():
         check(code != 0 and "machine: 'five_axis_ac' is not this component's model 'vmc_3axis'" in log,
               "a params file of another model must refuse the load")
         s.unload()
-    if failures:
-        print("linuxcnc_component: %d failure(s)" % len(failures))
-        sys.exit(1)
-    print("linuxcnc_component: ok")
+    halsession.finish("linuxcnc_component")
 
 
 if __name__ == "__main__":

@@ -19,13 +19,7 @@ import sys
 sys.dont_write_bytecode = True  # a test writes nothing into the source tree
 import halsession  # noqa: E402
 
-failures = []
-
-
-def check(ok, what):
-    if not ok:
-        failures.append(what)
-        print("FAILED:", what)
+check = halsession.check
 
 
 def main():
@@ -93,10 +87,7 @@ def main():
                       "%s: %s.%s not connected" % (model, name, pin))
             print("%s: loads with trivkins coordinates=%s and motmod num_joints=%s; thread %s"
                   % (model, letters, joints.group(1), ", ".join(thread)))
-    if failures:
-        print("linuxcnc_configs: %d failure(s)" % len(failures))
-        sys.exit(1)
-    print("linuxcnc_configs: ok")
+    halsession.finish("linuxcnc_configs")
 
 
 if __name__ == "__main__":
