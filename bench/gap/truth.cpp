@@ -116,29 +116,6 @@ Eigen::MatrixXd position_jacobian(const NumericChain& chain, const std::vector<d
 
 }  // namespace
 
-const std::vector<std::string>& library_effects() {
-  static const std::vector<std::string> v = {"thermal_drift", "reversal",     "periodic",
-                                             "pdge_shape",    "higher_order", "missing_error",
-                                             "tool_offset",   "setup"};
-  return v;
-}
-
-const std::vector<std::string>& all_effects() {
-  static const std::vector<std::string> v = [] {
-    std::vector<std::string> a = library_effects();
-    a.push_back("step");
-    a.push_back("none");
-    return a;
-  }();
-  return v;
-}
-
-const std::vector<std::string>& layout_names() {
-  static const std::vector<std::string> v = {"grid",    "sparse",     "small", "line",
-                                             "ballbar", "ballbar_yz", "rtest", "rtest_small"};
-  return v;
-}
-
 double Rng::normal() {
   if (has_spare_) {
     has_spare_ = false;
@@ -184,9 +161,7 @@ int pdge_basis(int harmonics, int degree, double q, double a, double b, double* 
 Synthesiser::~Synthesiser() = default;
 
 Synthesiser::Synthesiser(ScenarioSpec spec) : spec_(std::move(spec)) {
-  const auto& layouts = layout_names();
-  if (std::find(layouts.begin(), layouts.end(), spec_.layout) == layouts.end())
-    throw fail("unknown layout '" + spec_.layout + "'");
+  layout_ = Layout::parse(spec_.layout);
   if (!(spec_.factor >= 0) || !(spec_.noise_um >= 0)) throw fail("factor and noise must be >= 0");
   if (spec_.truth_degree < 0 || spec_.truth_degree > 8 || spec_.fit_degree < 0 ||
       spec_.fit_degree > 8 || spec_.rotary_harmonics < 0 || spec_.rotary_harmonics > 7)
@@ -199,13 +174,15 @@ Synthesiser::Synthesiser(ScenarioSpec spec) : spec_(std::move(spec)) {
       names.push_back(rest.substr(0, p));
     names.push_back(rest);
   }
-  const auto& all = all_effects();
   for (const std::string& n : names)
-    if (std::find(all.begin(), all.end(), n) == all.end()) throw fail("unknown effect '" + n + "'");
+    if (n != "none" && !find_effect(n)) throw fail("unknown effect '" + n + "'");
   if (names.size() > 2) throw fail("at most two effects at once");
   if (names.size() == 2) {
-    const std::set<std::string> additive = {"thermal_drift", "reversal", "periodic", "pdge_shape"};
-    if (!additive.count(names[0]) || !additive.count(names[1]) || names[0] == names[1])
+    auto additive = [](const std::string& n) {
+      const EffectDef* d = find_effect(n);
+      return d && d->additive;
+    };
+    if (!additive(names[0]) || !additive(names[1]) || names[0] == names[1])
       throw fail(
           "two effects at once: two different ones of thermal_drift, reversal, periodic, "
           "pdge_shape");
@@ -216,11 +193,12 @@ Synthesiser::Synthesiser(ScenarioSpec spec) : spec_(std::move(spec)) {
   }
   for (const std::string& n : names) {
     Effect e;
+    e.kind = find_effect(n)->kind;
     e.name = n;
     effects_.push_back(e);
-    tool_offset_ = tool_offset_ || n == "tool_offset";
-    higher_order_ = higher_order_ || n == "higher_order";
-    missing_ = missing_ || n == "missing_error";
+    tool_offset_ = tool_offset_ || e.kind == EffectKind::ToolOffset;
+    higher_order_ = higher_order_ || e.kind == EffectKind::HigherOrder;
+    missing_ = missing_ || e.kind == EffectKind::MissingError;
   }
 
   truth_desc_ = load_machine_file(resolve_machine(spec_.machine));
@@ -354,102 +332,6 @@ int Synthesiser::positioning_error(int axis) const {
 // ---------------------------------------------------------------------------------------------
 // Effects
 
-void Synthesiser::build_effect(Effect& e, Rng& rng) {
-  const std::vector<int> linear = linear_axes();
-  auto pick = [&](const std::vector<int>& v) {
-    return v[static_cast<std::size_t>(rng.index(static_cast<int>(v.size())))];
-  };
-  // The axes an axis-bound effect may sit on: those the layout moves.
-  std::vector<int> moving = linear;
-  if (spec_.layout == "line") moving = {line_axis_};
-  if (spec_.layout.rfind("ballbar", 0) == 0) moving = {plane_a_, plane_b_};
-  if (spec_.layout.rfind("rtest", 0) == 0) {
-    moving.clear();
-    for (std::size_t k = 0; k < axes_.size(); ++k)
-      if (distinct_positions(static_cast<int>(k)) > 1) moving.push_back(static_cast<int>(k));
-  }
-  std::set<int> measured_dims;
-  if (column_dim_[0] < 0) {
-    measured_dims = {axes_[plane_a_].dim, axes_[plane_b_].dim};
-  } else {
-    for (int d : column_dim_) measured_dims.insert(d);
-  }
-  auto dim_of = [&](int err) {
-    const Vec3& d = truth_desc_.errors[static_cast<std::size_t>(err)].direction;
-    return static_cast<int>(
-        std::max_element(d.begin(), d.end(),
-                         [](double x, double y) { return std::abs(x) < std::abs(y); }) -
-        d.begin());
-  };
-  // A translation error of `axis` (line: its positioning error; a linear axis: along a measured
-  // direction; a rotary axis: radial or axial, which the R-test sees in every direction).
-  auto pick_error = [&](int axis) {
-    if (spec_.layout == "line") return positioning_error(axis);
-    std::vector<int> cand;
-    for (int i : translation_errors(axis))
-      if (!axes_[axis].linear || measured_dims.count(dim_of(i))) cand.push_back(i);
-    if (cand.empty()) throw fail("axis " + axes_[axis].name + " has no measured translation error");
-    return pick(cand);
-  };
-
-  if (e.name == "reversal") {
-    // On an R-test, a rotary axis or a linear one with equal odds.
-    std::vector<int> cand = moving;
-    if (spec_.layout.rfind("rtest", 0) == 0) {
-      std::vector<int> rot, lin;
-      for (int k : moving) (axes_[k].linear ? lin : rot).push_back(k);
-      cand = (rng.uniform() < 0.5 && !rot.empty()) || lin.empty() ? rot : lin;
-    }
-    e.axis = pick(cand);
-    e.error = positioning_error(e.axis);
-  } else if (e.name == "periodic" || e.name == "pdge_shape") {
-    // A shape needs enough positions along its axis to be told from other shapes: on 7
-    // positions a cubic PDGE leaves 3 shape degrees of freedom, which a period (amplitude,
-    // phase, period) or a bump (height, centre, width) uses up, so no data could tell either
-    // from a step there (docs/gap.md, "Verdict"). At least 9 positions; on an R-test the
-    // turning axis (the linear axes follow the spheres, not a grid).
-    std::vector<int> cand;
-    for (int k : moving)
-      if (distinct_positions(k) >= 9 && (spec_.layout.rfind("rtest", 0) != 0 || !axes_[k].linear))
-        cand.push_back(k);
-    if (cand.empty()) throw fail(e.name + ": no axis with 9 positions in layout " + spec_.layout);
-    e.axis = pick(cand);
-    e.error = pick_error(e.axis);
-    const double step = axis_step(e.axis);
-    const auto [lo, hi] = data_range(e.axis);
-    if (e.name == "periodic") {
-      e.period = 4 * step;  // 4 samples per period: resolved by every layout
-      e.phase = rng.uniform(0, 2 * kPi);
-    } else {
-      e.width = std::max(step, (hi - lo) / 25);
-      e.centre = rng.uniform(lo + 0.3 * (hi - lo), hi - 0.3 * (hi - lo));
-    }
-  } else if (e.name == "thermal_drift") {
-    // The tool point grows in the tool's frame (the spindle) or in the machine's (the column,
-    // the ram), and every linear axis' positioning scale grows from its reference point.
-    e.machine_frame = rng.uniform() < 0.5;
-    e.offset.assign(3, 0.0);
-    for (double& v : e.offset) v = rng.normal();
-    e.scale.assign(axes_.size(), 0.0);
-    for (int k : linear) e.scale[static_cast<std::size_t>(k)] = rng.normal();
-  } else if (e.name == "step") {
-    e.step_in_time = rng.uniform() < 0.5;
-    e.dim = *std::next(measured_dims.begin(), rng.index(static_cast<int>(measured_dims.size())));
-    if (e.step_in_time) {
-      e.step_at = std::round(rng.uniform(0.35, 0.65) * t_total_s_);
-    } else {
-      e.axis = pick(moving);
-      const auto [lo, hi] = data_range(e.axis);
-      e.step_at = std::round(rng.uniform(lo + 0.35 * (hi - lo), lo + 0.65 * (hi - lo)));
-    }
-  } else if (e.name == "tool_offset") {
-    bool found = false;
-    for (const Parameter& p : truth_desc_.parameters) found = found || p.name == "tool_length";
-    if (!found) throw fail("tool_offset needs a parameter 'tool_length' in the machine");
-  }
-  if (e.error >= 0 && e.name != "missing_error") e.dim = dim_of(e.error);
-}
-
 std::vector<double> Synthesiser::errors_at(const Row& row, const std::vector<double>& amps,
                                            const std::vector<bool>& on) const {
   const std::size_t n = truth_desc_.errors.size();
@@ -469,11 +351,11 @@ std::vector<double> Synthesiser::errors_at(const Row& row, const std::vector<dou
   }
   for (std::size_t k = 0; k < effects_.size(); ++k) {
     const Effect& f = effects_[k];
-    if (f.name == "higher_order") {
+    if (f.kind == EffectKind::HigherOrder) {
       for (double& v : e) v *= amps[k];  // both states: the exact chain against its linear part
       continue;
     }
-    if (f.name == "missing_error") {
+    if (f.kind == EffectKind::MissingError) {
       e[static_cast<std::size_t>(f.error)] *= on[k] ? amps[k] : 0.0;
       continue;
     }
@@ -484,12 +366,12 @@ std::vector<double> Synthesiser::errors_at(const Row& row, const std::vector<dou
         truth_desc_.errors[static_cast<std::size_t>(f.error)].effect == ErrorEffect::Rotation;
     const double amp = amps[k] * (rot ? 1e-6 : 1e-3);
     double add = 0;
-    if (f.name == "reversal") {
+    if (f.kind == EffectKind::Reversal) {
       // Backlash: the axis stops short by half the lost motion in its direction of approach.
       add = -amp / 2 * row.dir[static_cast<std::size_t>(f.axis)];
-    } else if (f.name == "periodic") {
+    } else if (f.kind == EffectKind::Periodic) {
       add = amp * std::sin(2 * kPi * q / f.period + f.phase);
-    } else if (f.name == "pdge_shape") {
+    } else if (f.kind == EffectKind::PdgeShape) {
       const double z = (q - f.centre) / f.width;
       add = amp * std::exp(-0.5 * z * z);
     }
@@ -534,7 +416,7 @@ std::vector<double> Synthesiser::evaluate(const std::vector<double>& amps,
   std::unique_ptr<NumericChain> tool_chain;
   const NumericChain* chain = truth_chain_.get();
   for (std::size_t k = 0; k < effects_.size(); ++k)
-    if (on[k] && effects_[k].name == "tool_offset") {
+    if (on[k] && effects_[k].kind == EffectKind::ToolOffset) {
       // The truth's tool is `amplitude` mm longer than the model's parameter says.
       tool_chain = std::make_unique<NumericChain>(truth_desc_);
       std::vector<double> p = truth_params_;
@@ -549,7 +431,7 @@ std::vector<double> Synthesiser::evaluate(const std::vector<double>& amps,
   const std::vector<double> zero(truth_desc_.errors.size(), 0.0);
   bool higher_on = false;
   for (std::size_t k = 0; k < effects_.size(); ++k)
-    higher_on = higher_on || (on[k] && effects_[k].name == "higher_order");
+    higher_on = higher_on || (on[k] && effects_[k].kind == EffectKind::HigherOrder);
   const Eigen::Vector3d first = tool_point(*truth_chain_, rows_[0].axes, zero);
   for (std::size_t r = 0; r < rows_.size(); ++r) {
     const Row& row = rows_[r];
@@ -558,7 +440,7 @@ std::vector<double> Synthesiser::evaluate(const std::vector<double>& amps,
     Eigen::Vector3d grow = Eigen::Vector3d::Zero();  // thermal growth of the tool point, mm
     for (std::size_t k = 0; k < effects_.size(); ++k) {
       const Effect& f = effects_[k];
-      if (!on[k] || f.name != "thermal_drift") continue;
+      if (!on[k] || f.kind != EffectKind::ThermalDrift) continue;
       const double w = drift(row.t_s) / dmax * amps[k] / 1000;  // mm
       for (std::size_t a = 0; a < axes_.size(); ++a)
         if (axes_[a].linear && axes_[a].max > axes_[a].min)
@@ -581,14 +463,14 @@ std::vector<double> Synthesiser::evaluate(const std::vector<double>& amps,
     }
     for (std::size_t k = 0; k < effects_.size(); ++k) {
       const Effect& f = effects_[k];
-      if (!on[k] || f.name != "step") continue;
+      if (!on[k] || f.kind != EffectKind::Step) continue;
       const double x = f.step_in_time ? row.t_s : row.axes[static_cast<std::size_t>(f.axis)];
       if (x >= f.step_at) d[f.dim] += amps[k] / 1000;
     }
     double* o = &out[r * nc];
     measure_row(r, d, o);
     for (std::size_t k = 0; k < effects_.size(); ++k) {
-      if (!on[k] || effects_[k].name != "setup") continue;
+      if (!on[k] || effects_[k].kind != EffectKind::Setup) continue;
       // Instrument cosine error: it reads (1 - k) of every displacement from its zero (the first
       // pose; the ballbar's calibrated length), k = amplitude in ppm.
       const double kk = -amps[k] * 1e-6;
@@ -824,10 +706,8 @@ void Synthesiser::place_gross_readings() {
 void Synthesiser::scale_effects() {
   for (std::size_t k = 0; k < effects_.size(); ++k) {
     Effect& f = effects_[k];
-    double amp = 1;  // µm or µrad (backlash, amplitudes, step), ppm (setup), mm (tool), x (scales)
-    if (f.name == "setup") amp = 10;
-    if (f.name == "tool_offset") amp = 100;
-    if (f.name == "higher_order") amp = 100;  // second-order terms of about a micrometre
+    // µm or µrad (backlash, amplitudes, step), ppm (setup), mm (tool), x (scales).
+    const double amp = effect_def(f.kind).nominal_amplitude;
     f.amplitude = amp;
     std::vector<double> s = signal(k, amp);
     const double v0 = max_of(unabsorbed_rms(s)), r0 = max_of(raw_rms(s));
@@ -843,7 +723,7 @@ void Synthesiser::scale_effects() {
       // Secant iteration on log(metric) against log(amplitude); slope 1 for effects linear in
       // their amplitude, about 2 for higher_order (second-order terms of scaled errors).
       double la = std::log(amp), lm = std::log(metric(s));
-      double slope = f.name == "higher_order" ? 2 : 1;
+      double slope = f.kind == EffectKind::HigherOrder ? 2 : 1;
       for (int it = 0; it < 60 && std::abs(lm - std::log(target)) > 1e-7; ++it) {
         const double la_new = la + (std::log(target) - lm) / slope;
         const double lm_new = std::log(metric(signal(k, std::exp(la_new))));
@@ -956,7 +836,7 @@ nlohmann::json Synthesiser::signal_bins(const Effect& e, int axis, std::size_t c
 
 std::string Synthesiser::expected_of(const Effect& e) const {
   if (!e.identifiable) return "none";
-  return e.name == "step" ? "unexplained" : e.name;
+  return e.kind == EffectKind::Step ? "unexplained" : e.name;
 }
 
 std::size_t Synthesiser::dominant_column(const Effect& e) const {
@@ -974,7 +854,7 @@ std::vector<std::string> Synthesiser::comment_lines() const {
   head_lines.push_back("# machine: " + model_desc_.name);
   head_lines.push_back("# layout: " + spec_.layout);
   const bool ballbar = column_dim_[0] < 0;
-  if (spec_.layout == "line") {
+  if (layout_.line()) {
     head_lines.push_back("# instrument: synthetic laser interferometer");
     head_lines.push_back("# axis: " + axes_[static_cast<std::size_t>(line_axis_)].name);
   } else if (ballbar) {
@@ -987,7 +867,7 @@ std::vector<std::string> Synthesiser::comment_lines() const {
     head_lines.push_back("# centre: " + centre);
     head_lines.push_back("# radius: " + fmt("%.10g", radius_mm_) + " mm");
     head_lines.push_back("# feed: ccw");
-  } else if (spec_.layout.rfind("rtest", 0) == 0) {
+  } else if (layout_.rtest()) {
     head_lines.push_back("# instrument: synthetic R-test (sphere centre relative to the tool)");
   } else {
     head_lines.push_back("# instrument: synthetic laser tracker");
@@ -1007,7 +887,7 @@ std::string Synthesiser::csv(bool with_effect, bool with_noise, bool with_gross)
   std::vector<std::string> head;
   for (const AxisInfo& a : axes_) head.push_back(a.name);
   head.push_back("t_s");
-  if (spec_.layout == "line") {
+  if (layout_.line()) {
     head.push_back("dir");
   } else if (ballbar) {
     head.push_back("dir");
@@ -1030,7 +910,7 @@ std::string Synthesiser::csv(bool with_effect, bool with_noise, bool with_gross)
     std::string line;
     for (double a : row.axes) line += fmt("%.10g", a) + ",";
     line += fmt("%.2f", row.t_s) + ",";
-    if (spec_.layout == "line") {
+    if (layout_.line()) {
       line += std::to_string(row.feed_dir) + ",";
     } else if (ballbar) {
       line += std::to_string(row.feed_dir) + "," +
@@ -1046,151 +926,6 @@ std::string Synthesiser::csv(bool with_effect, bool with_noise, bool with_gross)
     s += line + "\n";
   }
   return s;
-}
-
-nlohmann::json Synthesiser::effect_json(const Effect& f) const {
-  using nlohmann::json;
-  auto output_name = [&](std::size_t c) {
-    return column_dim_[c] >= 0 ? std::string(kDimNames[column_dim_[c]]) : std::string("dr");
-  };
-  json eff;
-  eff["name"] = f.name;
-  eff["observable"] = f.observable;
-  eff["identifiable"] = f.identifiable;
-  eff["expected"] = expected_of(f);
-  eff["heldout_signal_rms_um"] = f.unabsorbed_rms;
-  eff["raw_signal_rms_um"] = f.raw_rms;
-  eff["visible_fraction"] = f.raw_rms > 0 ? f.unabsorbed_rms / f.raw_rms : 0.0;
-  eff["snr"] = spec_.noise_um > 0 ? f.unabsorbed_rms / spec_.noise_um : 0.0;
-  json by_out = json::object(), raw_out = json::object();
-  for (std::size_t c = 0; c < f.unabsorbed_by_column.size(); ++c) {
-    by_out[output_name(c)] = f.unabsorbed_by_column[c];
-    raw_out[output_name(c)] = f.raw_by_column[c];
-  }
-  eff["heldout_signal_rms_by_output_um"] = by_out;
-  eff["raw_signal_rms_by_output_um"] = raw_out;
-  const std::size_t dominant = dominant_column(f);
-  json params = json::object();
-  const std::string out_name = output_name(dominant);
-  json loc = {{"kind", "output"}, {"by", json::array()}, {"output", out_name}};
-  const std::string axis_name =
-      f.axis >= 0 ? axes_[static_cast<std::size_t>(f.axis)].name : std::string();
-  const std::string error_name =
-      f.error >= 0 ? truth_desc_.errors[static_cast<std::size_t>(f.error)].name : std::string();
-  const bool rot = f.error >= 0 && truth_desc_.errors[static_cast<std::size_t>(f.error)].effect ==
-                                       ErrorEffect::Rotation;
-  const std::string axis_unit =
-      f.axis >= 0 && !axes_[static_cast<std::size_t>(f.axis)].linear ? "deg" : "mm";
-  if (f.name == "reversal") {
-    params = {{"axis", axis_name},
-              {"error", error_name},
-              {rot ? "backlash_urad" : "backlash_um", f.amplitude},
-              {"model", "error += -backlash/2 * dir (approach direction of the axis)"}};
-    loc = {{"kind", "direction"}, {"by", {"dir_" + axis_name, "dir"}}, {"output", out_name}};
-  } else if (f.name == "periodic") {
-    params = {{"axis", axis_name},
-              {"error", error_name},
-              {"period_" + axis_unit, f.period},
-              {rot ? "amplitude_urad" : "amplitude_um", f.amplitude},
-              {"phase_rad", f.phase}};
-    const auto [lo, hi] = data_range(f.axis);
-    loc = {{"kind", "whole"}, {"by", {axis_name}}, {"output", out_name}, {"from", lo}, {"to", hi}};
-  } else if (f.name == "pdge_shape") {
-    params = {{"axis", axis_name},
-              {"error", error_name},
-              {"centre_" + axis_unit, f.centre},
-              {"width_" + axis_unit, f.width},
-              {rot ? "amplitude_urad" : "amplitude_um", f.amplitude},
-              {"shape", "a exp(-(q-c)^2/(2 w^2))"}};
-    const auto [lo, hi] = data_range(f.axis);
-    loc = {{"kind", "interval"},
-           {"by", {axis_name}},
-           {"output", out_name},
-           {"from", std::max(lo, f.centre - 2 * f.width)},
-           {"to", std::min(hi, f.centre + 2 * f.width)},
-           {"at", f.centre}};
-  } else if (f.name == "thermal_drift") {
-    const double dmax = *std::max_element(drift_table_.begin(), drift_table_.end());
-    json scale = json::object();
-    for (std::size_t a = 0; a < axes_.size(); ++a)
-      if (axes_[a].linear && axes_[a].max > axes_[a].min)
-        scale[axes_[a].name] =
-            1000 * f.amplitude * f.scale[a] / (dmax * (axes_[a].max - axes_[a].min) / 2);
-    json offset = json::object();
-    for (int d = 0; d < 3; ++d)
-      offset[std::string(1, "xyz"[d])] = f.amplitude * f.offset[static_cast<std::size_t>(d)] / dmax;
-    params = {{"temperature", "T_spindle"},
-              {"frame", f.machine_frame ? "machine" : "tool"},
-              {"model",
-               "the tool point moves by D(t) offset (in the frame), each linear axis by D(t) "
-               "scale (q - home); D: first-order lag of T_spindle - 22 degC"},
-              {"tau_lag_s", t_total_s_ / 12},
-              {"drift_max_K", dmax},
-              {"offset_um_per_K", offset},
-              {"scale_um_per_m_per_K", scale}};
-    // Where the lagged rise is at least half its peak.
-    double from = t_total_s_, to = 0, at = 0, best = -1;
-    for (std::size_t i = 0; i < drift_table_.size(); ++i) {
-      const double t = t_total_s_ * i / (drift_table_.size() - 1);
-      if (drift_table_[i] >= 0.5 * dmax) {
-        from = std::min(from, t);
-        to = std::max(to, t);
-      }
-      if (drift_table_[i] > best) {
-        best = drift_table_[i];
-        at = t;
-      }
-    }
-    loc = {{"kind", "interval"}, {"by", {"t_s", "T_spindle", "cycle"}},
-           {"output", out_name}, {"from", from},
-           {"to", to},           {"at", at}};
-  } else if (f.name == "step") {
-    const std::string coord = f.step_in_time ? "t_s" : axis_name;
-    double hi = t_total_s_;
-    if (!f.step_in_time) hi = data_range(f.axis).second;
-    params = {{"kind", f.step_in_time ? "time" : "position"},
-              {"coordinate", coord},
-              {"at", f.step_at},
-              {"output", kDimNames[f.dim]},
-              {"step_um", f.amplitude}};
-    json by = json::array({coord});
-    if (f.step_in_time) by.push_back("cycle");
-    loc = {{"kind", "interval"}, {"by", by}, {"output", out_name},
-           {"from", f.step_at},  {"to", hi}, {"at", f.step_at}};
-  } else if (f.name == "higher_order") {
-    params = {{"error_scale", f.amplitude},
-              {"model_order", model_desc_.algebra.order},
-              {"how",
-               "every truth error multiplied by error_scale; the exact chain minus its "
-               "first-order part is the effect"}};
-  } else if (f.name == "missing_error") {
-    params = {{"error", spec_.missing_error},
-              {"unit", truth_desc_.errors[static_cast<std::size_t>(f.error)].unit},
-              {"scale_of_drawn", f.amplitude},
-              {"model_machine", model_machine_}};
-  } else if (f.name == "tool_offset") {
-    double model_len = 0;
-    for (std::size_t i = 0; i < model_desc_.parameters.size(); ++i)
-      if (model_desc_.parameters[i].name == "tool_length") model_len = model_params_[i];
-    params = {{"tool_length_model_mm", model_len},
-              {"tool_length_truth_mm", model_len + f.amplitude},
-              {"offset_mm", f.amplitude}};
-  } else if (f.name == "setup") {
-    params = {{"scale_ppm", -f.amplitude},
-              {"cosine_angle_mrad", 1e3 * std::acos(1 - f.amplitude * 1e-6)},
-              {"model", "reading = (1 - k) x displacement from the instrument zero (first pose)"}};
-  }
-  eff["params"] = params;
-  // Where the held-out signal is, along the primary coordinate: what a localisation is judged by.
-  if (loc["kind"] == "interval" || loc["kind"] == "whole") {
-    const std::string by = loc["by"][0].get<std::string>();
-    int axis = -1;
-    for (std::size_t k = 0; k < axes_.size(); ++k)
-      if (axes_[k].name == by) axis = static_cast<int>(k);
-    loc["bins"] = signal_bins(f, axis, dominant);
-  }
-  eff["localise"] = loc;
-  return eff;
 }
 
 nlohmann::json Synthesiser::truth() const {
@@ -1269,8 +1004,8 @@ nlohmann::json Synthesiser::truth() const {
     const TruthError& t = errors_[i];
     double scale = 1;
     for (const Effect& f : effects_) {
-      if (f.name == "higher_order") scale = f.amplitude;
-      if (f.name == "missing_error" && static_cast<int>(i) == f.error) scale = f.amplitude;
+      if (f.kind == EffectKind::HigherOrder) scale = f.amplitude;
+      if (f.kind == EffectKind::MissingError && static_cast<int>(i) == f.error) scale = f.amplitude;
     }
     json c = json::array();
     for (double v : t.coeff) c.push_back(v * scale);
@@ -1295,7 +1030,7 @@ nlohmann::json Synthesiser::truth() const {
   for (std::size_t i = 0; i < truth_desc_.parameters.size(); ++i) {
     double v = truth_params_[i];
     for (const Effect& f : effects_)
-      if (f.name == "tool_offset" && truth_desc_.parameters[i].name == "tool_length")
+      if (f.kind == EffectKind::ToolOffset && truth_desc_.parameters[i].name == "tool_length")
         v += f.amplitude;
     tp[truth_desc_.parameters[i].name] = v;
   }
