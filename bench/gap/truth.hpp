@@ -107,6 +107,14 @@ void copy_to(std::vector<T>& dst, const std::vector<T>& src) {
   for (std::size_t i = 0; i < src.size(); ++i) dst[i] = src[i];
 }
 
+// The largest element (0 when empty), and a number printed with a printf format.
+double max_of(const std::vector<double>& v);
+std::string fmt(const char* f, double v);
+// Central-difference Jacobian (3 × errors, mm per base unit) of the tool position of `chain`
+// at `axes`, step h (mm, rad).
+Eigen::MatrixXd position_jacobian(const NumericChain& chain, const std::vector<double>& axes,
+                                  std::size_t n, double h);
+
 // A 64-bit seed from text (FNV-1a): stable scenario seeds from scenario ids.
 std::uint64_t seed_from(const std::string& text);
 
