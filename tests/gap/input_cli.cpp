@@ -196,7 +196,7 @@ TEST_CASE("gap: bad data get a message, not a verdict") {
   CHECK(error_of("Y,Z,dx_um\n0,0,1\n") ==
         "b.csv:1: missing column 'X' (give the coordinate of a pose the data do not vary with "
         "--at X=VALUE; columns: Y, Z, dx_um)");
-  // A rotary coordinate in radians, a covariate with gaps: tests/test_gap_input.cpp.
+  // A rotary coordinate in radians, a covariate with gaps: the cases above.
   CHECK_THROWS_WITH_AS(parse_holdout("weekly"),
                        "--holdout \"weekly\": unknown scheme 'weekly' (expected cycle[:K], "
                        "time[:K], space[:AXIS][:K], forward[:FRACTION] or auto)",
