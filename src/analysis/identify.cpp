@@ -17,11 +17,13 @@
 namespace weilgen {
 
 const char* observation_name(std::size_t output) {
-  return output == kRadialOutput ? "dr" : output_name(output);
+  static const char* const line[] = {"dr", "lin", "str", "ang"};
+  return output >= 6 ? line[output - 6] : output_name(output);
 }
 
 const char* observation_unit(std::size_t output) {
-  return output == kRadialOutput ? "µm" : measured_unit(output);
+  if (output >= 6) return output == static_cast<std::size_t>(kLineAngular) ? "µrad" : "µm";
+  return measured_unit(output);
 }
 
 namespace {
@@ -146,50 +148,6 @@ void ErrorParameterisation::errors_at(const double* axes, const double* theta,
   for (std::size_t p = 0; p < params_.size(); ++p) errors[params_[p].error] += jac[p] * theta[p];
 }
 
-PointData point_data(const MeasurementTable& table, const Description& desc) {
-  PointData out;
-  out.file = table.file;
-  std::vector<const std::vector<double>*> dev(6, nullptr);
-  bool any = false;
-  for (int o = 0; o < 6; ++o)
-    if (table.has(kDeviationColumns[o])) dev[o] = &table.column(kDeviationColumns[o]), any = true;
-  if (!any)
-    throw InputError(SourceLoc{table.file, table.header_line, 0},
-                     "no deviation column (dx_um, dy_um, dz_um, da_urad, db_urad, dc_urad; "
-                     "columns: " +
-                         join(table.columns) + ")");
-  std::vector<std::string> names;
-  std::vector<const std::vector<double>*> coord;
-  for (int b : desc.axes()) {
-    names.push_back(desc.bodies[static_cast<std::size_t>(b)].joint.coordinate);
-    coord.push_back(&table.column(names.back()));
-  }
-  out.poses.assign(table.rows(), std::vector<double>(names.size(), kNaN));
-  for (std::size_t r = 0; r < table.rows(); ++r) {
-    bool measured = false;
-    for (int o = 0; o < 6; ++o) measured = measured || (dev[o] && std::isfinite((*dev[o])[r]));
-    if (!measured) continue;
-    for (std::size_t a = 0; a < names.size(); ++a) {
-      const double v = (*coord[a])[r];
-      if (!std::isfinite(v))
-        throw InputError(table.cell(r, names[a]),
-                         "column '" + names[a] +
-                             "' is empty but a deviation is measured (every "
-                             "observation needs the machine's coordinates)");
-      out.poses[r][a] = v;
-    }
-    for (int o = 0; o < 6; ++o) {
-      if (!dev[o] || !std::isfinite((*dev[o])[r])) continue;
-      out.observations.push_back({r, table.lines[r], o, (*dev[o])[r]});
-      ++out.count[static_cast<std::size_t>(o)];
-    }
-  }
-  if (out.observations.empty())
-    throw InputError(SourceLoc{table.file, 0, 0},
-                     "no observations (no row has a measured deviation)");
-  return out;
-}
-
 std::string NullCombination::str(const std::vector<IdentParameter>& params) const {
   std::string s;
   for (const auto& [p, c] : terms) {
@@ -264,6 +222,14 @@ MatrixXd design_matrix(const Model& model, const ErrorParameterisation& param,
       param.derivatives(pose, jac.data());
       last_row = ob.row;
     }
+    if (ob.error >= 0) {
+      // An error observed directly (a 6D line): µm per mm or µrad per rad of that error.
+      const double scale = error_measured_scale(model.description().errors[ob.error]);
+      for (std::size_t p = 0; p < np; ++p)
+        A(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(p)) =
+            param.parameters()[p].error == ob.error ? scale * jac[p] : 0.0;
+      continue;
+    }
     for (std::size_t p = 0; p < np; ++p) {
       const auto err = static_cast<std::size_t>(param.parameters()[p].error);
       double v = 0;
@@ -277,6 +243,43 @@ MatrixXd design_matrix(const Model& model, const ErrorParameterisation& param,
     }
   }
   return A;
+}
+
+std::size_t remove_references(const PointData& data, MatrixXd& A, VectorXd* y) {
+  std::size_t removed = 0;
+  for (const ObservationReference& ref : data.references) {
+    const auto n = static_cast<Eigen::Index>(ref.observations.size());
+    const auto k = static_cast<Eigen::Index>(ref.basis.size());
+    if (n == 0 || k == 0) continue;
+    MatrixXd N(n, k);
+    for (Eigen::Index j = 0; j < k; ++j)
+      for (Eigen::Index i = 0; i < n; ++i)
+        N(i, j) = ref.basis[static_cast<std::size_t>(j)][static_cast<std::size_t>(i)];
+    // An orthonormal basis of the functions' span at these observations (rank-revealing: a
+    // function the observations cannot tell from the others takes no degree of freedom).
+    const Eigen::ColPivHouseholderQR<MatrixXd> qr(N);
+    const auto rank = qr.rank();
+    if (rank == 0) continue;
+    const MatrixXd Q = MatrixXd(qr.householderQ()).leftCols(rank);
+    MatrixXd block(n, A.cols());
+    for (Eigen::Index i = 0; i < n; ++i)
+      block.row(i) =
+          A.row(static_cast<Eigen::Index>(ref.observations[static_cast<std::size_t>(i)]));
+    block -= Q * (Q.transpose() * block);
+    for (Eigen::Index i = 0; i < n; ++i)
+      A.row(static_cast<Eigen::Index>(ref.observations[static_cast<std::size_t>(i)])) =
+          block.row(i);
+    if (y) {
+      VectorXd v(n);
+      for (Eigen::Index i = 0; i < n; ++i)
+        v[i] = (*y)[static_cast<Eigen::Index>(ref.observations[static_cast<std::size_t>(i)])];
+      v -= Q * (Q.transpose() * v);
+      for (Eigen::Index i = 0; i < n; ++i)
+        (*y)[static_cast<Eigen::Index>(ref.observations[static_cast<std::size_t>(i)])] = v[i];
+    }
+    removed += static_cast<std::size_t>(rank);
+  }
+  return removed;
 }
 
 void IdentifyOptions::validate() const {
@@ -313,8 +316,10 @@ IdentifyResult Identification::run(const Model& model_, const ErrorParameterisat
   VectorXd y(static_cast<Eigen::Index>(m));
   for (std::size_t i = 0; i < m; ++i) y[static_cast<Eigen::Index>(i)] = data.observations[i].value;
 
-  // Linear model at zero error, without the fixed parameters.
-  const MatrixXd full = design_matrix(model_, param_, data);
+  // Linear model at zero error, without the fixed parameters; the set-up references removed
+  // from the data and the model alike.
+  MatrixXd full = design_matrix(model_, param_, data);
+  R.references = remove_references(data, full, &y);
   MatrixXd A(static_cast<Eigen::Index>(m), static_cast<Eigen::Index>(cols.size()));
   for (std::size_t q = 0; q < cols.size(); ++q)
     A.col(static_cast<Eigen::Index>(q)) = full.col(static_cast<Eigen::Index>(cols[q]));
@@ -324,17 +329,10 @@ IdentifyResult Identification::run(const Model& model_, const ErrorParameterisat
 
   // Residuals of the full model (exact at order 1; the Gauss-Newton objective above).
   auto residual = [&](const std::vector<double>& theta) {
-    VectorXd r(static_cast<Eigen::Index>(m));
-    std::size_t row = SIZE_MAX;
-    std::array<double, 6> f{};
-    for (std::size_t i = 0; i < m; ++i) {
-      const PointObservation& ob = data.observations[i];
-      if (ob.row != row) {
-        f = predict_deviation(model_, md, param_, theta, data.poses[ob.row].data());
-        row = ob.row;
-      }
-      r[static_cast<Eigen::Index>(i)] = ob.value - f[static_cast<std::size_t>(ob.output)];
-    }
+    VectorXd f = predict_observations(model_, md, param_, theta, data);
+    MatrixXd none(static_cast<Eigen::Index>(m), 0);
+    VectorXd r = y - f;
+    remove_references(data, none, &r);
     return r;
   };
   VectorXd r = model_.order() > 1 ? residual(R.theta) : VectorXd(y - A * S.x);
@@ -382,7 +380,8 @@ IdentifyResult Identification::run(const Model& model_, const ErrorParameterisat
   R.condition =
       sv.rank() ? sv.sigma()[0] / sv.sigma()[static_cast<Eigen::Index>(sv.rank() - 1)] : kNaN;
   const double sse = r.squaredNorm();
-  const double dof = static_cast<double>(m) - static_cast<double>(sv.rank());
+  const double dof =
+      static_cast<double>(m) - static_cast<double>(sv.rank()) - static_cast<double>(R.references);
   R.residual_sigma = dof > 0 ? std::sqrt(sse / dof) : kNaN;
   const Eigen::Index nf = static_cast<Eigen::Index>(cols.size());
   for (Eigen::Index q = 0; q < nf; ++q) {
@@ -397,22 +396,47 @@ IdentifyResult Identification::run(const Model& model_, const ErrorParameterisat
   }
   R.unidentifiable = null_combinations(sv, cols);
 
-  std::array<double, 6> ss_before{}, ss_after{};
+  std::array<double, kObservationKinds> ss_before{}, ss_after{};
   R.max_after.fill(0);
   for (std::size_t i = 0; i < m; ++i) {
     const auto o = static_cast<std::size_t>(data.observations[i].output);
-    const double ri = r[static_cast<Eigen::Index>(i)];
-    ss_before[o] += data.observations[i].value * data.observations[i].value;
+    const double ri = r[static_cast<Eigen::Index>(i)], yi = y[static_cast<Eigen::Index>(i)];
+    ss_before[o] += yi * yi;
     ss_after[o] += ri * ri;
     R.max_after[o] = std::max(R.max_after[o], std::abs(ri));
   }
-  for (std::size_t o = 0; o < 6; ++o) {
+  for (std::size_t o = 0; o < kObservationKinds; ++o) {
     const double n = static_cast<double>(R.count[o]);
     R.rms_before[o] = n > 0 ? std::sqrt(ss_before[o] / n) : kNaN;
     R.rms_after[o] = n > 0 ? std::sqrt(ss_after[o] / n) : kNaN;
     if (n == 0) R.max_after[o] = kNaN;
   }
   return R;
+}
+
+VectorXd predict_observations(const Model& model, ModelData& md, const ErrorParameterisation& param,
+                              const std::vector<double>& theta, const PointData& data) {
+  const Description& desc = model.description();
+  VectorXd f(static_cast<Eigen::Index>(data.observations.size()));
+  std::size_t row = SIZE_MAX;
+  std::array<double, 6> dev{};
+  std::vector<double> errors(desc.errors.size());
+  for (std::size_t i = 0; i < data.observations.size(); ++i) {
+    const PointObservation& ob = data.observations[i];
+    const double* pose = data.poses[ob.row].data();
+    if (ob.error >= 0) {
+      param.errors_at(pose, theta.data(), errors.data());
+      const auto k = static_cast<std::size_t>(ob.error);
+      f[static_cast<Eigen::Index>(i)] = error_measured_scale(desc.errors[k]) * errors[k];
+      continue;
+    }
+    if (ob.row != row) {
+      dev = predict_deviation(model, md, param, theta, pose);
+      row = ob.row;
+    }
+    f[static_cast<Eigen::Index>(i)] = observe(ob, dev);
+  }
+  return f;
 }
 
 std::array<double, 6> predict_deviation(const Model& model, ModelData& data,
@@ -423,28 +447,6 @@ std::array<double, 6> predict_deviation(const Model& model, ModelData& data,
   model.deviation(data, axes, data.errors.data(), out.data());
   for (std::size_t o = 0; o < 6; ++o) out[o] *= kMeasuredScale[o];
   return out;
-}
-
-// All --data files as one set of observations (rows keep their file for messages).
-PointData merged_point_data(const std::vector<std::string>& files, const Description& desc,
-                            const ReadOptions& ro,
-                            const std::function<void(const std::string&)>& warn) {
-  PointData all;
-  for (const std::string& f : files) {
-    const MeasurementTable t = read_measurements(f, ro);
-    if (warn)
-      for (const auto& w : t.warnings) warn(w);
-    PointData d = point_data(t, desc);
-    const std::size_t base = all.poses.size();
-    for (auto& p : d.poses) all.poses.push_back(std::move(p));
-    for (PointObservation ob : d.observations) {
-      ob.row += base;
-      all.observations.push_back(ob);
-    }
-    for (std::size_t o = 0; o < 6; ++o) all.count[o] += d.count[o];
-    all.file += (all.file.empty() ? "" : ", ") + f;
-  }
-  return all;
 }
 
 }  // namespace weilgen

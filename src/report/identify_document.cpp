@@ -14,6 +14,10 @@ namespace weilgen {
 
 namespace {
 std::string fmt(double v, int precision = 3) { return format_significant(v, precision); }
+// "_um" or "_urad": the JSON key suffix of an observation kind's figures.
+std::string unit_suffix(std::size_t kind) {
+  return std::string(observation_unit(kind)) == "µrad" ? "_urad" : "_um";
+}
 
 }  // namespace
 
@@ -53,14 +57,13 @@ json identify_json(const Model& model, const ErrorParameterisation& param, const
     null.push_back({{"text", c.str(param.parameters())}, {"terms", terms}});
   }
   json outputs = json::object();
-  for (int o = 0; o < 6; ++o) {
-    if (!r.count[static_cast<std::size_t>(o)]) continue;
-    const std::string u = o < 3 ? "_um" : "_urad";
-    outputs[output_name(static_cast<std::size_t>(o))] = {
-        {"observations", r.count[static_cast<std::size_t>(o)]},
-        {"rms_before" + u, json_number(r.rms_before[static_cast<std::size_t>(o)])},
-        {"rms_after" + u, json_number(r.rms_after[static_cast<std::size_t>(o)])},
-        {"max_after" + u, json_number(r.max_after[static_cast<std::size_t>(o)])}};
+  for (std::size_t o = 0; o < kObservationKinds; ++o) {
+    if (!r.count[o]) continue;
+    const std::string u = unit_suffix(o);
+    outputs[observation_name(o)] = {{"observations", r.count[o]},
+                                    {"rms_before" + u, json_number(r.rms_before[o])},
+                                    {"rms_after" + u, json_number(r.rms_after[o])},
+                                    {"max_after" + u, json_number(r.max_after[o])}};
   }
   return json_document("identify", {{"model", model_json(model)},
                                     {"data", files},
@@ -73,6 +76,7 @@ json identify_json(const Model& model, const ErrorParameterisation& param, const
                                     {"singular_values", r.singular_values},
                                     {"unidentifiable", null},
                                     {"residual_sigma", json_number(r.residual_sigma)},
+                                    {"references_removed", r.references},
                                     {"gauss_newton_iterations", r.gauss_newton_iterations},
                                     {"outputs", outputs}});
 }
@@ -84,12 +88,17 @@ std::string identify_text(const Model& model, const ErrorParameterisation& param
   os << "identify " << d.name << " (order " << model.order() << ", " << model.origin()
      << "): " << r.observations << " observations from " << data.file << " (";
   bool first = true;
-  for (int o = 0; o < 6; ++o)
-    if (r.count[static_cast<std::size_t>(o)])
-      os << (first ? "" : ", ") << output_name(static_cast<std::size_t>(o)) << " "
-         << r.count[static_cast<std::size_t>(o)],
-          first = false;
+  for (std::size_t o = 0; o < kObservationKinds; ++o)
+    if (r.count[o])
+      os << (first ? "" : ", ") << observation_name(o) << " " << r.count[o], first = false;
   os << ")\n";
+  if (!data.references.empty()) {
+    os << "set-up references removed (" << r.references << " functions):";
+    for (std::size_t i = 0; i < data.references.size() && i < 6; ++i)
+      os << (i ? "; " : " ") << data.references[i].what;
+    if (data.references.size() > 6) os << "; and " << data.references.size() - 6 << " more";
+    os << "\n";
+  }
   std::map<std::string, int> kinds;
   for (std::size_t k = 0; k < d.errors.size(); ++k)
     ++kinds[param.basis_of(k) ? param.basis_of(k)->name() : std::string("constant")];
@@ -106,12 +115,11 @@ std::string identify_text(const Model& model, const ErrorParameterisation& param
   os << "\nresidual sigma " << fmt(r.residual_sigma) << " (µm, µrad as measured)";
   if (r.gauss_newton_iterations) os << ", " << r.gauss_newton_iterations << " Gauss-Newton steps";
   os << "\n\noutput  rms before  rms after  max after\n";
-  for (int o = 0; o < 6; ++o) {
-    const auto u = static_cast<std::size_t>(o);
+  for (std::size_t u = 0; u < kObservationKinds; ++u) {
     if (!r.count[u]) continue;
-    os << std::left << std::setw(8) << output_name(u) << std::right << std::setw(10)
+    os << std::left << std::setw(8) << observation_name(u) << std::right << std::setw(10)
        << fmt(r.rms_before[u]) << std::setw(11) << fmt(r.rms_after[u]) << std::setw(11)
-       << fmt(r.max_after[u]) << "  " << observation_unit(static_cast<std::size_t>(o)) << "\n";
+       << fmt(r.max_after[u]) << "  " << observation_unit(u) << "\n";
   }
   os << "\nparameter" << std::string(16, ' ') << "value      ± s.e.  unit\n";
   for (std::size_t p = 0; p < param.size(); ++p) {
@@ -172,11 +180,12 @@ std::vector<Panel> identify_panels(const ErrorParameterisation& param, const Ide
   std::vector<Panel> panels;
   BarChart res;
   res.title = "RMS residual per output";
-  res.ylabel = "RMS (um for dx dy dz, urad for da db dc)";
+  res.ylabel = "RMS (um for dx dy dz dr lin str, urad for da db dc ang)";
   BarSeries before{"before (model without errors)", {}, {}, {}}, after{"after", {}, {}, {}};
-  for (std::size_t o = 0; o < 6; ++o) {
+  for (std::size_t o = 0; o < kObservationKinds; ++o) {
     if (!r.count[o]) continue;
-    res.categories.push_back(std::string(output_name(o)) + (o < 3 ? " (um)" : " (urad)"));
+    res.categories.push_back(std::string(observation_name(o)) + " (" + unit_suffix(o).substr(1) +
+                             ")");
     before.value.push_back(r.rms_before[o]);
     after.value.push_back(r.rms_after[o]);
   }
