@@ -172,6 +172,8 @@ struct SvdSolve {
       : svd(A, tol, /*full_v=*/true), x(svd.solve(y)) {}
 };
 
+}  // namespace
+
 // Readable null-space basis: reduced row echelon form of Nᵀ (each combination has a leading
 // parameter the others do not contain), in θ units, leading coefficient 1.
 std::vector<NullCombination> null_combinations(const EquilibratedSvd& s,
@@ -204,8 +206,6 @@ std::vector<NullCombination> null_combinations(const EquilibratedSvd& s,
   }
   return out;
 }
-
-}  // namespace
 
 MatrixXd design_matrix(const Model& model, const ErrorParameterisation& param,
                        const PointData& data) {

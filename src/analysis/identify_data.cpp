@@ -201,6 +201,39 @@ PointData line6d_point_data(const MeasurementTable& table, const Description& de
   return p;
 }
 
+void add_rtest_references(PointData& data) {
+  for (int o = 0; o < 6; ++o) {
+    ObservationReference ref;
+    ref.what = std::string("R-test zero of ") + output_name(static_cast<std::size_t>(o)) + " in " +
+               data.file;
+    ref.basis.assign(1, {});
+    for (std::size_t i = 0; i < data.observations.size(); ++i) {
+      if (data.observations[i].output != o) continue;
+      ref.observations.push_back(i);
+      ref.basis[0].push_back(1.0);
+    }
+    if (!ref.observations.empty()) data.references.push_back(std::move(ref));
+  }
+}
+
+PointData table_point_data(const MeasurementTable& t, const Description& desc,
+                           const BallbarFlags& circle, const std::vector<double>& parameters,
+                           const std::function<void(const std::string&)>& warn) {
+  if (is_line6d(t)) return line6d_point_data(t, desc, warn);
+  if (is_ballbar_table(t)) {
+    std::optional<BallbarCircle> c;
+    PointData d = ballbar_point_data(t, desc, circle, parameters, c);
+    std::vector<double> angles;
+    for (const PointObservation& ob : d.observations)
+      angles.push_back(t.column("angle_deg")[ob.row]);
+    d.references.push_back(ballbar_centre_reference(d, angles));
+    return d;
+  }
+  PointData d = point_data(t, desc);
+  if (lower(trim(t.header_key("instrument"))) == "rtest") add_rtest_references(d);
+  return d;
+}
+
 PointData merged_point_data(const std::vector<std::string>& files, const Description& desc,
                             const ReadOptions& ro,
                             const std::function<void(const std::string&)>& warn,
@@ -220,19 +253,7 @@ PointData merged_point_data(const std::vector<std::string>& files, const Descrip
     const MeasurementTable t = read_measurements(f, options);
     if (warn)
       for (const auto& w : t.warnings) warn(w);
-    if (line6d) {
-      all.append(line6d_point_data(t, desc, warn));
-    } else if (is_ballbar_table(t)) {
-      std::optional<BallbarCircle> c;
-      PointData d = ballbar_point_data(t, desc, circle, parameters, c);
-      std::vector<double> angles;
-      for (const PointObservation& ob : d.observations)
-        angles.push_back(t.column("angle_deg")[ob.row]);
-      d.references.push_back(ballbar_centre_reference(d, angles));
-      all.append(std::move(d));
-    } else {
-      all.append(point_data(t, desc));
-    }
+    all.append(table_point_data(t, desc, circle, parameters, warn));
   }
   return all;
 }

@@ -23,6 +23,18 @@ std::string unit_suffix(std::size_t kind) {
 
 using nlohmann::json;
 
+json null_combinations_json(const ErrorParameterisation& param,
+                            const std::vector<NullCombination>& combinations) {
+  json null = json::array();
+  for (const NullCombination& c : combinations) {
+    json terms = json::array();
+    for (const auto& [p, v] : c.terms)
+      terms.push_back({{"parameter", param.parameters()[p].label}, {"coefficient", v}});
+    null.push_back({{"text", c.str(param.parameters())}, {"terms", terms}});
+  }
+  return null;
+}
+
 json identify_json(const Model& model, const ErrorParameterisation& param, const IdentifyResult& r,
                    const std::vector<std::string>& files) {
   const Description& d = model.description();
@@ -49,13 +61,7 @@ json identify_json(const Model& model, const ErrorParameterisation& param, const
                                  {"from", b->a},
                                  {"to", b->b}};
   }
-  json null = json::array();
-  for (const NullCombination& c : r.unidentifiable) {
-    json terms = json::array();
-    for (const auto& [p, v] : c.terms)
-      terms.push_back({{"parameter", param.parameters()[p].label}, {"coefficient", v}});
-    null.push_back({{"text", c.str(param.parameters())}, {"terms", terms}});
-  }
+  const json null = null_combinations_json(param, r.unidentifiable);
   json outputs = json::object();
   for (std::size_t o = 0; o < kObservationKinds; ++o) {
     if (!r.count[o]) continue;

@@ -68,6 +68,66 @@ double design_criterion(const MatrixXd& M, DesignCriterion c, const MatrixXd& W)
   return 0;
 }
 
+double ContinuousBound::for_units(std::size_t n, DesignCriterion c, std::size_t r) const {
+  const double nn = static_cast<double>(n);
+  if (c == DesignCriterion::D) return bound + static_cast<double>(r) * std::log(nn);
+  if (c == DesignCriterion::E) return std::numeric_limits<double>::quiet_NaN();
+  return bound / nn;
+}
+
+ContinuousBound continuous_design(const DesignProblem& p, DesignCriterion c, std::size_t iterations,
+                                  unsigned threads) {
+  ContinuousBound out;
+  const std::size_t n = p.units.size();
+  if (n == 0) throw std::invalid_argument("continuous design: no candidate units");
+  const Eigen::Index r = p.units.front().cols();
+  if (c == DesignCriterion::E) {
+    out.bound = out.value = std::numeric_limits<double>::quiet_NaN();
+    return out;
+  }
+  const MatrixXd W = c == DesignCriterion::A ? MatrixXd::Identity(r, r) : p.weight;
+  const bool d_opt = c == DesignCriterion::D;
+  std::vector<double> w(n, 1.0 / static_cast<double>(n)), d(n);
+  constexpr std::size_t kBlock = 256;
+  const std::size_t blocks = (n + kBlock - 1) / kBlock;
+  for (std::size_t it = 0;; ++it) {
+    // M(ξ) in fixed blocks, summed in block order: the same for any thread count.
+    std::vector<MatrixXd> part(blocks, MatrixXd::Zero(r, r));
+    parallel_blocks(n, kBlock, threads,
+                    [&](std::size_t b, std::size_t lo, std::size_t hi, unsigned) {
+                      for (std::size_t j = lo; j < hi; ++j)
+                        part[b].noalias() += w[j] * p.units[j].transpose() * p.units[j];
+                    });
+    MatrixXd M = MatrixXd::Zero(r, r);
+    for (const MatrixXd& m : part) M += m;
+    const Eigen::LDLT<MatrixXd> ldlt(M);
+    const MatrixXd Minv = ldlt.solve(MatrixXd::Identity(r, r));
+    const MatrixXd K = d_opt ? Minv : MatrixXd(Minv * W * Minv);
+    parallel_blocks(n, kBlock, threads, [&](std::size_t, std::size_t lo, std::size_t hi, unsigned) {
+      for (std::size_t j = lo; j < hi; ++j)
+        d[j] = (p.units[j] * K * p.units[j].transpose()).trace();
+    });
+    const double dmax = *std::max_element(d.begin(), d.end());
+    if (d_opt) {
+      out.value = ldlt.vectorD().array().max(1e-300).log().sum();
+      out.bound = out.value + dmax - static_cast<double>(r);
+    } else {
+      out.value = (W * Minv).trace();
+      out.bound = 2 * out.value - dmax;
+    }
+    out.iterations = it;
+    if (it >= iterations) break;
+    double total = 0;
+    for (std::size_t j = 0; j < n; ++j) {
+      w[j] *= d_opt ? d[j] / static_cast<double>(r) : std::sqrt(std::max(0.0, d[j]) / out.value);
+      total += w[j];
+    }
+    for (double& x : w) x /= total;
+  }
+  out.weights = w;
+  return out;
+}
+
 ObservabilityIndices observability_indices(const VectorXd& s, std::size_t m) {
   ObservabilityIndices o;
   const Eigen::Index L = s.size();
@@ -175,9 +235,10 @@ class State {
   };
   // `Pi` = M⁻¹ Z_outᵀ and `Ki` = K Z_outᵀ for the unit going out (empty without one).
   Eval evaluate(const Move& mv, const MatrixXd& Pi, const MatrixXd& Ki, bool exact_e) const {
-    const Blocks b = blocks(mv, Pi, Ki);
+    const Blocks& b = blocks(mv, Pi, Ki, false);
     Eval e;
-    const Eigen::PartialPivLU<MatrixXd> lu(b.S);
+    lu_.compute(b.S);
+    const Eigen::PartialPivLU<MatrixXd>& lu = lu_;
     const double det = lu.determinant() * (b.k_out % 2 ? -1.0 : 1.0);
     if (!(det > 0)) return e;  // M would not stay positive definite (rounding)
     const double new_logdet = logdet_ + std::log(det);
@@ -200,7 +261,7 @@ class State {
         mv.out == kNone ? MatrixXd() : MatrixXd(Minv_ * p_.units[mv.out].transpose());
     const MatrixXd Ki =
         mv.out == kNone || !l_ ? MatrixXd() : MatrixXd(K_ * p_.units[mv.out].transpose());
-    const Blocks b = blocks(mv, Pi, Ki);
+    const Blocks b = blocks(mv, Pi, Ki, true);
     const Eigen::PartialPivLU<MatrixXd> lu(b.S);
     const MatrixXd E = lu.inverse();
     const MatrixXd P = Minv_ * b.U;  // r × k
@@ -232,12 +293,17 @@ class State {
       return;
     }
     if (c_ == DesignCriterion::E) lambda_min_ = min_eigen(M_);
+    MatrixXd a, aE, bb;
+    const MatrixXd EPWPE = l_ ? MatrixXd(E * PWP * E) : MatrixXd();
     for (std::size_t j = 0; j < p_.units.size(); ++j) {
-      const MatrixXd a = p_.units[j] * P;
-      G_[j] -= a * E * a.transpose();
+      a.noalias() = p_.units[j].lazyProduct(P);
+      aE.noalias() = a.lazyProduct(E);
+      G_[j].noalias() -= aE.lazyProduct(a.transpose());
       if (l_) {
-        const MatrixXd bb = p_.units[j] * T;
-        H_[j] += -bb * E * a.transpose() - a * E * bb.transpose() + a * E * PWP * E * a.transpose();
+        bb.noalias() = p_.units[j].lazyProduct(T);
+        H_[j].noalias() -= bb.lazyProduct(aE.transpose());
+        H_[j].noalias() -= aE.lazyProduct(bb.transpose());
+        H_[j].noalias() += a.lazyProduct(EPWPE).lazyProduct(a.transpose());
       }
     }
   }
@@ -256,27 +322,28 @@ class State {
     Eigen::Index k_out = 0;
   };
 
-  Blocks blocks(const Move& mv, const MatrixXd& Pi, const MatrixXd& Ki) const {
-    Blocks b;
+  // The blocks of a move; `with_u` also U (for apply). Reuses the state's workspace.
+  const Blocks& blocks(const Move& mv, const MatrixXd& Pi, const MatrixXd& Ki, bool with_u) const {
+    Blocks& b = work_;
     const Eigen::Index ki = mv.in == kNone ? 0 : p_.units[mv.in].rows();
     const Eigen::Index ko = mv.out == kNone ? 0 : p_.units[mv.out].rows();
     const Eigen::Index k = ki + ko;
     b.k_out = ko;
-    b.U.resize(r_, k);
+    if (with_u) b.U.resize(r_, k);
     b.C.resize(k);
     b.S.resize(k, k);
     if (ki) {
-      b.U.leftCols(ki) = p_.units[mv.in].transpose();
+      if (with_u) b.U.leftCols(ki) = p_.units[mv.in].transpose();
       b.C.head(ki).setOnes();
       b.S.topLeftCorner(ki, ki) = G_[mv.in];
     }
     if (ko) {
-      b.U.rightCols(ko) = p_.units[mv.out].transpose();
+      if (with_u) b.U.rightCols(ko) = p_.units[mv.out].transpose();
       b.C.tail(ko).setConstant(-1);
       b.S.bottomRightCorner(ko, ko) = G_[mv.out];
     }
     if (ki && ko) {
-      b.S.topRightCorner(ki, ko) = p_.units[mv.in] * Pi;
+      b.S.topRightCorner(ki, ko).noalias() = p_.units[mv.in].lazyProduct(Pi);
       b.S.bottomLeftCorner(ko, ki) = b.S.topRightCorner(ki, ko).transpose();
     }
     b.S.diagonal() += b.C;
@@ -285,7 +352,7 @@ class State {
       if (ki) b.H.topLeftCorner(ki, ki) = H_[mv.in];
       if (ko) b.H.bottomRightCorner(ko, ko) = H_[mv.out];
       if (ki && ko) {
-        b.H.topRightCorner(ki, ko) = p_.units[mv.in] * Ki;
+        b.H.topRightCorner(ki, ko).noalias() = p_.units[mv.in].lazyProduct(Ki);
         b.H.bottomLeftCorner(ko, ki) = b.H.topRightCorner(ki, ko).transpose();
       }
     }
@@ -305,6 +372,8 @@ class State {
   std::vector<MatrixXd> G_, H_;
   std::vector<char> in_;
   std::vector<std::size_t> sel_;
+  mutable Blocks work_;
+  mutable Eigen::PartialPivLU<MatrixXd> lu_;
   double logdet_ = 0, trace_ = 0, lambda_min_ = 0, cost_ = 0;
   int updates_ = 0;
   bool fragile_ = true;

@@ -29,6 +29,7 @@
 #include "weilgen/measure/ballbar.hpp"
 #include "weilgen/measure/measurement_csv.hpp"
 #include "weilgen/model/model.hpp"
+#include "weilgen/uq/lsq.hpp"
 
 namespace weilgen {
 
@@ -181,9 +182,20 @@ ObservationReference ballbar_centre_reference(const PointData& data,
 PointData line6d_point_data(const MeasurementTable& table, const Description& desc,
                             const std::function<void(const std::string&)>& warn = {});
 
+// An R-test file (a point file with the header key `# instrument: rtest`): its sensors are zeroed
+// at the start, so each measured output (dx, dy, dz …) carries an unknown constant: one
+// reference per output over the file's observations.
+void add_rtest_references(PointData& data);
+
+// One table's observations by its kind (below), with its set-up references.
+PointData table_point_data(const MeasurementTable& table, const Description& desc,
+                           const BallbarFlags& circle, const std::vector<double>& parameters,
+                           const std::function<void(const std::string&)>& warn = {});
+
 // Every --data file's observations as one set (rows keep their file for messages): point
-// measurements, ballbar traces (is_ballbar_table; the circle from the header keys, `circle`
-// overriding) and 6D line files (`# format: line6d`); `warn` receives each file's reader warnings
+// measurements (R-test files with their zero references), ballbar traces (is_ballbar_table;
+// the circle from the header keys, `circle` overriding) and 6D line files (`# format: line6d`);
+// `warn` receives each file's reader warnings
 // (may be empty).
 PointData merged_point_data(const std::vector<std::string>& files, const Description& desc,
                             const ReadOptions& options,
@@ -216,6 +228,12 @@ struct NullCombination {
   std::vector<std::pair<std::size_t, double>> terms;                 // (parameter, coefficient)
   std::string str(const std::vector<IdentParameter>& params) const;  // "E_XX[1] - E_XY[1]"
 };
+
+// The null space of an equilibrated SVD (every column beyond its rank) as readable
+// combinations: reduced row-echelon form, so that each combination has a leading parameter the
+// others lack, in θ units, leading coefficient 1. `cols`: the parameter of each SVD column.
+std::vector<NullCombination> null_combinations(const EquilibratedSvd& svd,
+                                               const std::vector<std::size_t>& cols);
 
 struct IdentifyResult {
   std::vector<double> theta;           // parameter values (declared units); min-norm

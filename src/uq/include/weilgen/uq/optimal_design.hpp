@@ -80,6 +80,26 @@ class ExchangeDesign {
   ExchangeOptions options_;
 };
 
+// How good any design of n units can be: the optimal continuous (approximate) design of the
+// candidates by the multiplicative algorithm (Silvey, Titterington & Torsney 1978: w_j ← w_j d_j/r
+// for D; the square-root update w_j ← w_j √(d_j/Φ) for A and I, Fellman 1974), and a bound that
+// holds whatever the iterations reached, from the convexity of the criterion (the general
+// equivalence theorem, Kiefer & Wolfowitz 1960): with M(ξ) = Σ w_j Z_jᵀ Z_j,
+//   D:    log det M* ≤ log det M(ξ) + max_j tr(Z_j M⁻¹ Z_jᵀ) − r,
+//   A, I: Φ(M*) ≥ 2 Φ(M(ξ)) − max_j tr(Z_j M⁻¹ W M⁻¹ Z_jᵀ).
+// A design of n distinct units is n times a continuous design (weights 1/n on them), so its
+// log det is at most bound + r log n, and its trace(W M⁻¹) at least bound / n. E: no bound (NaN).
+struct ContinuousBound {
+  double bound = 0;  // per unit (n = 1), as above
+  double value = 0;  // the criterion of the last iterate (per unit)
+  std::size_t iterations = 0;
+  std::vector<double> weights;  // of the last iterate
+  // The bound for n units, in ExchangeResult::value's terms.
+  double for_units(std::size_t n, DesignCriterion criterion, std::size_t r) const;
+};
+ContinuousBound continuous_design(const DesignProblem& problem, DesignCriterion criterion,
+                                  std::size_t iterations, unsigned threads = 0);
+
 // The criterion of an information matrix (no ridge), as ExchangeResult::value.
 double design_criterion(const Eigen::MatrixXd& information, DesignCriterion criterion,
                         const Eigen::MatrixXd& weight);

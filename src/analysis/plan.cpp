@@ -1,0 +1,819 @@
+// The planner of `weilgen plan` (docs/planning.md, "How"): the candidates' estimable space as the
+// frame of the exchange, the exchange, the exact evaluation of a layout as identify will estimate
+// from it, and the comparison layouts.
+#include "weilgen/analysis/plan.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <numeric>
+#include <stdexcept>
+
+#include "weilgen/analysis/study_spec.hpp"
+#include "weilgen/base/format.hpp"
+#include "weilgen/base/memory.hpp"
+#include "weilgen/base/parallel.hpp"
+#include "weilgen/base/text.hpp"
+#include "weilgen/base/units.hpp"
+#include "weilgen/uq/lsq.hpp"
+
+namespace weilgen {
+
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+const Joint& joint_of(const Description& d, std::size_t axis) {
+  return d.bodies[static_cast<std::size_t>(d.axes()[axis])].joint;
+}
+
+std::uint64_t mix(std::uint64_t z) {
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
+// The model the planner works with: every unit's rows (noise-weighted) over the free parameters
+// and the nuisance columns of set-up references shared by several units (a 6D line's reference
+// over the positions of its axis, an R-test's zeros over the poses of its nest); a reference
+// within one unit (a ballbar circle's centre) is projected out of that unit's rows.
+class PlanModel {
+ public:
+  PlanModel(const PlanInput& in, const std::vector<std::size_t>& cols) : in_(in), cols_(cols) {}
+
+  // The blocks of `units` (k_j × (free + nuisance) each). New nuisance keys are added when
+  // `grow` (the candidates define them).
+  std::vector<MatrixXd> blocks(const std::vector<PlanUnit>& units, bool grow) {
+    std::vector<std::size_t> unit_of;
+    const PointData data =
+        plan_observations(*in_.model, in_.candidates, units, in_.angles, &unit_of);
+    const MatrixXd full = design_matrix(*in_.model, *in_.param, data);
+    const auto m = static_cast<Eigen::Index>(data.observations.size());
+    const auto nf = static_cast<Eigen::Index>(cols_.size());
+    // Which references are shared, and their columns.
+    std::vector<std::vector<std::size_t>> local(units.size());  // references within one unit
+    std::vector<std::pair<std::size_t, std::size_t>> shared;    // (reference, first column)
+    for (std::size_t r = 0; r < data.references.size(); ++r) {
+      const ObservationReference& ref = data.references[r];
+      if (ref.observations.empty()) continue;
+      const std::size_t u0 = unit_of[ref.observations.front()];
+      bool one = true;
+      for (std::size_t i : ref.observations) one = one && unit_of[i] == u0;
+      if (one) {
+        local[u0].push_back(r);
+        continue;
+      }
+      auto it = nuisance_.find(ref.what);
+      if (it == nuisance_.end()) {
+        if (!grow) continue;  // a reference the candidates do not have: no column for it
+        it = nuisance_.emplace(ref.what, nuisance_count_).first;
+        nuisance_count_ += ref.basis.size();
+      }
+      shared.emplace_back(r, it->second);
+    }
+    const Eigen::Index width = nf + static_cast<Eigen::Index>(nuisance_count_);
+    MatrixXd X = MatrixXd::Zero(m, width);
+    std::vector<double> weight(static_cast<std::size_t>(m));
+    for (Eigen::Index i = 0; i < m; ++i) {
+      const auto& ob = data.observations[static_cast<std::size_t>(i)];
+      weight[static_cast<std::size_t>(i)] = 1 / in_.noise[static_cast<std::size_t>(ob.output)];
+      for (Eigen::Index q = 0; q < nf; ++q)
+        X(i, q) = full(i, static_cast<Eigen::Index>(cols_[static_cast<std::size_t>(q)])) *
+                  weight[static_cast<std::size_t>(i)];
+    }
+    for (const auto& [r, first] : shared) {
+      const ObservationReference& ref = data.references[r];
+      for (std::size_t f = 0; f < ref.basis.size(); ++f)
+        for (std::size_t t = 0; t < ref.observations.size(); ++t)
+          X(static_cast<Eigen::Index>(ref.observations[t]),
+            nf + static_cast<Eigen::Index>(first + f)) =
+              ref.basis[f][t] * weight[ref.observations[t]];
+    }
+    // Rows of each unit, its own references projected out.
+    std::vector<std::vector<Eigen::Index>> rows(units.size());
+    for (Eigen::Index i = 0; i < m; ++i) rows[unit_of[static_cast<std::size_t>(i)]].push_back(i);
+    std::vector<MatrixXd> out(units.size());
+    for (std::size_t u = 0; u < units.size(); ++u) {
+      MatrixXd B(static_cast<Eigen::Index>(rows[u].size()), width);
+      for (std::size_t t = 0; t < rows[u].size(); ++t)
+        B.row(static_cast<Eigen::Index>(t)) = X.row(rows[u][t]);
+      if (!local[u].empty()) {
+        PointData one;  // the unit's references re-indexed to its rows
+        for (std::size_t r : local[u]) {
+          ObservationReference ref = data.references[r];
+          for (std::size_t& i : ref.observations)
+            i = static_cast<std::size_t>(
+                std::find(rows[u].begin(), rows[u].end(), static_cast<Eigen::Index>(i)) -
+                rows[u].begin());
+          one.references.push_back(std::move(ref));
+        }
+        remove_references(one, B);
+        // Compressed to its information: as many rows as its rank.
+        const Eigen::SelfAdjointEigenSolver<MatrixXd> es(B.transpose() * B);
+        const VectorXd& l = es.eigenvalues();
+        const double top = l.size() ? l.maxCoeff() : 0;
+        std::vector<Eigen::Index> keep;
+        for (Eigen::Index k = 0; k < l.size(); ++k)
+          if (l[k] > 1e-13 * top) keep.push_back(k);
+        MatrixXd C(static_cast<Eigen::Index>(keep.size()), width);
+        for (std::size_t t = 0; t < keep.size(); ++t)
+          C.row(static_cast<Eigen::Index>(t)) =
+              std::sqrt(l[keep[t]]) * es.eigenvectors().col(keep[t]).transpose();
+        B = std::move(C);
+      }
+      out[u] = std::move(B);
+    }
+    return out;
+  }
+
+  std::size_t nuisance() const { return nuisance_count_; }
+
+ private:
+  const PlanInput& in_;
+  std::vector<std::size_t> cols_;
+  std::map<std::string, std::size_t> nuisance_;
+  std::size_t nuisance_count_ = 0;
+};
+
+// The frame of the exchange: every column scaled by its RMS over the candidates, then the
+// candidates' estimable space (their right singular vectors above the rank tolerance).
+struct Frame {
+  VectorXd scale;           // per column (free parameters, then nuisance)
+  MatrixXd Q;               // columns × r
+  MatrixXd W;               // r × r: the I criterion's weight
+  std::vector<MatrixXd> Z;  // the candidates in the frame
+  MatrixXd to_frame(const MatrixXd& block) const {
+    const Eigen::Index w = scale.size();
+    MatrixXd b = MatrixXd::Zero(block.rows(), w);
+    b.leftCols(std::min(w, block.cols())) = block.leftCols(std::min(w, block.cols()));
+    return b * scale.cwiseInverse().asDiagonal() * Q;
+  }
+};
+
+Frame make_frame(const std::vector<MatrixXd>& blocks, double rank_tol) {
+  Frame f;
+  Eigen::Index rows = 0;
+  const Eigen::Index width = blocks.front().cols();
+  for (const MatrixXd& b : blocks) rows += b.rows();
+  check_memory(static_cast<double>(rows) * static_cast<double>(width) * 8 * 3,
+               "plan: the candidates' design matrix",
+               "use fewer candidates (--candidates AXIS=start:stop:count, --angles)");
+  MatrixXd X(rows, width);
+  Eigen::Index at = 0;
+  for (const MatrixXd& b : blocks) {
+    X.middleRows(at, b.rows()) = b;
+    at += b.rows();
+  }
+  f.scale = X.colwise().norm().transpose() / std::sqrt(static_cast<double>(blocks.size()));
+  const double big = f.scale.maxCoeff();
+  for (Eigen::Index p = 0; p < width; ++p)
+    if (!(f.scale[p] > 1e-10 * big)) f.scale[p] = 1;  // a column no candidate sees
+  X = X * f.scale.cwiseInverse().asDiagonal();
+  const Eigen::BDCSVD<MatrixXd> svd(X, Eigen::ComputeThinV);
+  const VectorXd& s = svd.singularValues();
+  Eigen::Index r = 0;
+  while (r < s.size() && s[r] > rank_tol * s[0]) ++r;
+  f.Q = svd.matrixV().leftCols(r);
+  f.Z.reserve(blocks.size());
+  for (const MatrixXd& b : blocks) f.Z.push_back(b * f.scale.cwiseInverse().asDiagonal() * f.Q);
+  return f;
+}
+
+// dx, dy, dz observations (values 0) at each pose.
+PointData volumetric_rows(std::vector<std::vector<double>> poses) {
+  PointData g;
+  g.file = "volumetric";
+  g.poses = std::move(poses);
+  for (std::size_t r = 0; r < g.poses.size(); ++r)
+    for (int o = 0; o < 3; ++o) {
+      PointObservation ob;
+      ob.row = r;
+      ob.output = o;
+      g.observations.push_back(ob);
+    }
+  return g;
+}
+
+// The volumetric prediction rows: dx, dy, dz at a 5-level grid over every axis's travel.
+PointData prediction_grid(const Description& d) {
+  std::vector<std::vector<double>> levels;
+  for (std::size_t a = 0; a < d.axes().size(); ++a) {
+    const Joint& j = joint_of(d, a);
+    std::vector<double> v;
+    for (int i = 0; i < 5; ++i)
+      v.push_back(j.max > j.min ? j.min + (j.max - j.min) * i / 4.0 : 0.0);
+    levels.push_back(v);
+  }
+  std::vector<std::vector<double>> poses;
+  std::vector<std::size_t> digit(levels.size(), 0);
+  for (bool more = true; more;) {
+    std::vector<double> pose;
+    for (std::size_t a = 0; a < levels.size(); ++a) pose.push_back(levels[a][digit[a]]);
+    poses.push_back(pose);
+    more = false;
+    for (std::size_t a = levels.size(); a-- > 0;) {
+      if (++digit[a] < levels[a].size()) {
+        more = true;
+        break;
+      }
+      digit[a] = 0;
+    }
+  }
+  return volumetric_rows(std::move(poses));
+}
+
+struct Context {
+  const PlanInput& in;
+  const PlanOptions& o;
+  std::vector<std::size_t> cols;  // free parameters
+  MatrixXd Wg;                    // the grid's Gram over the free parameters, per row
+  PlanModel model;
+  Frame frame;
+  Context(const PlanInput& i, const PlanOptions& opt, std::vector<std::size_t> c)
+      : in(i), o(opt), cols(std::move(c)), model(i, cols) {}
+};
+
+// The figures of a layout as identify will estimate from it.
+LayoutFigures evaluate(Context& cx, const std::string& name, const std::vector<PlanUnit>& units,
+                       const std::vector<MatrixXd>* frame_blocks,
+                       EquilibratedSvd* keep_svd = nullptr, MatrixXd* cov_out = nullptr) {
+  LayoutFigures f;
+  f.name = name;
+  f.layout = units;
+  const PointData data = plan_observations(*cx.in.model, cx.in.candidates, units, cx.in.angles);
+  const MatrixXd full = design_matrix(*cx.in.model, *cx.in.param, data);
+  const auto m = static_cast<Eigen::Index>(data.observations.size());
+  const auto nf = static_cast<Eigen::Index>(cx.cols.size());
+  MatrixXd A(m, nf);
+  for (Eigen::Index q = 0; q < nf; ++q)
+    A.col(q) = full.col(static_cast<Eigen::Index>(cx.cols[static_cast<std::size_t>(q)]));
+  remove_references(data, A);
+  const EquilibratedSvd svd(A, cx.o.rank_tolerance, true);
+  f.observations = static_cast<std::size_t>(m);
+  f.rank = svd.rank();
+  f.condition = f.rank ? svd.sigma()[0] / svd.sigma()[static_cast<Eigen::Index>(f.rank - 1)] : kNaN;
+  // Cov θ̂ = A⁺ Σ A⁺ᵀ: the equilibrated minimum-norm estimator with each observation's noise.
+  const MatrixXd B =
+      svd.pinv_right() * svd.U().leftCols(static_cast<Eigen::Index>(f.rank)).transpose();
+  VectorXd sd(m);
+  for (Eigen::Index i = 0; i < m; ++i)
+    sd[i] =
+        cx.in
+            .noise[static_cast<std::size_t>(data.observations[static_cast<std::size_t>(i)].output)];
+  const MatrixXd C = B * sd.asDiagonal();
+  const MatrixXd cov = C * C.transpose();
+  f.prediction_sd_um = std::sqrt(std::max(0.0, (cov * cx.Wg).trace()));
+  f.parameter_sd.assign(cx.in.param->size(), kNaN);
+  for (Eigen::Index q = 0; q < nf; ++q) {
+    double null_weight = 0;
+    for (Eigen::Index i = static_cast<Eigen::Index>(f.rank); i < nf; ++i)
+      null_weight += svd.V()(q, i) * svd.V()(q, i);
+    if (null_weight < 1e-12)
+      f.parameter_sd[cx.cols[static_cast<std::size_t>(q)]] = std::sqrt(std::max(0.0, cov(q, q)));
+  }
+  // In the frame: the information of the layout's units.
+  std::vector<MatrixXd> own;
+  if (!frame_blocks) {
+    for (const MatrixXd& b : cx.model.blocks(units, false)) own.push_back(cx.frame.to_frame(b));
+    frame_blocks = &own;
+  }
+  const Eigen::Index r = cx.frame.Q.cols();
+  MatrixXd M = MatrixXd::Zero(r, r);
+  for (const MatrixXd& z : *frame_blocks) M.noalias() += z.transpose() * z;
+  f.log_det = design_criterion(M, DesignCriterion::D, cx.frame.W);
+  f.criterion = design_criterion(M, cx.o.criterion, cx.frame.W);
+  const Eigen::SelfAdjointEigenSolver<MatrixXd> es(M, Eigen::EigenvaluesOnly);
+  VectorXd sv(r);
+  for (Eigen::Index i = 0; i < r; ++i)
+    sv[i] = std::sqrt(std::max(0.0, es.eigenvalues()[r - 1 - i]));
+  f.observability = observability_indices(sv, f.observations);
+  if (keep_svd) *keep_svd = svd;
+  if (cov_out) *cov_out = cov;
+  return f;
+}
+
+std::vector<MatrixXd> frame_blocks_of(const Context& cx, const std::vector<std::size_t>& idx) {
+  std::vector<MatrixXd> z;
+  for (std::size_t j : idx) z.push_back(cx.frame.Z[j]);
+  return z;
+}
+
+std::vector<PlanUnit> units_of(const PlanCandidates& c, const std::vector<std::size_t>& idx) {
+  std::vector<PlanUnit> u;
+  for (std::size_t j : idx) u.push_back(c.units[j]);
+  return u;
+}
+
+LayoutFigures evaluate_candidates(Context& cx, const std::string& name,
+                                  const std::vector<std::size_t>& idx) {
+  const std::vector<MatrixXd> z = frame_blocks_of(cx, idx);
+  LayoutFigures f = evaluate(cx, name, units_of(cx.in.candidates, idx), &z);
+  f.units = idx;
+  return f;
+}
+
+// Greedy rank building in the frame: units in turn, each adding the most new directions, until
+// the frame's rank. Returns how many units it took.
+std::size_t greedy_rank_units(const Frame& f, const std::vector<std::size_t>& forced) {
+  const Eigen::Index r = f.Q.cols();
+  MatrixXd basis(r, 0);
+  auto add = [&](const MatrixXd& z) {
+    MatrixXd p = z.transpose();  // r × k
+    if (basis.cols()) p -= basis * (basis.transpose() * p);
+    const Eigen::JacobiSVD<MatrixXd> s(p, Eigen::ComputeThinU);
+    Eigen::Index k = 0;
+    while (k < s.singularValues().size() && s.singularValues()[k] > 1e-8 * std::max(1.0, z.norm()))
+      ++k;
+    if (k == 0) return;
+    MatrixXd nb(r, basis.cols() + k);
+    nb << basis, s.matrixU().leftCols(k);
+    basis = nb;
+  };
+  std::size_t n = 0;
+  for (std::size_t j : forced) add(f.Z[j]), ++n;
+  std::vector<char> used(f.Z.size(), 0);
+  for (std::size_t j : forced) used[j] = 1;
+  while (basis.cols() < r) {
+    std::size_t best = f.Z.size();
+    double best_new = 0;
+    for (std::size_t j = 0; j < f.Z.size(); ++j) {
+      if (used[j]) continue;
+      MatrixXd p = f.Z[j].transpose();
+      if (basis.cols()) p -= basis * (basis.transpose() * p);
+      const double gain = p.squaredNorm() / std::max(1e-300, f.Z[j].squaredNorm());
+      if (gain > best_new + 1e-12) best_new = gain, best = j;
+    }
+    if (best == f.Z.size() || best_new < 1e-12) break;
+    used[best] = 1;
+    add(f.Z[best]);
+    ++n;
+  }
+  return n;
+}
+
+// ---- Comparison layouts ------------------------------------------------------------------------
+
+// Levels per axis whose product is at most n (each at least 2 when n allows), the largest such
+// product, then the most balanced.
+std::vector<std::size_t> balanced_factors(std::size_t n, std::size_t k) {
+  std::vector<std::size_t> best, cur;
+  std::size_t best_prod = 0;
+  double best_ratio = 1e300;
+  const std::size_t low = n >= (std::size_t{1} << k) ? 2 : 1;
+  std::function<void(std::size_t, std::size_t)> rec = [&](std::size_t prod, std::size_t from) {
+    if (cur.size() == k) {
+      const double ratio = static_cast<double>(*std::max_element(cur.begin(), cur.end())) /
+                           static_cast<double>(*std::min_element(cur.begin(), cur.end()));
+      if (prod > best_prod || (prod == best_prod && ratio < best_ratio))
+        best = cur, best_prod = prod, best_ratio = ratio;
+      return;
+    }
+    for (std::size_t f = from; prod * f <= n; ++f) {
+      cur.push_back(f);
+      rec(prod * f, f);
+      cur.pop_back();
+    }
+  };
+  if (k == 0) return {};
+  rec(1, low);
+  std::sort(best.rbegin(), best.rend());
+  return best;
+}
+
+std::vector<double> spread(double lo, double hi, std::size_t n, bool turn, double turn_size) {
+  std::vector<double> v(n, lo);
+  for (std::size_t i = 0; i < n; ++i)
+    v[i] = turn     ? lo + turn_size * static_cast<double>(i) / static_cast<double>(n)
+           : n == 1 ? (lo + hi) / 2
+                    : lo + (hi - lo) * static_cast<double>(i) / static_cast<double>(n - 1);
+  return v;
+}
+
+// The regular layout of n units: a grid over the candidates' varying axes (points; the rotary
+// axes of an R-test, the linear ones following the nest), equally spaced positions on each axis
+// of a 6D line, circles spread evenly through the candidates (ballbar). Poses the instrument
+// cannot take, and the units a grid of fewer poses leaves, are random candidates.
+std::vector<PlanUnit> regular_layout(const PlanInput& in, std::size_t n, std::string& name,
+                                     std::uint64_t seed) {
+  const Description& d = in.model->description();
+  const PlanCandidates& c = in.candidates;
+  const std::size_t na = d.axes().size();
+  std::vector<PlanUnit> out;
+  // Per axis: the candidates' range and number of levels.
+  std::vector<double> lo(na, INFINITY), hi(na, -INFINITY);
+  std::vector<std::vector<double>> distinct(na);
+  for (const PlanUnit& u : c.units)
+    for (std::size_t a = 0; a < na; ++a) {
+      lo[a] = std::min(lo[a], u.pose[a]);
+      hi[a] = std::max(hi[a], u.pose[a]);
+      if (distinct[a].size() < 1000 &&
+          std::find(distinct[a].begin(), distinct[a].end(), u.pose[a]) == distinct[a].end())
+        distinct[a].push_back(u.pose[a]);
+    }
+  if (in.instrument == Instrument::Points || in.instrument == Instrument::RTest) {
+    std::vector<std::size_t> vary;
+    for (std::size_t a = 0; a < na; ++a) {
+      const bool rot = joint_of(d, a).type == JointType::Revolute;
+      if (in.instrument == Instrument::RTest && !rot) continue;
+      if (distinct[a].size() > 1) vary.push_back(a);
+    }
+    // More levels to the axes with more candidate levels.
+    std::stable_sort(vary.begin(), vary.end(), [&](std::size_t x, std::size_t y) {
+      return distinct[x].size() > distinct[y].size();
+    });
+    const std::size_t setups = in.instrument == Instrument::RTest ? c.setups.size() : 1;
+    std::vector<std::string> shape;
+    for (std::size_t s = 0; s < setups; ++s) {
+      const std::size_t share = n / setups + (s < n % setups ? 1 : 0);
+      const std::vector<std::size_t> fac = balanced_factors(share, vary.size());
+      const PlanUnit* base = nullptr;
+      for (const PlanUnit& u : c.units)
+        if (u.setup == s && !base) base = &u;
+      if (!base) continue;
+      std::vector<std::vector<double>> levels(na);
+      for (std::size_t a = 0; a < na; ++a) levels[a] = {base->pose[a]};
+      for (std::size_t i = 0; i < vary.size(); ++i) {
+        const std::size_t a = vary[i];
+        const Joint& j = joint_of(d, a);
+        const bool turn = j.type == JointType::Revolute &&
+                          (j.max - j.min) * j.to_base >= 6.283185307179586 - 1e-9;
+        levels[a] = spread(lo[a], hi[a], fac[i], turn, 6.283185307179586 / j.to_base);
+      }
+      if (s == 0)
+        for (std::size_t f : fac) shape.push_back(std::to_string(f));
+      std::vector<std::size_t> digit(na, 0);
+      for (bool more = true; more;) {
+        PlanUnit u{s, {}, 0};
+        for (std::size_t a = 0; a < na; ++a) u.pose.push_back(levels[a][digit[a]]);
+        if (in.instrument != Instrument::RTest || hold_nest(*in.model, c.setups[s], u.pose))
+          out.push_back(u);
+        more = false;
+        for (std::size_t a = na; a-- > 0;) {
+          if (++digit[a] < levels[a].size()) {
+            more = true;
+            break;
+          }
+          digit[a] = 0;
+        }
+      }
+    }
+    name = "grid";
+    for (std::size_t i = 0; i < shape.size(); ++i) name += (i ? "x" : " ") + shape[i];
+  } else if (in.instrument == Instrument::Line6d) {
+    const std::size_t setups = c.setups.size();
+    for (std::size_t s = 0; s < setups; ++s) {
+      const std::size_t share = n / setups + (s < n % setups ? 1 : 0);
+      std::size_t a = 0;
+      while (joint_of(d, a).coordinate != c.setups[s].axis) ++a;
+      const PlanUnit* base = nullptr;
+      for (const PlanUnit& u : c.units)
+        if (u.setup == s && !base) base = &u;
+      if (!base) continue;
+      for (double v : spread(lo[a], hi[a], share, false, 0)) {
+        PlanUnit u{s, base->pose, v * joint_of(d, a).to_base};
+        u.pose[a] = v;
+        out.push_back(u);
+      }
+    }
+    name = "equally spaced positions";
+  } else {
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto j =
+          static_cast<std::size_t>((static_cast<double>(i) + 0.5) *
+                                   static_cast<double>(c.units.size()) / static_cast<double>(n));
+      out.push_back(c.units[std::min(j, c.units.size() - 1)]);
+    }
+    name = "circles spread evenly";
+  }
+  // Up to n with random candidates.
+  std::uint64_t state = mix(seed + 4242);
+  for (std::size_t guard = 0; out.size() < n && guard < 100 * n; ++guard) {
+    state = mix(state + 0x9E3779B97F4A7C15ull);
+    out.push_back(c.units[static_cast<std::size_t>(state % c.units.size())]);
+  }
+  if (out.size() > n) out.resize(n);
+  return out;
+}
+
+}  // namespace
+
+// ---- Noise and options
+// ---------------------------------------------------------------------------
+
+KindNoise parse_noise(const std::vector<std::string>& items, KindNoise base) {
+  if (base[0] == 0) {
+    for (std::size_t k = 0; k < kObservationKinds; ++k)
+      base[k] = std::string(observation_unit(k)) == "µrad" ? 1.0 : 1.0;
+  }
+  for (const std::string& flag : items) {
+    for (const std::string& raw : split(flag, ',')) {
+      const std::string item = trim(raw);
+      const std::string context = "--noise " + quoted(item);
+      if (item.empty()) throw std::invalid_argument("--noise: empty item in " + quoted(flag));
+      const auto eq = item.find('=');
+      const std::string kind = eq == std::string::npos ? "" : trim(item.substr(0, eq));
+      const std::string value = eq == std::string::npos ? item : trim(item.substr(eq + 1));
+      std::size_t k = kObservationKinds;
+      if (!kind.empty()) {
+        for (std::size_t i = 0; i < kObservationKinds; ++i)
+          if (kind == observation_name(i)) k = i;
+        if (k == kObservationKinds)
+          throw std::invalid_argument(context + ": unknown kind '" + kind +
+                                      "' (dx, dy, dz, da, db, dc, dr, lin, str, ang)");
+      }
+      const bool angle = k < kObservationKinds && std::string(observation_unit(k)) == "µrad";
+      const Quantity q =
+          parse_quantity_unit(value, k < kObservationKinds && angle ? "urad" : "um", context);
+      if (k < kObservationKinds && q.unit.angle != angle)
+        throw std::invalid_argument(context + ": " + kind + " is " +
+                                    (angle ? "an angle" : "a length") + " but '" + q.unit_name +
+                                    "' is not");
+      const double v = q.unit.angle ? q.in(parse_unit("urad")) : q.in(parse_unit("um"));
+      if (!(v > 0) || !std::isfinite(v))
+        throw std::invalid_argument(context + ": the noise must be > 0");
+      for (std::size_t i = 0; i < kObservationKinds; ++i) {
+        const bool is_angle = std::string(observation_unit(i)) == "µrad";
+        if (k == i || (k == kObservationKinds && is_angle == q.unit.angle)) base[i] = v;
+      }
+    }
+  }
+  return base;
+}
+
+void PlanOptions::validate() const {
+  if (units == 0 && !(target_sd_um > 0))
+    throw std::invalid_argument("give --poses N or --target-sd (e.g. --poses 64)");
+  if (units > 0 && target_sd_um > 0)
+    throw std::invalid_argument("--poses and --target-sd: give one of them");
+  if (restarts < 1 || restarts > 1000) throw std::invalid_argument("--restarts must be 1 to 1000");
+  if (bound_iterations > 100000) throw std::invalid_argument("--bound must be 0 to 100000");
+  if (random_sets < 1 || random_sets > 100000)
+    throw std::invalid_argument("--random-sets must be 1 to 100000");
+  if (!(rank_tolerance > 0 && rank_tolerance < 1))
+    throw std::invalid_argument("--rank-tol must be in (0, 1)");
+}
+
+Planner::Planner(PlanOptions options) : options_(std::move(options)) { options_.validate(); }
+
+PlanResult Planner::run(const PlanInput& in) const {
+  const auto t0 = std::chrono::steady_clock::now();
+  const PlanOptions& o = options_;
+  const Description& d = in.model->description();
+  PlanResult R;
+  R.instrument = in.instrument;
+  R.candidates = in.candidates;
+  R.noise = in.noise;
+  // The free parameters: identify's --fix.
+  std::vector<bool> fixed(in.param->size(), false);
+  for (const std::string& f : o.fixed)
+    for (const ErrorTarget& t : select_errors(d, f, "--fix " + quoted(f)))
+      for (std::size_t p = 0; p < in.param->size(); ++p)
+        if (in.param->parameters()[p].error == static_cast<int>(t.error)) fixed[p] = true;
+  std::vector<std::size_t> cols;
+  for (std::size_t p = 0; p < in.param->size(); ++p)
+    if (!fixed[p]) cols.push_back(p);
+  if (cols.empty()) throw std::invalid_argument("--fix: every error is fixed: nothing to plan");
+  R.free_parameters = cols.size();
+  Context cx(in, o, cols);
+  // The volumetric prediction grid.
+  {
+    const PointData g = prediction_grid(d);
+    const MatrixXd G = design_matrix(*in.model, *in.param, g);
+    MatrixXd Gf(G.rows(), static_cast<Eigen::Index>(cols.size()));
+    for (std::size_t q = 0; q < cols.size(); ++q)
+      Gf.col(static_cast<Eigen::Index>(q)) = G.col(static_cast<Eigen::Index>(cols[q]));
+    cx.Wg = Gf.transpose() * Gf / static_cast<double>(G.rows());
+  }
+  // The frame from every candidate.
+  const std::vector<MatrixXd> blocks = cx.model.blocks(in.candidates.units, true);
+  cx.frame = make_frame(blocks, o.rank_tolerance);
+  {
+    const Eigen::Index w = cx.frame.scale.size(), nf = static_cast<Eigen::Index>(cols.size());
+    MatrixXd Wfull = MatrixXd::Zero(w, w);
+    Wfull.topLeftCorner(nf, nf) = cx.Wg;
+    const VectorXd inv = cx.frame.scale.cwiseInverse();
+    // Prediction rows are θ rows: in the frame's scaled coordinates they are g·S⁻¹... the
+    // weight of φ = S θ is S⁻¹ Wg S⁻¹.
+    const MatrixXd Ws = inv.asDiagonal() * Wfull * inv.asDiagonal();
+    cx.frame.W = cx.frame.Q.transpose() * Ws * cx.frame.Q;
+  }
+  // Every candidate at once: what identify would determine from all of them.
+  std::vector<std::size_t> all(in.candidates.units.size());
+  std::iota(all.begin(), all.end(), 0);
+  EquilibratedSvd all_svd(MatrixXd::Zero(1, 1), 0.5, false);
+  {
+    const std::vector<MatrixXd> z = frame_blocks_of(cx, all);
+    const LayoutFigures every = evaluate(cx, "every candidate", in.candidates.units, &z, &all_svd);
+    R.candidate_rank = every.rank;
+    R.unidentifiable = null_combinations(all_svd, cols);
+  }
+  const Eigen::Index r = cx.frame.Q.cols();
+  std::size_t widest = 1;
+  for (const MatrixXd& z : cx.frame.Z)
+    widest = std::max<std::size_t>(widest, static_cast<std::size_t>(z.rows()));
+  R.minimum_units = std::max<std::size_t>(in.candidates.forced.size(),
+                                          (static_cast<std::size_t>(r) + widest - 1) / widest);
+  R.greedy_units = greedy_rank_units(cx.frame, in.candidates.forced);
+
+  const char* what = in.instrument == Instrument::Ballbar  ? "circles"
+                     : in.instrument == Instrument::Line6d ? "positions"
+                                                           : "poses";
+  auto plan_of = [&](std::size_t n) {
+    DesignProblem p;
+    p.units = cx.frame.Z;
+    p.weight = cx.frame.W;
+    p.forced = in.candidates.forced;
+    ExchangeOptions eo;
+    eo.criterion = o.criterion;
+    eo.size = n;
+    eo.restarts = o.restarts;
+    eo.seed = o.seed;
+    eo.threads = o.threads;
+    R.exchange = ExchangeDesign(eo).run(p);
+    return evaluate_candidates(cx, "plan", R.exchange.selected);
+  };
+  const std::size_t candidates = in.candidates.units.size();
+  auto check_size = [&](std::size_t n, const std::string& flag) {
+    if (n < R.minimum_units)
+      throw std::invalid_argument(
+          flag + ": " + std::to_string(n) + " " + what + " cannot determine the " +
+          std::to_string(r) + " combinations the candidates identify (at most " +
+          std::to_string(widest) + " per unit): at least " + std::to_string(R.minimum_units) +
+          " are needed, and the sequential design reaches full rank with " +
+          std::to_string(R.greedy_units));
+    if (n > candidates)
+      throw std::invalid_argument(flag + ": " + std::to_string(n) + " " + what + " but only " +
+                                  std::to_string(candidates) +
+                                  " candidates (give more with --candidates)");
+  };
+  if (o.target_sd_um > 0) {
+    // The fewest units whose plan reaches the target: the candidates' own figure first (no
+    // plan of fewer can do better), then a bisection guided by sd ∝ 1/√n.
+    const LayoutFigures every = evaluate_candidates(cx, "every candidate", all);
+    if (every.prediction_sd_um > o.target_sd_um)
+      throw std::invalid_argument("--target-sd " + format_significant(o.target_sd_um, 3) +
+                                  " um: even all " + std::to_string(candidates) + " candidate " +
+                                  what + " give " + format_significant(every.prediction_sd_um, 3) +
+                                  " um (lower the noise, or give more candidates)");
+    std::size_t lo = std::max(R.minimum_units, std::size_t{1}), hi = candidates;
+    std::map<std::size_t, LayoutFigures> seen;
+    auto sd_at = [&](std::size_t n) {
+      auto it = seen.find(n);
+      if (it == seen.end()) {
+        it = seen.emplace(n, plan_of(n)).first;
+        if (it->second.rank < R.candidate_rank) it->second.prediction_sd_um = INFINITY;
+        R.target_search.emplace_back(n, it->second.prediction_sd_um);
+      }
+      return it->second.prediction_sd_um;
+    };
+    seen.emplace(hi, every);
+    if (sd_at(lo) <= o.target_sd_um) {
+      hi = lo;
+    } else {
+      const double s0 = seen.at(lo).prediction_sd_um;
+      if (std::isfinite(s0)) {
+        const auto guess = static_cast<std::size_t>(
+            std::ceil(static_cast<double>(lo) * (s0 / o.target_sd_um) * (s0 / o.target_sd_um)));
+        const std::size_t g = std::clamp(guess, lo + 1, hi);
+        if (sd_at(g) <= o.target_sd_um)
+          hi = g;
+        else
+          lo = g;
+      }
+      while (hi > lo + 1) {
+        const std::size_t mid = lo + (hi - lo) / 2;
+        if (sd_at(mid) <= o.target_sd_um)
+          hi = mid;
+        else
+          lo = mid;
+      }
+    }
+    if (hi == candidates && seen.at(hi).units.size() == candidates && R.target_search.empty()) {
+      R.plan = evaluate_candidates(cx, "plan", all);
+    } else {
+      if (!seen.count(hi) || seen.at(hi).units.empty()) sd_at(hi);
+      R.plan = seen.at(hi);
+      if (R.plan.units.size() != hi) R.plan = plan_of(hi);
+    }
+    R.plan.name = "plan";
+    // The exchange result of the chosen size.
+    if (R.exchange.selected != R.plan.units) plan_of(hi);
+  } else {
+    check_size(o.units, "--poses");
+    R.plan = plan_of(o.units);
+  }
+  if (R.plan.rank < R.candidate_rank)
+    throw std::invalid_argument("--poses: the " + std::to_string(R.plan.units.size()) +
+                                " planned " + what + " reach rank " + std::to_string(R.plan.rank) +
+                                " of the candidates' " + std::to_string(R.candidate_rank) +
+                                "; the sequential design reaches full rank with " +
+                                std::to_string(R.greedy_units));
+  const std::size_t n = R.plan.units.size();
+  R.plan.lost = R.candidate_rank - R.plan.rank;
+  if (o.bound_iterations > 0) {
+    DesignProblem p;
+    p.units = cx.frame.Z;
+    p.weight = cx.frame.W;
+    const auto rr = static_cast<std::size_t>(r);
+    const ContinuousBound bi =
+        continuous_design(p, DesignCriterion::I, o.bound_iterations, o.threads);
+    R.prediction_sd_bound_um = std::sqrt(std::max(0.0, bi.for_units(n, DesignCriterion::I, rr)));
+    R.criterion_bound = o.criterion == DesignCriterion::I
+                            ? bi.for_units(n, o.criterion, rr)
+                            : continuous_design(p, o.criterion, o.bound_iterations, o.threads)
+                                  .for_units(n, o.criterion, rr);
+    R.bound_iterations = o.bound_iterations;
+  }
+  if (o.compare) {
+    std::string name;
+    const std::vector<PlanUnit> grid = regular_layout(in, n, name, o.seed);
+    R.compare.push_back(evaluate(cx, name, grid, nullptr));
+    // The random sets, in parallel (each its own stream); the best by prediction_sd_um.
+    std::vector<LayoutFigures> sets(o.random_sets);
+    std::vector<std::vector<std::size_t>> picks(o.random_sets);
+    for (std::size_t s = 0; s < o.random_sets; ++s) {
+      std::uint64_t state = mix(o.seed * 0x9E3779B97F4A7C15ull + 7777 + s);
+      std::vector<std::size_t> pool = all;
+      for (std::size_t i = 0; i < n; ++i) {
+        state = mix(state + 0x9E3779B97F4A7C15ull);
+        const std::size_t k = i + static_cast<std::size_t>(state % (pool.size() - i));
+        std::swap(pool[i], pool[k]);
+      }
+      picks[s].assign(pool.begin(), pool.begin() + static_cast<std::ptrdiff_t>(n));
+      std::sort(picks[s].begin(), picks[s].end());
+    }
+    parallel_blocks(o.random_sets, 1, o.threads,
+                    [&](std::size_t s, std::size_t, std::size_t, unsigned) {
+                      sets[s] = evaluate_candidates(cx, "random", picks[s]);
+                    });
+    std::size_t best = 0;
+    for (std::size_t s = 0; s < sets.size(); ++s) {
+      R.random_sd_um.push_back(sets[s].prediction_sd_um);
+      if (sets[s].prediction_sd_um < sets[best].prediction_sd_um) best = s;
+    }
+    sets[best].name = "best of " + std::to_string(o.random_sets) + " random";
+    R.compare.push_back(sets[best]);
+    for (LayoutFigures& f : R.compare)
+      f.lost = R.candidate_rank > f.rank ? R.candidate_rank - f.rank : 0;
+  }
+  // The prediction SD map of the plan over two axes (the first two linear ones, else the first
+  // two), the others at the middle of their travel.
+  {
+    MatrixXd cov;
+    evaluate(cx, "plan", R.plan.layout, nullptr, nullptr, &cov);
+    std::vector<std::size_t> axes;
+    for (std::size_t a = 0; a < d.axes().size(); ++a)
+      if (joint_of(d, a).type == JointType::Prismatic && joint_of(d, a).max > joint_of(d, a).min)
+        axes.push_back(a);
+    for (std::size_t a = 0; a < d.axes().size() && axes.size() < 2; ++a)
+      if (std::find(axes.begin(), axes.end(), a) == axes.end()) axes.push_back(a);
+    SdMap& map = R.sd_map;
+    PointData g;
+    std::vector<double> middle;
+    for (std::size_t a = 0; a < d.axes().size(); ++a) {
+      const Joint& j = joint_of(d, a);
+      middle.push_back(j.max > j.min ? (j.min + j.max) / 2 : 0.0);
+    }
+    auto levels = [&](std::size_t a) {
+      const Joint& j = joint_of(d, a);
+      std::vector<double> v;
+      for (int i = 0; i < 21; ++i)
+        v.push_back(j.max > j.min ? j.min + (j.max - j.min) * i / 20.0 : 0.0);
+      return v;
+    };
+    map.x_axis = joint_of(d, axes[0]).coordinate;
+    map.x_unit = joint_of(d, axes[0]).unit;
+    map.x = levels(axes[0]);
+    if (axes.size() > 1) {
+      map.y_axis = joint_of(d, axes[1]).coordinate;
+      map.y_unit = joint_of(d, axes[1]).unit;
+      map.y = levels(axes[1]);
+    } else {
+      map.y = {0.0};
+    }
+    std::vector<std::vector<double>> poses;
+    for (double y : map.y)
+      for (double x : map.x) {
+        poses.push_back(middle);
+        poses.back()[axes[0]] = x;
+        if (axes.size() > 1) poses.back()[axes[1]] = y;
+      }
+    g = volumetric_rows(std::move(poses));
+    const MatrixXd G = design_matrix(*in.model, *in.param, g);
+    MatrixXd Gf(G.rows(), static_cast<Eigen::Index>(cols.size()));
+    for (std::size_t q = 0; q < cols.size(); ++q)
+      Gf.col(static_cast<Eigen::Index>(q)) = G.col(static_cast<Eigen::Index>(cols[q]));
+    const VectorXd var = (Gf * cov).cwiseProduct(Gf).rowwise().sum();
+    for (Eigen::Index p = 0; p + 2 < var.size(); p += 3)
+      map.sd_um.push_back(std::sqrt(std::max(0.0, (var[p] + var[p + 1] + var[p + 2]) / 3)));
+    map.middle = middle;
+  }
+  R.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return R;
+}
+
+}  // namespace weilgen
