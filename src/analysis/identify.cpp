@@ -38,6 +38,31 @@ int error_of_name(const Description& d, const std::string& name, const std::stri
   return k;
 }
 
+// The joint with the range its link takes over the corners of the independent axes' travel
+// (exact for a link linear in each axis, as Y23.2 = -Y23.1 or A12 = A04).
+Joint linked_range(const Description& d, const Joint& j, const std::vector<double>& params) {
+  Joint out = j;
+  const std::vector<int> axes = d.axes();
+  double lo = INFINITY, hi = -INFINITY;
+  const std::size_t n = axes.size();
+  for (std::size_t corner = 0; corner < (std::size_t{1} << std::min<std::size_t>(n, 16));
+       ++corner) {
+    std::map<std::string, double> values;
+    for (std::size_t p = 0; p < d.parameters.size(); ++p)
+      values[d.parameters[p].name] = p < params.size() ? params[p] : d.parameters[p].value;
+    for (std::size_t a = 0; a < n; ++a) {
+      const Joint& ja = d.bodies[static_cast<std::size_t>(axes[a])].joint;
+      values[ja.coordinate] = (corner >> a) & 1 ? ja.max : ja.min;
+    }
+    resolve_links(d, values);
+    lo = std::min(lo, values.at(j.coordinate));
+    hi = std::max(hi, values.at(j.coordinate));
+  }
+  out.min = lo;
+  out.max = hi;
+  return out;
+}
+
 }  // namespace
 
 PdgeBasisChoice parse_pdge_flags(const Description& desc, const std::vector<std::string>& flags,
@@ -95,13 +120,16 @@ ErrorParameterisation::ErrorParameterisation(const Description& desc, const Pdge
     if (choice.all) spec = *choice.all, where = {};
     for (const auto& [name, s] : choice.per_error)
       if (name == e.name) spec = s, where = {};
-    if (!(j.max > j.min)) {
+    // A linked joint without a range of its own takes its link's range over the travel.
+    Joint placed = j;
+    if (!(j.max > j.min) && j.link) placed = linked_range(desc, j, param_values_);
+    if (!(placed.max > placed.min)) {
       throw InputError(j.loc, "joint " + j.coordinate + ": " + e.name +
                                   " is position dependent but the joint has no travel range "
                                   "(range: [min, max]) to place its basis on");
     }
     try {
-      bases_[k] = basis_on_joint(parse_basis(spec), j);
+      bases_[k] = basis_on_joint(parse_basis(spec), placed);
     } catch (const std::invalid_argument& ex) {
       if (where.line > 0) throw InputError(where, ex.what());
       throw std::invalid_argument(e.name + ": " + ex.what());

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <map>
 #include <numeric>
+#include <set>
 #include <stdexcept>
 
 #include "weilgen/analysis/study_spec.hpp"
@@ -112,18 +113,14 @@ class PlanModel {
           one.references.push_back(std::move(ref));
         }
         remove_references(one, B);
-        // Compressed to its information: as many rows as its rank.
-        const Eigen::SelfAdjointEigenSolver<MatrixXd> es(B.transpose() * B);
-        const VectorXd& l = es.eigenvalues();
-        const double top = l.size() ? l.maxCoeff() : 0;
-        std::vector<Eigen::Index> keep;
-        for (Eigen::Index k = 0; k < l.size(); ++k)
-          if (l[k] > 1e-13 * top) keep.push_back(k);
-        MatrixXd C(static_cast<Eigen::Index>(keep.size()), width);
-        for (std::size_t t = 0; t < keep.size(); ++t)
-          C.row(static_cast<Eigen::Index>(t)) =
-              std::sqrt(l[keep[t]]) * es.eigenvectors().col(keep[t]).transpose();
-        B = std::move(C);
+        // Compressed to its information (Bᵀ B = Vᵀ S² V): the rows S Vᵀ, as many as its rank.
+        if (B.rows() > B.cols()) {
+          const Eigen::BDCSVD<MatrixXd> svd(B, Eigen::ComputeThinV);
+          const VectorXd& sv = svd.singularValues();
+          Eigen::Index k = 0;
+          while (k < sv.size() && sv[k] > 1e-15 * sv[0]) ++k;
+          B = sv.head(k).asDiagonal() * svd.matrixV().leftCols(k).transpose();
+        }
       }
       out[u] = std::move(B);
     }
@@ -154,7 +151,7 @@ struct Frame {
   }
 };
 
-Frame make_frame(const std::vector<MatrixXd>& blocks, double rank_tol) {
+Frame make_frame(const std::vector<MatrixXd>& blocks, double rank_tol, Eigen::Index max_rank) {
   Frame f;
   Eigen::Index rows = 0;
   const Eigen::Index width = blocks.front().cols();
@@ -176,7 +173,7 @@ Frame make_frame(const std::vector<MatrixXd>& blocks, double rank_tol) {
   const Eigen::BDCSVD<MatrixXd> svd(X, Eigen::ComputeThinV);
   const VectorXd& s = svd.singularValues();
   Eigen::Index r = 0;
-  while (r < s.size() && s[r] > rank_tol * s[0]) ++r;
+  while (r < s.size() && r < max_rank && s[r] > rank_tol * s[0]) ++r;
   f.Q = svd.matrixV().leftCols(r);
   f.Z.reserve(blocks.size());
   for (const MatrixXd& b : blocks) f.Z.push_back(b * f.scale.cwiseInverse().asDiagonal() * f.Q);
@@ -240,7 +237,8 @@ struct Context {
 // The figures of a layout as identify will estimate from it.
 LayoutFigures evaluate(Context& cx, const std::string& name, const std::vector<PlanUnit>& units,
                        const std::vector<MatrixXd>* frame_blocks,
-                       EquilibratedSvd* keep_svd = nullptr, MatrixXd* cov_out = nullptr) {
+                       EquilibratedSvd* keep_svd = nullptr, MatrixXd* cov_out = nullptr,
+                       bool in_frame = true) {
   LayoutFigures f;
   f.name = name;
   f.layout = units;
@@ -275,6 +273,9 @@ LayoutFigures evaluate(Context& cx, const std::string& name, const std::vector<P
     if (null_weight < 1e-12)
       f.parameter_sd[cx.cols[static_cast<std::size_t>(q)]] = std::sqrt(std::max(0.0, cov(q, q)));
   }
+  if (keep_svd) *keep_svd = svd;
+  if (cov_out) *cov_out = cov;
+  if (!in_frame) return f;
   // In the frame: the information of the layout's units.
   std::vector<MatrixXd> own;
   if (!frame_blocks) {
@@ -291,8 +292,6 @@ LayoutFigures evaluate(Context& cx, const std::string& name, const std::vector<P
   for (Eigen::Index i = 0; i < r; ++i)
     sv[i] = std::sqrt(std::max(0.0, es.eigenvalues()[r - 1 - i]));
   f.observability = observability_indices(sv, f.observations);
-  if (keep_svd) *keep_svd = svd;
-  if (cov_out) *cov_out = cov;
   return f;
 }
 
@@ -588,9 +587,20 @@ PlanResult Planner::run(const PlanInput& in) const {
       Gf.col(static_cast<Eigen::Index>(q)) = G.col(static_cast<Eigen::Index>(cols[q]));
     cx.Wg = Gf.transpose() * Gf / static_cast<double>(G.rows());
   }
-  // The frame from every candidate.
+  // Every candidate at once: what identify would determine from all of them.
+  std::vector<std::size_t> all(in.candidates.units.size());
+  std::iota(all.begin(), all.end(), 0);
+  {
+    EquilibratedSvd all_svd(MatrixXd::Zero(1, 1), 0.5, false);
+    const LayoutFigures every =
+        evaluate(cx, "every candidate", in.candidates.units, nullptr, &all_svd, nullptr, false);
+    R.candidate_rank = every.rank;
+    R.unidentifiable = null_combinations(all_svd, cols);
+  }
+  // The frame from every candidate: at most identify's rank and the set-up references'.
   const std::vector<MatrixXd> blocks = cx.model.blocks(in.candidates.units, true);
-  cx.frame = make_frame(blocks, o.rank_tolerance);
+  cx.frame = make_frame(blocks, o.rank_tolerance,
+                        static_cast<Eigen::Index>(R.candidate_rank + cx.model.nuisance()));
   {
     const Eigen::Index w = cx.frame.scale.size(), nf = static_cast<Eigen::Index>(cols.size());
     MatrixXd Wfull = MatrixXd::Zero(w, w);
@@ -600,16 +610,6 @@ PlanResult Planner::run(const PlanInput& in) const {
     // weight of φ = S θ is S⁻¹ Wg S⁻¹.
     const MatrixXd Ws = inv.asDiagonal() * Wfull * inv.asDiagonal();
     cx.frame.W = cx.frame.Q.transpose() * Ws * cx.frame.Q;
-  }
-  // Every candidate at once: what identify would determine from all of them.
-  std::vector<std::size_t> all(in.candidates.units.size());
-  std::iota(all.begin(), all.end(), 0);
-  EquilibratedSvd all_svd(MatrixXd::Zero(1, 1), 0.5, false);
-  {
-    const std::vector<MatrixXd> z = frame_blocks_of(cx, all);
-    const LayoutFigures every = evaluate(cx, "every candidate", in.candidates.units, &z, &all_svd);
-    R.candidate_rank = every.rank;
-    R.unidentifiable = null_combinations(all_svd, cols);
   }
   const Eigen::Index r = cx.frame.Q.cols();
   std::size_t widest = 1;
@@ -652,56 +652,74 @@ PlanResult Planner::run(const PlanInput& in) const {
   };
   if (o.target_sd_um > 0) {
     // The fewest units whose plan reaches the target: the candidates' own figure first (no
-    // plan of fewer can do better), then a bisection guided by sd ∝ 1/√n.
+    // plan of fewer can do better), then upward from the minimum and a bisection.
     const LayoutFigures every = evaluate_candidates(cx, "every candidate", all);
     if (every.prediction_sd_um > o.target_sd_um)
       throw std::invalid_argument("--target-sd " + format_significant(o.target_sd_um, 3) +
                                   " um: even all " + std::to_string(candidates) + " candidate " +
                                   what + " give " + format_significant(every.prediction_sd_um, 3) +
                                   " um (lower the noise, or give more candidates)");
-    std::size_t lo = std::max(R.minimum_units, std::size_t{1}), hi = candidates;
+    // From the size the sequential design reaches full rank at: below it the exchange rarely
+    // does, and a rank-deficient search is slow.
+    std::size_t lo = std::max({R.minimum_units, R.greedy_units, std::size_t{1}}), hi = candidates;
     std::map<std::size_t, LayoutFigures> seen;
+    std::set<std::size_t> planned;
+    std::size_t last_planned = 0;
     auto sd_at = [&](std::size_t n) {
       auto it = seen.find(n);
       if (it == seen.end()) {
         it = seen.emplace(n, plan_of(n)).first;
+        planned.insert(n);
+        last_planned = n;
         if (it->second.rank < R.candidate_rank) it->second.prediction_sd_um = INFINITY;
         R.target_search.emplace_back(n, it->second.prediction_sd_um);
       }
       return it->second.prediction_sd_um;
     };
     seen.emplace(hi, every);
-    if (sd_at(lo) <= o.target_sd_um) {
-      hi = lo;
-    } else {
-      const double s0 = seen.at(lo).prediction_sd_um;
-      if (std::isfinite(s0)) {
-        const auto guess = static_cast<std::size_t>(
-            std::ceil(static_cast<double>(lo) * (s0 / o.target_sd_um) * (s0 / o.target_sd_um)));
-        const std::size_t g = std::clamp(guess, lo + 1, hi);
-        if (sd_at(g) <= o.target_sd_um)
-          hi = g;
-        else
-          lo = g;
+    // Upward from the minimum, each step to where sd ∝ 1/√n puts the target (at least half as
+    // many again while the size misses the rank), then a bisection of the last step.
+    for (std::size_t at = lo;;) {
+      const double s = sd_at(at);
+      if (s <= o.target_sd_um) {
+        hi = at;
+        break;
       }
-      while (hi > lo + 1) {
-        const std::size_t mid = lo + (hi - lo) / 2;
-        if (sd_at(mid) <= o.target_sd_um)
-          hi = mid;
-        else
-          lo = mid;
-      }
+      lo = at;
+      const double next = std::isfinite(s)
+                              ? std::ceil(static_cast<double>(at) * (s / o.target_sd_um) *
+                                          (s / o.target_sd_um) * 1.05)
+                              : std::ceil(static_cast<double>(at) * 1.5);
+      at = std::min(candidates, std::max(at + 1, static_cast<std::size_t>(next)));
+      if (at == candidates) break;
     }
-    if (hi == candidates && seen.at(hi).units.size() == candidates && R.target_search.empty()) {
+    // Between the last miss and the first hit: where sd ∝ n^-α through both puts the target,
+    // every other step a plain bisection (so that the interval always halves in two steps).
+    for (bool model = true; hi > lo + 1; model = !model) {
+      std::size_t mid = lo + (hi - lo) / 2;
+      const double s_lo = seen.at(lo).prediction_sd_um, s_hi = seen.at(hi).prediction_sd_um;
+      if (model && std::isfinite(s_lo) && s_hi > 0) {
+        const double alpha =
+            std::log(s_lo / s_hi) / std::log(static_cast<double>(hi) / static_cast<double>(lo));
+        const double n = static_cast<double>(lo) * std::pow(s_lo / o.target_sd_um, 1 / alpha);
+        if (alpha > 0 && std::isfinite(n))
+          mid = std::clamp(static_cast<std::size_t>(std::ceil(n)), lo + 1, hi - 1);
+      }
+      if (sd_at(mid) <= o.target_sd_um)
+        hi = mid;
+      else
+        lo = mid;
+    }
+    // The exchange's record of the size chosen (the last one planned may be another).
+    if (hi == candidates && !planned.count(hi)) {
       R.plan = evaluate_candidates(cx, "plan", all);
+      R.exchange = ExchangeResult{};
+      R.exchange.selected = all;
     } else {
-      if (!seen.count(hi) || seen.at(hi).units.empty()) sd_at(hi);
+      if (last_planned != hi) plan_of(hi);
       R.plan = seen.at(hi);
-      if (R.plan.units.size() != hi) R.plan = plan_of(hi);
     }
     R.plan.name = "plan";
-    // The exchange result of the chosen size.
-    if (R.exchange.selected != R.plan.units) plan_of(hi);
   } else {
     check_size(o.units, "--poses");
     R.plan = plan_of(o.units);

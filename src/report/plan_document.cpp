@@ -288,7 +288,9 @@ std::string plan_text(const PlanRun& run, const std::vector<std::string>& files)
   }
   if (run.options.target_sd_um > 0) {
     os << "\n--target-sd " << fmt(run.options.target_sd_um) << " um: tried";
-    for (const auto& [n, sd] : r.target_search) os << " " << n << " (" << fmt(sd) << " um)";
+    for (const auto& [n, sd] : r.target_search)
+      os << " " << n << " (" << (std::isfinite(sd) ? fmt(sd) + " um" : std::string("rank short"))
+         << ")";
     os << "; the fewest reaching it: " << r.plan.layout.size() << "\n";
   }
   os << "\nplanned " << unit_word(r.instrument) << ":\n";

@@ -216,7 +216,7 @@ class State {
     lambda_min_ = min_eigen(M_);
     // Near the ridge, M⁻¹ holds 1/ε in the unseen directions and rank updates lose the digits
     // that matter: every move is then followed by a full refresh.
-    fragile_ = lambda_min_ < 1e6 * ridge_;
+    fragile_ = lambda_min_ < 100 * ridge_;
     const std::size_t n = p_.units.size();
     G_.resize(n);
     if (l_) H_.resize(n);
