@@ -29,9 +29,16 @@ int verb_plan(const Args& args) {
       "measurement templates identify reads once filled. docs/planning.md.\n\nOptions");
   std::string out, json_path, plot_path;
   opts.add_options()("help,h", "show this help")(
-      "instrument", po::value<std::string>(&rq.instrument)->default_value(rq.instrument),
+      "instrument", po::value<std::string>(&rq.instrument),
       "points (dx dy dz at a pose) | line6d (a 6D laser along an axis) | ballbar (circles) |\n"
-      "rtest (a sphere held at a nest while the rotary axes turn)")(
+      "rtest (a sphere held at a nest while the rotary axes turn); default points")(
+      "instruments", po::value<std::string>(&rq.instruments),
+      "several instruments with their noise (points:0.5um,ballbar:0.2um,line6d:1um): which\n"
+      "set-ups and units fit --time-budget")("time-budget", po::value<std::string>(&rq.time_budget),
+                                             "with --instruments: the time available (4h, 90 min)")(
+      "times", po::value<std::string>(&rq.times),
+      "with --instruments: a YAML of each instrument's set-up and per-unit time\n"
+      "(points: {setup: 60 min, pose: 1 min}; docs/planning.md has the defaults)")(
       "poses", ranged(&rq.poses, NumberRange::whole_numbers(1, 1e6)),
       "how many units to plan: poses (points, rtest), circles (ballbar), positions (line6d)")(
       "target-sd", po::value<std::string>(&rq.target_sd),
@@ -97,6 +104,7 @@ int verb_plan(const Args& args) {
   for (const std::string& c : rq.candidates)
     if (c.find('=') == std::string::npos) inputs.push_back({"--candidates", c});
   for (const std::string& f : rq.include) inputs.push_back({"--include", f});
+  if (!rq.times.empty()) inputs.push_back({"--times", rq.times});
   check_output_paths(inputs, {{"--out", out}, {"--json", json_path}, {"--plot", plot_path}});
   if (!plot_path.empty()) check_plot_target(plot_path);
 

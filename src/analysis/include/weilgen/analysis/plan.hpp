@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -36,6 +37,9 @@ enum class Instrument { Points, Line6d, Ballbar, RTest };
 Instrument parse_instrument(const std::string& text, const std::string& flag = "--instrument");
 const char* instrument_name(Instrument instrument);
 
+// The noise of each observation kind (identify.hpp kinds: dx … dc, dr, lin, str, ang), µm or µrad.
+using KindNoise = std::array<double, kObservationKinds>;
+
 // One set-up of an instrument: every unit of a set-up goes into one measurement file.
 struct PlanSetup {
   Instrument instrument = Instrument::Points;
@@ -46,6 +50,8 @@ struct PlanSetup {
   std::vector<double> nest_pose;  // rtest: the pose (axes order) at which the sphere is in the nest
   std::array<double, 3> nest_mm{};    // rtest: the nest in the workpiece frame (mm)
   std::vector<std::string> channels;  // line6d: the laser columns of the machine's errors
+  KindNoise noise{};                  // this set-up's noise per kind (0: PlanInput::noise)
+  double setup_s = 0, pose_s = 0;     // time budget: the set-up's time and each unit's
 };
 
 // One candidate unit: one step of an instrument.
@@ -66,13 +72,24 @@ struct PlanCandidates {
 // no solution within the travel (Newton on the exact chain at zero errors, to 1 nm).
 bool hold_nest(const Model& model, const PlanSetup& setup, std::vector<double>& pose);
 
+// The time an instrument takes (--times FILE, docs/planning.md "Several instruments"): each
+// set-up (points: the instrument; line6d: an axis; ballbar: a circle's pivot; rtest: a nest) and
+// each unit (a pose, a position, a circle run), in seconds.
+struct InstrumentTimes {
+  double setup_s = 0, pose_s = 0;
+};
+InstrumentTimes default_instrument_times(Instrument instrument);
+// The defaults with a YAML file's entries over them ("" = the defaults):
+//   points: {setup: 60 min, pose: 1 min}
+//   ballbar: {setup: 5 min, pose: 2 min}
+// InputError with file:line:column for bad entries.
+std::map<Instrument, InstrumentTimes> read_instrument_times(const std::string& path);
+
 // How many observation rows one unit of the instrument gives (ballbar: per circle point).
 std::size_t rows_per_unit(Instrument instrument, const PlanSetup& setup, std::size_t angles);
 
 // ---- Options ----------------------------------------------------------------------------------
 
-// The noise of each observation kind (identify.hpp kinds: dx … dc, dr, lin, str, ang), µm or µrad.
-using KindNoise = std::array<double, kObservationKinds>;
 // --noise: comma-separated or repeated items, each "Q" (a length sets every µm kind, an angle every
 // µrad kind) or "KIND=Q" (dx dy dz da db dc dr lin str ang); defaults 1 µm and 1 µrad. Units as
 // in docs/study-inputs.md (1um, 0.5 µm, 2urad, 1 arcsec). std::invalid_argument naming --noise.
@@ -92,6 +109,8 @@ struct PlanOptions {
   // --bound: iterations of the continuous design that bounds every design of the same size
   // (0: not computed).
   std::size_t bound_iterations = 0;
+  // --time-budget (s): choose set-ups and units within it instead of a size (0: not given).
+  double budget_s = 0;
   void validate() const;  // std::invalid_argument naming the flag
 };
 
@@ -112,6 +131,14 @@ struct LayoutFigures {
   double prediction_sd_um = 0;       // √(mean over the 5-level grid and dx dy dz of the variance)
   std::vector<double> parameter_sd;  // per parameter, declared units; NaN: not identifiable/fixed
   ObservabilityIndices observability;
+  double time_s = 0;  // time budget: the set-ups' and units' time
+};
+
+// Time budget: one set-up of the plan and its time.
+struct TimeUse {
+  std::size_t setup = 0;  // index into PlanCandidates::setups
+  std::size_t units = 0;
+  double setup_s = 0, units_s = 0;
 };
 
 // The plan's prediction SD over two axes (the others at the middle of their travel), µm:
@@ -138,6 +165,11 @@ struct PlanResult {
   // --target-sd: the sizes tried and their prediction_sd_um.
   std::vector<std::pair<std::size_t, double>> target_search;
   SdMap sd_map;
+  // Time budget (several instruments): the set-ups used and the time they take; `compare` holds
+  // each instrument alone within the same budget.
+  std::vector<Instrument> instruments;
+  std::vector<TimeUse> time_use;
+  double time_used_s = 0;
   // --bound: the best any design of the plan's size on these candidates can reach, in the frame
   // (uq/optimal_design.hpp, continuous_design): the criterion's bound, and the prediction SD's
   // (√ of the I bound: the prediction SD when the volumetric rows are estimable). NaN: not
@@ -151,7 +183,7 @@ struct PlanResult {
 // ---- The request (flags as written) -----------------------------------------------------------
 
 struct PlanRequest : MeasurementRequest {
-  std::string instrument = "points";     // --instrument
+  std::string instrument;                // --instrument ("" = points)
   std::vector<std::string> noise;        // --noise
   std::string criterion = "D";           // --criterion
   std::size_t poses = 0;                 // --poses
@@ -166,7 +198,10 @@ struct PlanRequest : MeasurementRequest {
   std::vector<std::string> planes;  // --plane (ballbar; repeatable; none: every plane)
   std::vector<std::string> nests;   // --nest (rtest)
   std::size_t restarts = 8, random_sets = 20;
-  std::size_t bound = 0;  // --bound: continuous-design iterations (0: no bound)
+  std::size_t bound = 0;    // --bound: continuous-design iterations (0: no bound)
+  std::string instruments;  // --instruments points:0.5um,ballbar:0.2um,line6d:1um
+  std::string time_budget;  // --time-budget 4h
+  std::string times;        // --times FILE.yaml
   std::uint64_t seed = 1;
   unsigned threads = 0;
   // The flags alone, before any file is read (std::invalid_argument naming the flag).
@@ -224,6 +259,7 @@ struct PlanInput {
   Instrument instrument = Instrument::Points;
   KindNoise noise{};
   std::size_t angles = 360;
+  std::vector<Instrument> instruments;  // several (a time budget), each set-up its own noise
 };
 
 class Planner {

@@ -47,4 +47,9 @@ Quantity parse_quantity_unit(const std::string& text, const std::string& default
 double parse_quantity(const std::string& text, const std::string& default_unit,
                       const std::string& what);
 
+// A duration in seconds: "4h", "30 min", "90 s", "1.5h" (an expression allowed); units s, min, h,
+// `default_unit` when none is written. Throws std::invalid_argument "<what>: <why>".
+double parse_duration_s(const std::string& text, const std::string& default_unit,
+                        const std::string& what);
+
 }  // namespace weilgen
