@@ -19,4 +19,13 @@ function(weilgen_add_layer name)
     PRIVATE ${CMAKE_CURRENT_SOURCE_DIR})
   target_link_libraries(weilgen_${name} PUBLIC ${ARG_DEPENDS} PRIVATE ${ARG_PRIVATE})
   target_compile_options(weilgen_${name} PRIVATE ${WEILGEN_WARNINGS})
+  weilgen_unity(weilgen_${name})
+endfunction()
+
+# weilgen_unity(<target>): compile the target's files in batches (WEILGEN_UNITY_BUILD).
+function(weilgen_unity target)
+  if(WEILGEN_UNITY_BUILD)
+    set_target_properties(${target} PROPERTIES UNITY_BUILD ON
+      UNITY_BUILD_BATCH_SIZE ${WEILGEN_UNITY_BATCH})
+  endif()
 endfunction()

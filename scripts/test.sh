@@ -9,8 +9,7 @@ bash scripts/install_deps.sh
 export BUILD_DIR=${BUILD_DIR:-build}
 # The build writes nothing into the source tree; the CTest generated_files_current compares the
 # committed generated/ with fresh generation.
-cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build "$BUILD_DIR" -j"$(nproc)"
+bash scripts/build.sh
 if [ -x scripts/build_example.sh ]; then
   bash scripts/build_example.sh "$BUILD_DIR"
 fi

@@ -26,6 +26,7 @@ std::shared_ptr<const Model> vmc() { return test::builtin_model("vmc_3axis"); }
 
 struct Row {
   double X, Y, Z, t_s, dir_X, cycle, T;
+  double dir_Y = 0;  // ballbar traces: the direction of travel of Y
 };
 
 // Effect added to (dx, dy, dz) in µm at a row.
@@ -406,7 +407,8 @@ namespace {
 // steps, ccw then cw, `cycles` cycles; dr = exact projection of the model's deviation with
 // random errors plus `extra` (µm, in dx dy dz), plus N(0, noise²).
 std::string ballbar_synth(std::uint32_t seed, const EffectFn& extra, int cycles = 4,
-                          double noise = 0.4, bool with_temperature = false) {
+                          double noise = 0.4, bool with_temperature = false,
+                          bool dir_column = true) {
   Truth truth_machine(seed);
   const BallbarMachine bm = ballbar_machine(vmc()->description());
   BallbarFlags f;
@@ -416,7 +418,8 @@ std::string ballbar_synth(std::uint32_t seed, const EffectFn& extra, int cycles 
   const BallbarCircle circle = parse_ballbar_circle(f, bm);
   std::ostringstream s;
   s << "# plane: XY\n# centre: X=250, Y=-200, Z=-150\n# radius: 100 mm\n"
-    << "t_s,dir,dir_X,cycle,angle_deg," << (with_temperature ? "T_spindle," : "") << "dr_um\n";
+    << "t_s,dir," << (dir_column ? "dir_X," : "") << "cycle,angle_deg,"
+    << (with_temperature ? "T_spindle," : "") << "dr_um\n";
   double t = 0;
   for (int cy = 1; cy <= cycles; ++cy)
     for (int feed : {1, -1})
@@ -427,14 +430,17 @@ std::string ballbar_synth(std::uint32_t seed, const EffectFn& extra, int cycles 
         // X moves toward +X on the way up when the feed's tangent has a positive x part.
         const double th = (a - feed * 1.0) * M_PI / 180;
         const double dir_x = -feed * std::sin(th) > 0 ? 1 : -1;
+        const double dir_y = feed * std::cos(th) > 0 ? 1 : -1;
         // A spindle warming by 3 K with a time constant of a quarter of the run.
         const double temp = 22 + 3 * (1 - std::exp(-t / (cycles * 180.0 * 0.25)));
-        const Row r{q[1], q[0], q[2], t, dir_x, static_cast<double>(cy), temp};
+        const Row r{q[1], q[0], q[2], t, dir_x, static_cast<double>(cy), temp, dir_y};
         const std::array<double, 6> dev = truth_machine.deviation(q.data());
         const std::array<double, 3> e = extra(r);
         double dr = noise * truth_machine.normal();
         for (std::size_t o = 0; o < 3; ++o) dr += u[o] * (dev[o] + e[o]);
-        s << t << "," << feed << "," << dir_x << "," << cy << "," << a << ",";
+        s << t << "," << feed << ",";
+        if (dir_column) s << dir_x << ",";
+        s << cy << "," << a << ",";
         if (with_temperature) s << temp << ",";
         s << dr << "\n";
         t += 0.5;
@@ -503,7 +509,11 @@ TEST_CASE("gap: ballbar traces are dr observations, and reversal on X is read fr
   CHECK(res.verdict == "reversal");
   const EffectFit* e = effect(res, "reversal");
   REQUIRE(e);
-  CHECK(std::abs(e->params.at("reversal_um")) == doctest::Approx(5.0).epsilon(0.1));
+  // X alone, or X and Y at once (the circle's both axes) with Y's at the noise.
+  const bool both = e->params.count("reversal_um_X") == 1;
+  CHECK(std::abs(e->params.at(both ? "reversal_um_X" : "reversal_um")) ==
+        doctest::Approx(5.0).epsilon(0.1));
+  if (both) CHECK(std::abs(e->params.at("reversal_um_Y")) < 0.5);
   CHECK(res.final_rms[kRadialOutput] < 1.2 * 0.4);
   // "where" along the trace's angle is in deg, the unit the measurement reader gives the
   // column (classify_column); the feed (ccw +1, cw -1) has none.
@@ -521,6 +531,44 @@ TEST_CASE("gap: ballbar traces are dr observations, and reversal on X is read fr
   }
   CHECK(angle >= 1);
   CHECK(feed >= 1);
+}
+
+TEST_CASE(
+    "gap: a trace without dir columns still has its axes' directions: 6 um X and 4 um Y backlash "
+    "are named") {
+  // The issue-29 case: a trace gives angle_deg and the feed only. The directions of X and Y come
+  // from the circle (ballbar_travel_direction), so `reversal` is a candidate. On vmc_3axis the
+  // table carries X and Y: an axis short by dir B/2 moves the tool by +dir B/2 along x or y.
+  const MeasurementTable t =
+      parse_measurements(ballbar_synth(
+                             24,
+                             [](const Row& w) {
+                               return std::array<double, 3>{3.0 * w.dir_X, 2.0 * w.dir_Y, 0};
+                             },
+                             4, 0.4, false, false),
+                         "bb.csv");
+  CHECK_FALSE(t.has("dir_X"));
+  const GapData d = gap_data(t, vmc()->description());
+  CHECK(d.derived_dir == std::vector<std::string>{"X", "Y"});
+  REQUIRE(d.dir.count("X") == 1);
+  // The derived directions equal the synthesiser's.
+  const std::vector<double> with_column =
+      parse_measurements(ballbar_synth(24, none, 4, 0.4, false, true), "b.csv").column("dir_X");
+  CHECK(d.dir.at("X") == with_column);
+  PdgeBasisChoice c;
+  c.all = "poly:2";
+  const ErrorParameterisation p(vmc()->description(), c, vmc()->parameters());
+  const GapResult res = GapDiagnosis().run(*vmc(), p, d, *parse_holdout("cycle:4"), "test");
+  CHECK(res.verdict == "reversal");
+  // Both axes reverse on a circle: the variant of both at once, one size each.
+  REQUIRE_FALSE(res.explanation.empty());
+  const EffectFit& e = res.explanation.front();
+  CHECK(e.name == "reversal");
+  REQUIRE(e.params.count("reversal_um_X") == 1);
+  REQUIRE(e.params.count("reversal_um_Y") == 1);
+  CHECK(std::abs(e.params.at("reversal_um_X")) == doctest::Approx(6.0).epsilon(0.1));
+  CHECK(std::abs(e.params.at("reversal_um_Y")) == doctest::Approx(4.0).epsilon(0.1));
+  CHECK(res.final_rms[kRadialOutput] < 1.2 * 0.4);
 }
 
 TEST_CASE("gap: on a ballbar trace the lack of fit sees a step in y in time (a centre shift)") {

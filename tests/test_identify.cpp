@@ -10,6 +10,7 @@
 #include <random>
 #include <sstream>
 
+#include "golden/numeric_text.hpp"
 #include "test_support.hpp"
 #include "vmc_3axis_params.hpp"
 #include "weilgen/analysis/identify.hpp"
@@ -410,8 +411,12 @@ TEST_CASE("identify: the committed params header is current and evaluates the id
   const std::string committed =
       test::read_text(std::string(WEILGEN_SOURCE_DIR) + "/generated/vmc_3axis_params.hpp");
   const std::string text = params_header(m, p, r.theta, identify_provenance(r));
-  CHECK_MESSAGE(text == committed,
-                "generated/vmc_3axis_params.hpp is stale: run scripts/regenerate_params.sh");
+  // Numbers within rounding (tests/golden/numeric_text.hpp), the text exactly.
+  const std::string stale = golden::numeric_text_mismatch(committed, text, golden::kParamsRelTol);
+  CHECK_MESSAGE(stale.empty(),
+                "generated/vmc_3axis_params.hpp is stale (run "
+                "scripts/regenerate_params.sh): "
+                    << stale);
   namespace hp = weilgen_models::vmc_3axis_params;
   static_assert(hp::kNumErrors == 21 && hp::kNumAxes == 3);
   std::mt19937 rng(19);
@@ -446,8 +451,9 @@ TEST_CASE("identify CLI: points, a ballbar prediction of the same machine, JSON 
   CHECK(bb["kind"] == "ballbar");
   CHECK(bb["compared"][0]["rms_difference_um"].get<double>() < 0.3);
   CHECK(bb["compared"][0]["centred_correlation"].get<double>() > 0.95);
-  CHECK(test::read_text(std::string(WEILGEN_SOURCE_DIR) + "/generated/vmc_3axis_params.hpp") ==
-        test::read_text(hpp));
+  CHECK(golden::numeric_text_mismatch(
+            test::read_text(std::string(WEILGEN_SOURCE_DIR) + "/generated/vmc_3axis_params.hpp"),
+            test::read_text(hpp), golden::kParamsRelTol) == "");
 
   // Bad input: named file and line, non-zero exit, no output written.
   const std::string bad = (dir / "bad.csv").string();

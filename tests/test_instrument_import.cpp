@@ -148,10 +148,11 @@ TEST_CASE("import: the hand-computed example gives the same figures from tidy, C
   check_same_figures(wide, tidy);
   CHECK(carto.classical.figures.A == doctest::Approx(14));  // docs/iso230-2.md
   CHECK(wide.classical.figures.R == doctest::Approx(14));
-  // The CARTO file's expansion coefficient normalises (material at 20.0 degC: no change); its
-  // air values are reported, the instrument compensated them.
-  CHECK(carto.normalisation.material_applied);
-  CHECK(carto.normalisation.material_correction_um.max == 0);
+  // The CARTO file gives a coefficient but not whether its software applied it: not normalised
+  // again (docs/iso230-2.md, "Instrument compensation state"); its air values are reported, the
+  // instrument compensated them.
+  CHECK_FALSE(carto.normalisation.material_applied);
+  CHECK(carto.normalisation.material_compensation == "unstated");
   CHECK(carto.normalisation.air == AirCompensation::Instrument);
   CHECK(carto.normalisation.air_temperature_C.max == doctest::Approx(20.3));
   // The wide file's per-cycle times give the drift rate per hour.
@@ -211,7 +212,10 @@ TEST_CASE("import: every bad CARTO input names its file, line and column") {
         "Reverse/Backward/Bwd/-1/Down)");
   CHECK(error_of(head + ",Forward,1\n") ==
         "f.csv:3:1: column 'Target Position (mm)': empty: every row needs its target");
-  CHECK(error_of(head + "0,Forward,1,2\n") == "f.csv:3: 4 fields, the header (line 2) has 3");
+  CHECK(error_of(head + "0,Forward,1,2\n") ==
+        "f.csv:3:13: 4 fields, the header (line 2) has 3 (decimal commas in a comma-separated "
+        "file split every number: export with ';' or a tab between the fields, or with a "
+        "decimal point)");
   CHECK(parse_instrument_text(head + "0,Forward,1,\n", "f.csv").table.rows() == 1);  // trailing ,
   CHECK(error_of(head) == "f.csv:2: no data rows after the header");
   CHECK(error_of("Axis,X\nTarget Position (mm),Direction,Run 1 (psi)\n0,Forward,1\n")
@@ -330,4 +334,114 @@ TEST_CASE("import CLI: prints the tidy CSV, writes --out atomically, refuses bad
   CHECK(run(cli("import " + carto + " --out " + carto)).status == 2);
   CHECK(run(cli("import " + carto + " --axis Y")).status == 2);
   CHECK(run(cli("import")).status == 2);
+}
+
+TEST_CASE("import slips: a leading 'Target No.' column, a title line, runs without a unit") {
+  // A CARTO export numbering its targets first: found, the number checked and not carried.
+  const std::string numbered =
+      "Renishaw XL-80 linear measurement\nAxis,X\n"
+      "Target No.,Target Position (mm),Direction,Run 1 (um),Run 2 (um)\n"
+      "1,0,Forward,1,2\n2,100,Forward,3,4\n2,100,Reverse,5,6\n1,0,Reverse,7,8\n";
+  CHECK(detect_instrument_format(numbered) == InstrumentFormat::Carto);
+  const ImportResult r = parse_instrument_text(numbered, "n.csv");
+  CHECK(r.table.columns == std::vector<std::string>{"X", "dir", "cycle", "dx_um"});
+  CHECK(r.table.rows() == 8);
+  CHECK(r.table.column("dx_um")[7] == 8);
+  CHECK(r.mapping[0] == "'Target No.' -> (the target's number: checked, not carried)");
+  CHECK(error_of("Axis,X\nTarget No.,Target Position (mm),Direction,Run 1 (um)\n"
+                 "one,0,Forward,1\n") ==
+        "f.csv:3:1: column 'Target No.': 'one' is not a whole number");
+  CHECK(
+      error_of("Axis,X\nTarget Position (mm),Target (mm),Direction,Run 1 (um)\n0,0,Forward,1\n") ==
+      "f.csv:2:22: two target columns: give one");
+  // An export whose table is not recognised: the tidy reader's complaint about the title line
+  // carries the hint instead of misleading alone.
+  const std::string hidden =
+      "Renishaw XL-80 linear measurement\nAxis,X\nPosition,Direction,Run 1 (um)\n0,Forward,1\n";
+  const std::string e = error_of(hidden);
+  CHECK(e.rfind("f.csv:1: unknown column 'Renishaw XL-80 linear measurement'", 0) == 0);
+  CHECK(e.find("an instrument export whose table was not found? Its header row needs a target "
+               "column such as 'Target Position (mm)'") != std::string::npos);
+  // Runs without a unit are refused where the header says nothing, read in the 'Units' line's
+  // unit otherwise.
+  CHECK(error_of("Axis,X\nTarget Position (mm),Direction,Run 1\n0,Forward,1\n") ==
+        "f.csv:2:32: column 'Run 1': no unit: the deviations could be in um, mm or nm; write it "
+        "in the header ('Run 1 (um)') or give a 'Units,um' line before the table");
+  const ImportResult mm = parse_instrument_text(
+      "Axis,X\nUnits,mm\nTarget Position (mm),Direction,Run 1\n0,Forward,0.0012\n", "f.csv");
+  CHECK(mm.table.column("dx_um")[0] == doctest::Approx(1.2).epsilon(1e-12));
+  CHECK(mm.mapping[2] == "'Run 1' -> dx_um of cycle 1 (um, x 1000)");
+}
+
+TEST_CASE("import slips: a wide file's tidy output reads back, a degF sensor is named") {
+  // The tidy file an import writes keeps no '# format: wide' key: iso230-2 reads it as tidy.
+  const ImportResult w = parse_instrument_text(kWideSmall, "w.csv");
+  CHECK(w.table.header_keys.count("format") == 0);
+  const auto dir = test::fresh_dir("import_wide_cli");
+  const std::string wide = (dir / "wide.csv").string(), out = (dir / "tidy.csv").string();
+  write_file_atomically(wide, kWideSmall);
+  REQUIRE(run(cli("import " + wide + " --out " + out)).status == 0);
+  CHECK(test::read_text(out).find("# format") == std::string::npos);
+  const test::Run iso = run(cli("iso230-2 " + out));
+  CHECK(iso.status == 0);
+  CHECK(iso.out.find("bidirectional accuracy                     14.000") != std::string::npos);
+
+  // Three material sensors, the third labelled degF but recording degC (23 read as -5 degC):
+  // the reading is named with its header cell, in the study and on the CLI's stderr.
+  const std::string degf =
+      "Axis,X\nMaterial Compensation,Off\nMaterial Expansion Coefficient (ppm/K),11.7\n"
+      "Target Position (mm),Direction,Run 1 (um),Run 2 (um),Material Temperature 1 (degC),"
+      "Material Temperature 2 (degC),Material Temperature 3 (degF)\n"
+      "0,Forward,1,2,23.0,23.1,23\n100,Forward,3,4,23.0,23.1,23\n"
+      "100,Reverse,5,6,23.0,23.1,23\n0,Reverse,7,8,23.0,23.1,23\n";
+  const Iso230_2StudyResult s = study(parse_instrument_text(degf, "f.csv").table);
+  REQUIRE(s.normalisation.warnings.size() == 1);
+  CHECK(s.normalisation.warnings[0] ==
+        "f.csv:4:114: material sensor 'T_material_3' reads -5.0 degC on average beside 23.0 degC, "
+        "the median of the material sensors: check its unit (degF read as degC?); it pulls the "
+        "mean used for the correction");
+  const std::string degf_file = (dir / "degf.csv").string(), js = (dir / "degf.json").string();
+  write_file_atomically(degf_file, degf);
+  const test::Run r = run(cli("iso230-2 " + degf_file + " --json " + js));
+  CHECK(r.status == 0);
+  CHECK(r.out.find("degf.csv:4:114: material sensor 'T_material_3' reads -5.0 degC") !=
+        std::string::npos);
+  CHECK(json::parse(test::read_text(js))["normalisation"]["warnings"].size() == 1);
+  // Two sensors that disagree are both named; one tidy sensor far from 20 degC is flagged too.
+  const Iso230_2StudyResult two = study(parse_measurements(
+      "# axis: X\nX,dir,cycle,dx_um,T_material_1,T_material_2\n0,1,1,1,20,30\n0,1,2,1,20,30\n"
+      "0,-1,1,1,20,30\n0,-1,2,1,20,30\n",
+      "t.csv"));
+  REQUIRE(two.normalisation.warnings.size() == 1);
+  CHECK(two.normalisation.warnings[0].rfind(
+            "t.csv:2:32: material sensors 'T_material_1' and 'T_material_2' differ by 10.0 K", 0) ==
+        0);
+  const Iso230_2StudyResult hot = study(parse_measurements(
+      "# axis: X\nX,dir,cycle,dx_um,T_material\n0,1,1,1,73\n0,1,2,1,73\n0,-1,1,1,73\n"
+      "0,-1,2,1,73\n",
+      "h.csv"));
+  REQUIRE(hot.normalisation.warnings.size() == 1);
+  CHECK(hot.normalisation.warnings[0] ==
+        "h.csv:2:19: the material temperature reads 73.0 degC on average, far from a test's 20 "
+        "degC: check the unit");
+}
+
+TEST_CASE("import: LaserXL-style 'Key: Value' lines and the compensation states") {
+  const std::string text =
+      "Laser measurement: linear, X axis (a title with a colon)\nAxis: X\n"
+      "Material Compensation: On\nEnvironmental Compensation: Automatic\n"
+      "Expansion Coefficient (ppm/K): 11.5\n"
+      "Target Position (mm),Direction,Run 1 (um),Run 2 (um)\n"
+      "0,Forward,1,2\n100,Forward,3,4\n100,Reverse,5,6\n0,Reverse,7,8\n";
+  const ImportResult r = parse_instrument_text(text, "xl.csv");
+  CHECK(r.table.header_keys.at("axis") == "X");
+  CHECK(r.table.header_keys.at("material_compensation") == "instrument");
+  CHECK(r.table.header_keys.at("air_compensation") == "instrument");
+  CHECK(r.table.header_keys.at("expansion_ppm_per_K") == "11.5");
+  CHECK(r.table.header_key_lines.at("material_compensation") == 3);
+  CHECK(r.table.header_keys.count("laser_measurement") == 0);  // the title is no key
+  CHECK(error_of("Axis,X\nMaterial Compensation,sometimes\n"
+                 "Target Position (mm),Direction,Run 1 (um)\n0,Forward,1\n") ==
+        "f.csv:2:23: 'Material Compensation': 'sometimes' (expected on/applied/automatic/manual "
+        "or off/none)");
 }

@@ -16,6 +16,7 @@
 #include "weilgen/measure/iso230_2_study.hpp"
 #include "weilgen/report/iso230_2_document.hpp"
 #include "weilgen/report/iso230_2_html.hpp"
+#include "weilgen/report/plot.hpp"
 #include "weilgen/report/svg_chart.hpp"
 
 using namespace weilgen;
@@ -135,7 +136,17 @@ TEST_CASE("html report: sections, charts, numbers equal to the JSON, nothing ext
   CHECK(count(html,
               "tolerance \xC2\xB1"
               "12 \xC2\xB5m") == 2);
-  CHECK(html.find("data-key=\"tolerance_pass\" data-value=\"true\"") != std::string::npos);
+  // The air is not compensated (the file does not say): the verdict is not proven, the title and
+  // a banner say the run is not to ISO 230-2, with every condition it misses.
+  CHECK(html.find("data-key=\"tolerance_pass\" data-value=\"false\"") != std::string::npos);
+  CHECK(html.find("<span class=\"open\">NOT PROVEN</span>") != std::string::npos);
+  CHECK(html.find("evaluated after ISO 230-2:2014, not to ISO 230-2</h1>") != std::string::npos);
+  for (const char* check : {"targets", "cycles", "air", "temperature"})
+    CHECK(html.find("<li data-check=\"" + std::string(check) + "\">") != std::string::npos);
+  // Identification rows a signed report needs are there, blank to fill in.
+  for (const char* key : {"serial", "location", "date", "operator"})
+    CHECK(html.find("<td data-key=\"" + std::string(key) + "\" class=\"fill\"></td>") !=
+          std::string::npos);
   CHECK(html.find("Not normalised to 20 \xC2\xB0"
                   "C") != std::string::npos);
   CHECK(html.find("Air refraction: the file does not say") != std::string::npos);
@@ -150,12 +161,21 @@ TEST_CASE("iso230-2 --report: writes the HTML with the JSON, bad targets are ref
                         " --tolerance 12,A=13"));
   CHECK(r.status == 0);
   CHECK(r.out.find("wrote " + html) != std::string::npos);
+  // The file does not say whether the air was compensated: A's 14 > 13 proves nothing.
+  CHECK(r.out.find("verdict: NOT PROVEN (the refractive index of the air is not compensated") !=
+        std::string::npos);
+  json j = json::parse(test::read_text(js));
+  CHECK(j["tolerance"]["verdict"] == "not proven");
+  CHECK(j["normalisation"]["air"]["compensation"] == "unstated");
+  r = run(cli("iso230-2 " + small_csv() + " --report " + html + " --json " + js +
+              " --tolerance 12,A=13 --air-compensation instrument"));
+  CHECK(r.status == 0);
   CHECK(r.out.find("verdict: FAIL (A out of tolerance)") != std::string::npos);
   const std::string text = test::read_text(html);
   CHECK(text.find("fail\">FAIL") != std::string::npos);
-  const json j = json::parse(test::read_text(js));
+  j = json::parse(test::read_text(js));
   CHECK(j["tolerance"]["pass"] == false);
-  CHECK(j["normalisation"]["air"]["compensation"] == "unstated");
+  CHECK(j["tolerance"]["verdict"] == "does not conform");
   // Refused before the work, nothing written: a report that is not .html, the data file itself,
   // a bad tolerance, a bad air mode.
   write_file_atomically(html, "keep\n");
@@ -177,8 +197,9 @@ TEST_CASE("iso230-2 --report: writes the HTML with the JSON, bad targets are ref
   CHECK(r.status == 3);  // the small example has no T_table column
   r = run(cli("iso230-2 " + small_csv() + " --expansion 11.5 --material-temperature 20"));
   CHECK(r.status == 0);
-  CHECK(r.out.find("Normalised to 20 degC (ISO 1): expansion coefficient 11.5 um/(m K), material "
-                   "temperature 20.00 degC [--material-temperature]") != std::string::npos);
+  CHECK(r.out.find("Normalised to 20 degC by weilgen (ISO 1; --normalise auto): corrected with "
+                   "alpha 11.5 um/(m K) (--expansion); material temperature 20.00 degC "
+                   "[--material-temperature]") != std::string::npos);
 }
 
 TEST_CASE("iso230-2 --csv and --plot: the per-target table equals the JSON, refusals come first") {
@@ -247,4 +268,136 @@ TEST_CASE("iso230-2 --csv and --plot: the per-target table equals the JSON, refu
   CHECK(x.status != 0);
   CHECK(x.out.find("gnuplot not found") != std::string::npos);
   CHECK_FALSE(std::filesystem::exists(keep));
+}
+
+TEST_CASE("report details: --iso-only, --expansion 0, no -0.000, bands and tolerance lines") {
+  // --iso-only: no Student-t set and no drift elimination, in the study, the text and the JSON.
+  Iso230_2StudyOptions o;
+  o.iso_only = true;
+  const MeasurementTable t = read_measurements(small_csv());
+  const Iso230_2StudyResult r = Iso230_2Study(o).run(t);
+  CHECK_FALSE(r.classical.student.has_value());
+  CHECK_FALSE(r.drift.has_value());
+  const std::string text = iso230_2_text("small.csv", r);
+  CHECK(text.find("Student-t  ") == std::string::npos);  // no column of the figures
+  CHECK(text.find("drift-elim.") == std::string::npos);
+  CHECK(text.find("Drift elimination and the Student-t set: off (--iso-only).") !=
+        std::string::npos);
+  const json j = iso230_2_json("small.csv", r);
+  CHECK(j["student"].is_null());
+  CHECK(j["drift_eliminated"].is_null());
+  CHECK(j["iso_only"] == true);
+  const std::string html = iso230_2_html("small.csv", r);
+  CHECK(html.find("chart-drift") == std::string::npos);
+  CHECK(html.find("Student-t") == std::string::npos);
+  const auto dir = test::fresh_dir("iso_details_cli");
+  CHECK(run(cli("iso230-2 " + small_csv() + " --iso-only --comp-table " + (dir / "c.tbl").string() +
+                " --comp-source drift"))
+            .status == 2);
+  CHECK(run(cli("iso230-2 " + small_csv() + " --iso-only --reference-cycle 2")).status == 2);
+
+  // --expansion 0 corrects nothing and does not say "normalised".
+  const std::string carto = std::string(WEILGEN_SOURCE_DIR) + "/examples/data/carto_x.csv";
+  test::Run zero = run(cli("iso230-2 " + carto + " --expansion 0"));
+  REQUIRE(zero.status == 0);
+  CHECK(zero.out.find("Not normalised to 20 degC (--normalise auto): expansion coefficient 0 "
+                      "(--expansion): no expansion correction") != std::string::npos);
+  CHECK(zero.out.find("Normalised to") == std::string::npos);
+
+  // A value that rounds to zero is printed without a sign, in every table.
+  CHECK(format_fixed(-0.0004, 3) == "0.000");
+  CHECK(format_fixed(-0.0005001, 3) == "-0.001");
+  CHECK(format_fixed(-0.0, 2) == "0.00");
+  const std::string drift = std::string(WEILGEN_SOURCE_DIR) + "/examples/data/iso230_2_drift.csv";
+  test::Run d = run(cli("iso230-2 " + drift));
+  REQUIRE(d.status == 0);
+  CHECK(d.out.find("-0.000") == std::string::npos);
+  CHECK(zero.out.find("-0.000") == std::string::npos);
+
+  // The gnuplot charts: x-bar +- 2s as shaded bands in their line's colour, the tolerance lines.
+  Iso230_2StudyOptions tol;
+  tol.tolerance = parse_iso_tolerance("12");
+  const Iso230_2StudyResult rt = Iso230_2Study(tol).run(t);
+  const std::string script =
+      plot_script(dir.string(), (dir / "p.png").string(), "png", iso230_2_panels(rt), "t");
+  CHECK(count(script,
+              "with filledcurves fs transparent solid 0.18 noborder lt 1 title "
+              "'mean up +-2s'") == 1);
+  CHECK(count(script,
+              "with filledcurves fs transparent solid 0.18 noborder lt 2 title "
+              "'mean down +-2s'") == 1);
+  CHECK(count(script, "12 with lines dt 2 lw 1.5 lc rgb '#000000' title 'tolerance +-12 um'") == 2);
+  CHECK(count(script, "-12 with lines dt 2 lw 1.5 lc rgb '#000000' notitle") == 2);
+  CHECK(script.find("mean up +2s") == std::string::npos);  // no longer drawn as lines
+}
+
+TEST_CASE("conformance: ISO 230-2's test conditions, each named, and the report's title") {
+  auto runs = [](std::size_t targets, double travel_mm, std::size_t cycles) {
+    IsoRuns r;
+    for (std::size_t i = 0; i < targets; ++i)
+      r.positions_mm.push_back(travel_mm * static_cast<double>(i) / (targets - 1));
+    for (int d : {kUp, kDown})
+      for (std::size_t j = 1; j <= cycles; ++j) r.cycles[d].push_back(static_cast<long>(j));
+    return r;
+  };
+  IsoColumns linear;
+  linear.unit = "um";
+  NormalisationResult ok;
+  ok.air = AirCompensation::Instrument;
+  ok.material_temperature_C.add(20.5);
+  auto checks = [](const std::vector<ConformanceIssue>& issues) {
+    std::vector<std::string> out;
+    for (const auto& i : issues) out.push_back(i.check);
+    return out;
+  };
+  CHECK(iso230_2_conformance(runs(5, 1000, 5), linear, ok).empty());
+  CHECK(checks(iso230_2_conformance(runs(4, 400, 5), linear, ok)) ==
+        std::vector<std::string>{"targets"});
+  // 5 per metre: 1500 mm needs 8; beyond 2000 mm one per 250 mm: 3000 mm needs 12.
+  CHECK(iso230_2_conformance(runs(7, 1500, 5), linear, ok)[0].message ==
+        "7 targets over 1500 mm; ISO 230-2 asks for 8 (at least 5, and 5 per metre of travel)");
+  CHECK(iso230_2_conformance(runs(8, 1500, 5), linear, ok).empty());
+  CHECK(iso230_2_conformance(runs(11, 3000, 5), linear, ok)[0].message ==
+        "11 targets over 3000 mm; ISO 230-2 asks for 12 (one per 250 mm of travel beyond 2000 "
+        "mm)");
+  // Three cycles are named; more than five are fine.
+  CHECK(iso230_2_conformance(runs(5, 1000, 3), linear, ok)[0].message ==
+        "3 cycles forward and 3 reverse; ISO 230-2 asks for 5 in each direction");
+  CHECK(iso230_2_conformance(runs(5, 1000, 8), linear, ok).empty());
+  // The air not compensated, and nothing known of the temperature.
+  NormalisationResult raw;
+  CHECK(checks(iso230_2_conformance(runs(5, 1000, 5), linear, raw)) ==
+        std::vector<std::string>{"air", "temperature"});
+  raw.air = AirCompensation::None;
+  CHECK(iso230_2_conformance(runs(5, 1000, 5), linear, raw)[0].message ==
+        "the refractive index of the air is not compensated (stated as not compensated): the "
+        "readings may be off by about 271 um per metre of travel");
+  raw.material_compensation = "instrument";  // the instrument normalised: nothing to state
+  raw.air_applied = true;
+  CHECK(iso230_2_conformance(runs(5, 1000, 5), linear, raw).empty());
+
+  // Two targets x two cycles: the text, JSON and report say so; the shipped CARTO run conforms.
+  const auto dir = test::fresh_dir("iso_conformance_cli");
+  const std::string tiny = (dir / "tiny.csv").string(), js = (dir / "t.json").string(),
+                    html = (dir / "t.html").string();
+  write_file_atomically(tiny,
+                        "# axis: X\n# air_compensation: instrument\n# material_temperature_C: 20\n"
+                        "X,dir,cycle,dx_um\n0,1,1,1\n100,1,1,2\n100,-1,1,3\n0,-1,1,1\n"
+                        "0,1,2,1\n100,1,2,2\n100,-1,2,3\n0,-1,2,1\n");
+  test::Run r = run(cli("iso230-2 " + tiny + " --json " + js + " --report " + html));
+  REQUIRE(r.status == 0);
+  CHECK(r.out.find("Conformance: NOT to ISO 230-2\n") != std::string::npos);
+  CHECK(r.out.find("- targets: 2 targets over 100 mm; ISO 230-2 asks for 5") != std::string::npos);
+  CHECK(r.out.find("- cycles: 2 cycles forward and 2 reverse") != std::string::npos);
+  json j = json::parse(test::read_text(js));
+  CHECK(j["conformance"]["iso230_2"] == false);
+  CHECK(j["conformance"]["issues"].size() == 2);
+  CHECK(test::read_text(html).find("not to ISO 230-2</h1>") != std::string::npos);
+  const std::string carto = std::string(WEILGEN_SOURCE_DIR) + "/examples/data/carto_x.csv";
+  r = run(cli("iso230-2 " + carto + " --json " + js + " --report " + html));
+  REQUIRE(r.status == 0);
+  CHECK(json::parse(test::read_text(js))["conformance"]["iso230_2"] == true);
+  CHECK(test::read_text(html).find("Positioning accuracy and repeatability \xE2\x80\x93 ISO "
+                                   "230-2:2014</h1>") != std::string::npos);
+  CHECK(test::read_text(html).find("id=\"conformance\"") == std::string::npos);
 }

@@ -11,8 +11,10 @@
 // the material temperature of run j T_j = 21.4 + 0.05 (j − 1) °C (so the uncorrected scale shows
 // 11.7 µm/(m K) × 1.5 K ≈ 17.6 µm/m of expansion). Each row records the mean material temperature
 // of its runs from two sensors (±0.02 K) and the air (the instrument compensated it: "Air
-// Compensation,Automatic"). Normal deviates: Box-Muller on std::mt19937_64 (seed 2302), so the
-// file is the same with any standard library.
+// Compensation,Automatic"); the material it did not ("Material Compensation,Off": the readings
+// carry the expansion, which `iso230-2` removes once with the coefficient of the header). Normal
+// deviates: Box-Muller on std::mt19937_64 (seed 2302), so the file is the same with any standard
+// library.
 #include <cmath>
 #include <cstdio>
 
@@ -39,6 +41,7 @@ int main(int argc, char** argv) {
                "Instrument,XL-80 laser with XC-80 compensator\n"
                "Material Expansion Coefficient (ppm/\xC2\xB0"
                "C),11.7\n"
+               "Material Compensation,Off\n"
                "Air Compensation,Automatic\n"
                "\n"
                "Target Position (mm),Direction");

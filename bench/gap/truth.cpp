@@ -109,7 +109,7 @@ Eigen::MatrixXd position_jacobian(const NumericChain& chain, const std::vector<d
     e[i] = -h;
     const Eigen::Vector3d minus = chain.tool_in_workpiece(axes, e).block<3, 1>(0, 3);
     e[i] = 0;
-    J.col(static_cast<Eigen::Index>(i)) = (plus - minus) / (2 * h);
+    J.block<3, 1>(0, static_cast<Eigen::Index>(i)) = (plus - minus) / (2 * h);
   }
   return J;
 }

@@ -5,6 +5,7 @@
 
 #include "weilgen/analysis/study_spec.hpp"
 #include "weilgen/base/atomic_file.hpp"
+#include "weilgen/base/constants.hpp"
 #include "weilgen/base/format.hpp"
 #include "weilgen/base/output_paths.hpp"
 #include "weilgen/base/text.hpp"
@@ -12,9 +13,7 @@
 
 namespace weilgen {
 
-namespace {
-constexpr double kPi = 3.14159265358979323846;
-}  // namespace
+namespace {}  // namespace
 
 void AxisCompTableOptions::validate() const {
   if (axis.empty())

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "weilgen/analysis/study_spec.hpp"
+#include "weilgen/base/constants.hpp"
 #include "weilgen/base/format.hpp"
 #include "weilgen/base/text.hpp"
 #include "weilgen/base/units.hpp"
@@ -27,8 +28,6 @@ const char* observation_unit(std::size_t output) {
 }
 
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 int error_of_name(const Description& d, const std::string& name, const std::string& what) {
   const int k = d.error_index(name);

@@ -7,15 +7,11 @@
 #include "weilgen/analysis/ballbar_model.hpp"
 #include "weilgen/analysis/identify.hpp"
 #include "weilgen/analysis/prediction.hpp"
+#include "weilgen/base/constants.hpp"
 #include "weilgen/base/text.hpp"
 #include "weilgen/measure/line6d.hpp"
 
 namespace weilgen {
-
-namespace {
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kPi = 3.14159265358979323846;
-}  // namespace
 
 void PointData::append(PointData other) {
   const std::size_t row_base = poses.size(), obs_base = observations.size();

@@ -13,6 +13,7 @@
 
 #include "plan_internal.hpp"
 #include "weilgen/analysis/study_spec.hpp"
+#include "weilgen/base/constants.hpp"
 #include "weilgen/base/format.hpp"
 #include "weilgen/base/memory.hpp"
 #include "weilgen/base/parallel.hpp"
@@ -28,8 +29,6 @@ using Eigen::VectorXd;
 namespace {
 
 using namespace plan_detail;
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // ---- Comparison layouts ------------------------------------------------------------------------
 
@@ -93,7 +92,7 @@ std::vector<PlanUnit> regular_layout(const PlanInput& in, std::size_t n, std::st
   if (in.instrument == Instrument::Points || in.instrument == Instrument::RTest) {
     std::vector<std::size_t> vary;
     for (std::size_t a = 0; a < na; ++a) {
-      const bool rot = joint_of(d, a).type == JointType::Revolute;
+      const bool rot = d.axis_joint(a).type == JointType::Revolute;
       if (in.instrument == Instrument::RTest && !rot) continue;
       if (distinct[a].size() > 1) vary.push_back(a);
     }
@@ -114,10 +113,10 @@ std::vector<PlanUnit> regular_layout(const PlanInput& in, std::size_t n, std::st
       for (std::size_t a = 0; a < na; ++a) levels[a] = {base->pose[a]};
       for (std::size_t i = 0; i < vary.size(); ++i) {
         const std::size_t a = vary[i];
-        const Joint& j = joint_of(d, a);
-        const bool turn = j.type == JointType::Revolute &&
-                          (j.max - j.min) * j.to_base >= 6.283185307179586 - 1e-9;
-        levels[a] = spread(lo[a], hi[a], fac[i], turn, 6.283185307179586 / j.to_base);
+        const Joint& j = d.axis_joint(a);
+        const bool turn =
+            j.type == JointType::Revolute && (j.max - j.min) * j.to_base >= 2 * kPi - 1e-9;
+        levels[a] = spread(lo[a], hi[a], fac[i], turn, 2 * kPi / j.to_base);
       }
       if (s == 0)
         for (std::size_t f : fac) shape.push_back(std::to_string(f));
@@ -144,13 +143,13 @@ std::vector<PlanUnit> regular_layout(const PlanInput& in, std::size_t n, std::st
     for (std::size_t s = 0; s < setups; ++s) {
       const std::size_t share = n / setups + (s < n % setups ? 1 : 0);
       std::size_t a = 0;
-      while (joint_of(d, a).coordinate != c.setups[s].axis) ++a;
+      while (d.axis_joint(a).coordinate != c.setups[s].axis) ++a;
       const PlanUnit* base = nullptr;
       for (const PlanUnit& u : c.units)
         if (u.setup == s && !base) base = &u;
       if (!base) continue;
       for (double v : spread(lo[a], hi[a], share, false, 0)) {
-        PlanUnit u{s, base->pose, v * joint_of(d, a).to_base};
+        PlanUnit u{s, base->pose, v * d.axis_joint(a).to_base};
         u.pose[a] = v;
         out.push_back(u);
       }
@@ -473,7 +472,7 @@ PlanResult Planner::run(const PlanInput& in) const {
     evaluate(cx, "plan", R.plan.layout, nullptr, nullptr, &cov);
     std::vector<std::size_t> axes;
     for (std::size_t a = 0; a < d.axes().size(); ++a)
-      if (joint_of(d, a).type == JointType::Prismatic && joint_of(d, a).max > joint_of(d, a).min)
+      if (d.axis_joint(a).type == JointType::Prismatic && d.axis_joint(a).max > d.axis_joint(a).min)
         axes.push_back(a);
     for (std::size_t a = 0; a < d.axes().size() && axes.size() < 2; ++a)
       if (std::find(axes.begin(), axes.end(), a) == axes.end()) axes.push_back(a);
@@ -481,22 +480,22 @@ PlanResult Planner::run(const PlanInput& in) const {
     PointData g;
     std::vector<double> middle;
     for (std::size_t a = 0; a < d.axes().size(); ++a) {
-      const Joint& j = joint_of(d, a);
+      const Joint& j = d.axis_joint(a);
       middle.push_back(j.max > j.min ? (j.min + j.max) / 2 : 0.0);
     }
     auto levels = [&](std::size_t a) {
-      const Joint& j = joint_of(d, a);
+      const Joint& j = d.axis_joint(a);
       std::vector<double> v;
       for (int i = 0; i < 21; ++i)
         v.push_back(j.max > j.min ? j.min + (j.max - j.min) * i / 20.0 : 0.0);
       return v;
     };
-    map.x_axis = joint_of(d, axes[0]).coordinate;
-    map.x_unit = joint_of(d, axes[0]).unit;
+    map.x_axis = d.axis_joint(axes[0]).coordinate;
+    map.x_unit = d.axis_joint(axes[0]).unit;
     map.x = levels(axes[0]);
     if (axes.size() > 1) {
-      map.y_axis = joint_of(d, axes[1]).coordinate;
-      map.y_unit = joint_of(d, axes[1]).unit;
+      map.y_axis = d.axis_joint(axes[1]).coordinate;
+      map.y_unit = d.axis_joint(axes[1]).unit;
       map.y = levels(axes[1]);
     } else {
       map.y = {0.0};

@@ -4,17 +4,10 @@
 #include <limits>
 
 #include "plan_internal.hpp"
+#include "weilgen/base/constants.hpp"
 #include "weilgen/base/memory.hpp"
 
 namespace weilgen::plan_detail {
-
-namespace {
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-}  // namespace
-
-const Joint& joint_of(const Description& d, std::size_t axis) {
-  return d.bodies[static_cast<std::size_t>(d.axes()[axis])].joint;
-}
 
 std::uint64_t mix(std::uint64_t z) {
   z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
@@ -155,7 +148,7 @@ PointData volumetric_rows(std::vector<std::vector<double>> poses) {
 PointData prediction_grid(const Description& d) {
   std::vector<std::vector<double>> levels;
   for (std::size_t a = 0; a < d.axes().size(); ++a) {
-    const Joint& j = joint_of(d, a);
+    const Joint& j = d.axis_joint(a);
     std::vector<double> v;
     for (int i = 0; i < 5; ++i)
       v.push_back(j.max > j.min ? j.min + (j.max - j.min) * i / 4.0 : 0.0);

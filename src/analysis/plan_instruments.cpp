@@ -8,6 +8,7 @@
 #include "weilgen/analysis/ballbar_model.hpp"
 #include "weilgen/analysis/plan.hpp"
 #include "weilgen/analysis/study_spec.hpp"
+#include "weilgen/base/constants.hpp"
 #include "weilgen/base/format.hpp"
 #include "weilgen/base/text.hpp"
 #include "weilgen/base/units.hpp"
@@ -18,15 +19,8 @@ namespace weilgen {
 
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kTwoPi = 6.283185307179586;
-
-const Joint& joint_of(const Description& d, std::size_t axis) {
-  return d.bodies[static_cast<std::size_t>(d.axes()[axis])].joint;
-}
-
 bool full_turn(const Joint& j) {
-  return j.type == JointType::Revolute && (j.max - j.min) * j.to_base >= kTwoPi - 1e-9;
+  return j.type == JointType::Revolute && (j.max - j.min) * j.to_base >= 2 * kPi - 1e-9;
 }
 
 // n values over the joint's travel: evenly from min to max; over one turn from min without the
@@ -36,7 +30,7 @@ std::vector<double> travel_levels(const Joint& j, std::size_t n) {
   if (n <= 1) return {(j.min + j.max) / 2};
   std::vector<double> v(n);
   if (full_turn(j)) {
-    const double turn = kTwoPi / j.to_base;
+    const double turn = 2 * kPi / j.to_base;
     for (std::size_t i = 0; i < n; ++i)
       v[i] = j.min + turn * static_cast<double>(i) / static_cast<double>(n);
   } else {
@@ -65,7 +59,7 @@ double rest_value(const Joint& j) {
 std::string pose_text(const Description& d, const std::vector<double>& pose) {
   std::string s;
   for (std::size_t a = 0; a < pose.size(); ++a)
-    s += (a ? ", " : "") + joint_of(d, a).coordinate + "=" + format_number(pose[a]);
+    s += (a ? ", " : "") + d.axis_joint(a).coordinate + "=" + format_number(pose[a]);
   return s;
 }
 
@@ -98,21 +92,22 @@ Levels parse_levels(const Description& d, const CandidateSpec& spec) {
   for (const std::string& item : spec.set) {
     for (auto& [a, values] : parse_axis_values(d, "--set", item)) {
       if (values.size() != 1)
-        throw std::invalid_argument("--set: " + quoted(item) + ": " + joint_of(d, a).coordinate +
+        throw std::invalid_argument("--set: " + quoted(item) + ": " + d.axis_joint(a).coordinate +
                                     " takes one value (--set holds an axis; ranges go in "
                                     "--candidates)");
       if (L.fixed[a])
-        throw std::invalid_argument("--set: axis " + joint_of(d, a).coordinate + " is given twice");
+        throw std::invalid_argument("--set: axis " + d.axis_joint(a).coordinate +
+                                    " is given twice");
       L.fixed[a] = values.front();
     }
   }
   for (const std::string& item : spec.grid) {
     for (auto& [a, values] : parse_axis_values(d, "--candidates", item)) {
       if (L.named[a])
-        throw std::invalid_argument("--candidates: axis " + joint_of(d, a).coordinate +
+        throw std::invalid_argument("--candidates: axis " + d.axis_joint(a).coordinate +
                                     " is given twice");
       if (L.fixed[a])
-        throw std::invalid_argument("--candidates: axis " + joint_of(d, a).coordinate +
+        throw std::invalid_argument("--candidates: axis " + d.axis_joint(a).coordinate +
                                     " is held by --set; give it in one of them");
       L.named[a] = std::move(values);
     }
@@ -127,7 +122,7 @@ std::vector<std::vector<double>> read_pose_file(const Description& d, const std:
   const MeasurementTable t = read_measurements(path, ro);
   std::vector<std::vector<double>> poses(t.rows(), std::vector<double>(d.axes().size()));
   for (std::size_t a = 0; a < d.axes().size(); ++a) {
-    const std::string& c = joint_of(d, a).coordinate;
+    const std::string& c = d.axis_joint(a).coordinate;
     if (!t.has(c))
       throw InputError(SourceLoc{path, t.header_line, 0}, flag + ": missing column '" + c +
                                                               "' (a pose needs every coordinate; " +
@@ -145,7 +140,7 @@ std::vector<std::vector<double>> read_pose_file(const Description& d, const std:
 
 bool in_travel(const Description& d, const std::vector<double>& pose) {
   for (std::size_t a = 0; a < pose.size(); ++a) {
-    const Joint& j = joint_of(d, a);
+    const Joint& j = d.axis_joint(a);
     if (!(j.max > j.min)) continue;
     const double slack = 1e-9 * std::max({1.0, std::abs(j.min), std::abs(j.max)});
     if (pose[a] < j.min - slack || pose[a] > j.max + slack) return false;
@@ -173,7 +168,7 @@ void points_candidates(const Description& d, const CandidateSpec& spec, const Le
     for (std::size_t a = 0; a < na; ++a)
       levels.push_back(L.fixed[a]   ? std::vector<double>{*L.fixed[a]}
                        : L.named[a] ? *L.named[a]
-                                    : travel_levels(joint_of(d, a), default_levels(free)));
+                                    : travel_levels(d.axis_joint(a), default_levels(free)));
     poses = product(levels);
   }
   for (auto& p : poses) c.units.push_back({0, std::move(p), 0});
@@ -187,7 +182,7 @@ class NestSolver {
     chain_.set_parameters(model.parameters());
     zero_.assign(d_.errors.size(), 0.0);
     for (std::size_t a = 0; a < d_.axes().size(); ++a)
-      (joint_of(d_, a).type == JointType::Prismatic ? linear_ : rotary_).push_back(a);
+      (d_.axis_joint(a).type == JointType::Prismatic ? linear_ : rotary_).push_back(a);
   }
   const std::vector<std::size_t>& linear() const { return linear_; }
   const std::vector<std::size_t>& rotary() const { return rotary_; }
@@ -234,7 +229,7 @@ void rtest_candidates(const Model& model, const CandidateSpec& spec, const Level
   const NestSolver solver(model);
   const std::size_t na = d.axes().size();
   std::vector<std::string> lin_names;
-  for (std::size_t a : solver.linear()) lin_names.push_back(joint_of(d, a).coordinate);
+  for (std::size_t a : solver.linear()) lin_names.push_back(d.axis_joint(a).coordinate);
   if (solver.rotary().empty())
     throw std::invalid_argument(
         "--instrument rtest: the R-test measures while rotary axes turn; "
@@ -247,7 +242,7 @@ void rtest_candidates(const Model& model, const CandidateSpec& spec, const Level
         d.name + " has " + (lin_names.empty() ? std::string("none") : join(lin_names)));
   for (std::size_t a : solver.linear())
     if (L.named[a])
-      throw std::invalid_argument("--candidates: " + joint_of(d, a).coordinate +
+      throw std::invalid_argument("--candidates: " + d.axis_joint(a).coordinate +
                                   " is a linear axis: in an R-test the linear axes follow the nest "
                                   "(give the nest with --nest)");
   // The rotary levels (the candidates) and a coarse set of them (the default nest's search).
@@ -257,9 +252,9 @@ void rtest_candidates(const Model& model, const CandidateSpec& spec, const Level
   for (std::size_t a : solver.rotary()) {
     levels.push_back(L.fixed[a]   ? std::vector<double>{*L.fixed[a]}
                      : L.named[a] ? *L.named[a]
-                                  : travel_levels(joint_of(d, a), default_levels(free)));
+                                  : travel_levels(d.axis_joint(a), default_levels(free)));
     coarse.push_back(L.fixed[a] ? std::vector<double>{*L.fixed[a]}
-                                : travel_levels(joint_of(d, a), 7));
+                                : travel_levels(d.axis_joint(a), 7));
   }
   const std::vector<std::vector<double>> turns = product(levels);
   auto reachable = [&](const std::vector<double>& nest_pose,
@@ -275,7 +270,7 @@ void rtest_candidates(const Model& model, const CandidateSpec& spec, const Level
   };
   std::vector<double> rest(na);
   for (std::size_t a = 0; a < na; ++a)
-    rest[a] = L.fixed[a] ? *L.fixed[a] : rest_value(joint_of(d, a));
+    rest[a] = L.fixed[a] ? *L.fixed[a] : rest_value(d.axis_joint(a));
   // The nests: the linear axes where the sphere sits in the nest, every rotary axis at rest.
   // Without --nest: of a 5-level grid of the linear travel, the position from which the sphere
   // can be held at the most of a coarse grid of rotary poses (nearest the middle among equals).
@@ -285,7 +280,7 @@ void rtest_candidates(const Model& model, const CandidateSpec& spec, const Level
     std::vector<std::vector<double>> lin_levels;
     for (std::size_t a : solver.linear())
       lin_levels.push_back(L.fixed[a] ? std::vector<double>{*L.fixed[a]}
-                                      : travel_levels(joint_of(d, a), 5));
+                                      : travel_levels(d.axis_joint(a), 5));
     std::size_t best_n = 0;
     double best_dist = INFINITY;
     std::vector<double> best = rest;
@@ -295,7 +290,7 @@ void rtest_candidates(const Model& model, const CandidateSpec& spec, const Level
       for (std::size_t i = 0; i < solver.linear().size(); ++i) {
         const std::size_t a = solver.linear()[i];
         q[a] = lv[i];
-        const Joint& j = joint_of(d, a);
+        const Joint& j = d.axis_joint(a);
         if (j.max > j.min) dist += std::pow((lv[i] - rest[a]) / (j.max - j.min), 2);
       }
       if (solver.linear_rank(q) < 3) continue;
@@ -304,7 +299,7 @@ void rtest_candidates(const Model& model, const CandidateSpec& spec, const Level
     }
     std::string text;
     for (std::size_t a : solver.linear())
-      text += (text.empty() ? "" : ",") + joint_of(d, a).coordinate + "=" + format_number(best[a]);
+      text += (text.empty() ? "" : ",") + d.axis_joint(a).coordinate + "=" + format_number(best[a]);
     nests.push_back(text);
   }
   for (std::size_t k = 0; k < nests.size(); ++k) {
@@ -312,7 +307,8 @@ void rtest_candidates(const Model& model, const CandidateSpec& spec, const Level
     if (!nests[k].empty())
       for (auto& [a, v] : parse_axis_values(d, "--nest", nests[k])) {
         if (v.size() != 1)
-          throw std::invalid_argument("--nest: " + quoted(nests[k]) + ": one value per axis");
+          throw std::invalid_argument("--nest: " + weilgen::quoted(nests[k]) +
+                                      ": one value per axis");
         pose[a] = v.front();
       }
     if (solver.linear_rank(pose) < 3)
@@ -352,7 +348,7 @@ void ballbar_candidates(const Model& model, const CandidateSpec& spec, const Lev
   const std::size_t na = d.axes().size();
   std::vector<std::size_t> linear;
   for (std::size_t a = 0; a < na; ++a)
-    if (joint_of(d, a).type == JointType::Prismatic) linear.push_back(a);
+    if (d.axis_joint(a).type == JointType::Prismatic) linear.push_back(a);
   if (linear.size() < 2)
     throw std::invalid_argument(
         "--instrument ballbar: a ballbar circle needs two linear axes; "
@@ -360,7 +356,7 @@ void ballbar_candidates(const Model& model, const CandidateSpec& spec, const Lev
         d.name + " has " + std::to_string(linear.size()));
   // The planes: --planes, else every pair of linear axes (XY, YZ, ZX for X, Y, Z).
   std::vector<std::pair<std::size_t, std::size_t>> planes;
-  auto name_of = [&](std::size_t a) { return joint_of(d, a).coordinate; };
+  auto name_of = [&](std::size_t a) { return d.axis_joint(a).coordinate; };
   auto plane_text = [&](std::size_t a, std::size_t b) {
     return name_of(a).size() == 1 && name_of(b).size() == 1 ? name_of(a) + name_of(b)
                                                             : name_of(a) + "," + name_of(b);
@@ -372,7 +368,7 @@ void ballbar_candidates(const Model& model, const CandidateSpec& spec, const Lev
       f.plane = trim(item);
       f.radius = "1e-6 mm";
       std::vector<double> rest(na);
-      for (std::size_t a = 0; a < na; ++a) rest[a] = rest_value(joint_of(d, a));
+      for (std::size_t a = 0; a < na; ++a) rest[a] = rest_value(d.axis_joint(a));
       f.centre = pose_text(d, rest);
       BallbarCircle circle;
       try {
@@ -406,7 +402,7 @@ void ballbar_candidates(const Model& model, const CandidateSpec& spec, const Lev
     std::vector<std::vector<double>> levels;
     bool fits = true;
     for (std::size_t a = 0; a < na; ++a) {
-      const Joint& j = joint_of(d, a);
+      const Joint& j = d.axis_joint(a);
       if (L.fixed[a]) {
         levels.push_back({*L.fixed[a]});
         continue;
@@ -479,9 +475,9 @@ void line6d_candidates(const Description& d, const Levels& L, PlanCandidates& c)
   const std::size_t na = d.axes().size();
   std::vector<double> middle(na);
   for (std::size_t a = 0; a < na; ++a)
-    middle[a] = L.fixed[a] ? *L.fixed[a] : rest_value(joint_of(d, a));
+    middle[a] = L.fixed[a] ? *L.fixed[a] : rest_value(d.axis_joint(a));
   for (std::size_t a = 0; a < na; ++a) {
-    const Joint& j = joint_of(d, a);
+    const Joint& j = d.axis_joint(a);
     if (j.type != JointType::Prismatic ||
         (j.coordinate != "X" && j.coordinate != "Y" && j.coordinate != "Z"))
       continue;
@@ -675,7 +671,7 @@ std::vector<std::pair<std::string, MeasurementTable>> plan_tables(
       for (std::size_t a = 0; a < na; ++a) {
         std::vector<double> x;
         for (const PlanUnit* u : list) x.push_back(u->pose[a]);
-        column(joint_of(d, a).coordinate, x);
+        column(d.axis_joint(a).coordinate, x);
       }
       std::vector<double> cyc(n, 1.0);
       column("cycle", cyc);
@@ -701,7 +697,7 @@ std::vector<std::pair<std::string, MeasurementTable>> plan_tables(
       std::vector<double> x;
       for (const PlanUnit* u : list) {
         std::size_t a = 0;
-        while (joint_of(d, a).coordinate != s.axis) ++a;
+        while (d.axis_joint(a).coordinate != s.axis) ++a;
         x.push_back(u->pose[a]);
       }
       column(s.axis, x);

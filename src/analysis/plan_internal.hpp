@@ -15,7 +15,6 @@ namespace weilgen::plan_detail {
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
 
-const Joint& joint_of(const Description& d, std::size_t axis);
 std::uint64_t mix(std::uint64_t z);
 // The noise (µm, µrad) of an observation of `kind` made by a unit of set-up `setup`.
 double noise_of(const PlanInput& in, std::size_t setup, int kind);

@@ -5,13 +5,12 @@
 #include <memory>
 
 #include "weilgen/analysis/ballbar_model.hpp"
+#include "weilgen/base/constants.hpp"
 #include "weilgen/base/text.hpp"
 
 namespace weilgen {
 
-namespace {
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-}  // namespace
+namespace {}  // namespace
 
 Prediction predict_table(const Model& model, const ErrorParameterisation& param,
                          const std::vector<double>& theta, const MeasurementTable& table) {

@@ -10,12 +10,11 @@
 #include <stdexcept>
 #include <utility>
 
+#include "weilgen/base/constants.hpp"
 #include "weilgen/base/text.hpp"
 
 namespace weilgen {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 Expr unary(Expr::Kind kind, Expr a) {
   Expr e;

@@ -28,7 +28,10 @@ std::string format_fixed(double v, int decimals) {
   if (!std::isfinite(v)) return "-";
   std::ostringstream s;
   s << std::fixed << std::setprecision(decimals) << v;
-  return s.str();
+  std::string t = s.str();
+  // A value that rounds to zero prints without a sign: "-0.000" reads as a negative reading.
+  if (t[0] == '-' && t.find_first_of("123456789") == std::string::npos) t.erase(0, 1);
+  return t;
 }
 
 std::string format_significant(double v, int digits) {
@@ -44,6 +47,14 @@ std::string format_literal(double v) {
     std::snprintf(buf, sizeof buf, "%.*g", p, v);
     if (std::strtod(buf, nullptr) == v) break;
   }
+  std::string s(buf);
+  if (s.find_first_of(".en") == std::string::npos) s += ".0";
+  return s;
+}
+
+std::string format_literal17(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
   std::string s(buf);
   if (s.find_first_of(".en") == std::string::npos) s += ".0";
   return s;

@@ -7,13 +7,12 @@
 #include <stdexcept>
 #include <vector>
 
+#include "weilgen/base/constants.hpp"
 #include "weilgen/base/expr.hpp"
 #include "weilgen/base/text.hpp"
 
 namespace weilgen {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 struct NamedUnit {
   const char* name;
@@ -161,6 +160,28 @@ double parse_duration_s(const std::string& text, const std::string& default_unit
          "\"" + abbreviated(t) + "\" is not a number: unknown name \"" + e.params().front() + "\"");
   const double v = e.eval({}) * factor;
   if (!std::isfinite(v)) fail(what, "\"" + abbreviated(t) + "\" is not a finite number");
+  return v;
+}
+
+double parse_feedrate_mm_min(const std::string& text, const std::string& what) {
+  static const std::pair<const char*, double> units[] = {
+      {"mm/min", 1}, {"mm/s", 60}, {"m/min", 1000}, {"in/min", 25.4}, {"mm/sec", 60}};
+  const std::string t = trim(text);
+  std::string number = t;
+  double factor = 1;
+  for (const auto& [unit, f] : units) {
+    const std::string u = unit;
+    if (t.size() > u.size() && lower(t.substr(t.size() - u.size())) == u) {
+      number = trim(t.substr(0, t.size() - u.size()));
+      factor = f;
+      break;
+    }
+  }
+  const Quantity q = parse_quantity_unit(number, "mm", what);
+  if (q.unit_given)
+    fail(what, "\"" + abbreviated(t) + "\": a feedrate's unit is mm/min, mm/s, m/min or in/min");
+  const double v = q.number * factor;
+  if (!(v > 0)) fail(what, "\"" + abbreviated(t) + "\": the feedrate must be > 0");
   return v;
 }
 

@@ -16,6 +16,11 @@ po::options_description iso_options(IsoFlags& f) {
   o.add_options()("format", po::value<std::string>(&f.format)->default_value(f.format),
                   "the data file's layout: auto, tidy, carto (Renishaw XL-80/CARTO wide CSV) or "
                   "wide (docs/data-format.md, 'Instrument files')")(
+      "normalise", po::value<std::string>(&f.normalise)->default_value(f.normalise),
+      "corrections the instrument may already have applied: auto (never one the file says the "
+      "instrument applied; docs/iso230-2.md, 'Instrument compensation state'), force (normalise "
+      "to 20 degC with the coefficient given, and allow --air-compensation edlen, whatever the "
+      "file says) or never (no correction by weilgen)")(
       "expansion", ranged(&f.expansion_ppm_per_K, NumberRange::closed(-100, 100)),
       "expansion coefficient of the machine's material, um/(m K) = ppm/K: normalise the "
       "deviations to 20 degC (default: header key expansion_ppm_per_K, else none)")(
@@ -43,7 +48,14 @@ po::options_description iso_options(IsoFlags& f) {
       "tolerances in the deviation unit: a band +-T ('10'), figure limits ('A=12,R=6,B=4') or "
       "both ('10,A=12'); verdicts in the text, JSON and report")(
       "report", po::value<std::string>(&f.report),
-      "write the test report as one self-contained HTML file (charts inline)");
+      "write the test report as one self-contained HTML file (charts inline)")(
+      "iso-only",
+      "only the figures ISO 230-2 defines: no Student-t set, no drift-eliminated evaluation")(
+      "uncertainty", po::value<std::string>(&f.uncertainty),
+      "the measurement uncertainty of E, M, A, B, R (ISO 230-9, GUM, k = 2) and ISO 14253-1 "
+      "verdicts: auto (the instrument class from the air compensation), a class "
+      "(laser-compensated, laser-edlen, laser-manual, scale) or a budget file (YAML; "
+      "docs/iso230-2.md, 'Measurement uncertainty')");
   return o;
 }
 
@@ -51,6 +63,8 @@ void apply_iso_flags(const IsoFlags& f, const po::variables_map& vm, Iso230_2Stu
                      ImportOptions& imp) {
   if (lower(f.format) != "auto") imp.format = parse_instrument_format(f.format);
   NormalisationOptions& n = s.normalisation;
+  n.mode = parse_normalise_mode(f.normalise);
+  s.iso_only = vm.count("iso-only") > 0;
   if (vm.count("expansion")) n.expansion_ppm_per_K = f.expansion_ppm_per_K;
   if (vm.count("wavelength")) n.wavelength_nm = f.wavelength_nm;
   if (vm.count("air-index-assumed")) n.assumed_index = f.air_index_assumed;
@@ -68,6 +82,7 @@ void apply_iso_flags(const IsoFlags& f, const po::variables_map& vm, Iso230_2Stu
           parse_environment_source(vm[flag].as<std::string>(), quantity, std::string("--") + flag);
   n.validate();
   if (!f.tolerance.empty()) s.tolerance = parse_iso_tolerance(f.tolerance);
+  if (vm.count("uncertainty")) s.uncertainty = uncertainty_budget_from_flag(f.uncertainty);
   if (!f.report.empty()) {
     const std::string ext = lower(std::filesystem::path(f.report).extension().string());
     if (ext != ".html" && ext != ".htm")

@@ -12,15 +12,18 @@
 namespace weilgen::cli {
 
 struct IsoFlags {
-  std::string format = "auto";  // --format
-  std::string report;           // --report FILE.html
-  std::string tolerance;        // --tolerance
+  std::string format = "auto";     // --format
+  std::string normalise = "auto";  // --normalise
+  std::string uncertainty;         // --uncertainty
+  std::string report;              // --report FILE.html
+  std::string tolerance;           // --tolerance
   double expansion_ppm_per_K = 0, wavelength_nm = 0, air_index_assumed = 0, datum_mm = 0;
 };
 
-// --format, --expansion, --material-temperature, --air-compensation, --air-temperature,
+// --format, --normalise, --expansion, --material-temperature, --air-compensation,
+// --air-temperature,
 // --air-pressure, --air-humidity, --wavelength, --air-index-assumed, --datum, --tolerance,
-// --report.
+// --report, --iso-only, --uncertainty.
 boost::program_options::options_description iso_options(IsoFlags& flags);
 
 // The flags into the study's options and the import's (std::invalid_argument naming the flag);

@@ -46,6 +46,11 @@ const std::map<std::string, Verb>& verbs() {
         "iso230-2 <data.csv> [--axis X] [--json FILE] [--csv FILE] [--plot FILE]\n"
         "         [--report F.html] [--tolerance SPEC] [--expansion PPM_PER_K] ...\n"
         "      ISO 230-2 positioning figures, with the thermal-drift-eliminated evaluation"}},
+      {"ballbar",
+       {weilgen::cli::verb_ballbar,
+        "ballbar <trace.csv> [--radius 100] [--plane XY] [--plot F.svg] [--json F]\n"
+        "        [--report F.html] [--machine M]\n"
+        "      a ballbar trace on its own: ISO 230-4 G, F, H and the causes, ranked"}},
       {"import",
        {weilgen::cli::verb_import,
         "import <file> [--format auto|carto|wide|tidy] [--axis X] [--out FILE]\n"

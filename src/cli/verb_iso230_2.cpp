@@ -82,6 +82,7 @@ int verb_iso230_2(const Args& args) {
   const ImportResult imported = read_instrument_file(data, io);
   for (const auto& w : imported.table.warnings) std::cerr << w << "\n";
   const Iso230_2StudyResult r = Iso230_2Study(so).run(imported.table);
+  for (const auto& w : r.normalisation.warnings) std::cerr << "warning: " << w << "\n";
   const std::string format = to_string(imported.format);
   const CompTable comp_table =
       comp.path.empty() ? CompTable{} : comp_table_from_iso(r, comp.options.table);

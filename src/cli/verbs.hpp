@@ -17,6 +17,7 @@ int verb_sensitivity(const Args& args);
 int verb_reliability(const Args& args);
 int verb_allocate(const Args& args);
 int verb_iso230_2(const Args& args);
+int verb_ballbar(const Args& args);
 int verb_import(const Args& args);
 int verb_fit_pdge(const Args& args);
 int verb_identify(const Args& args);

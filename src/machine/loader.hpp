@@ -17,14 +17,13 @@
 #include <string>
 #include <vector>
 
+#include "weilgen/base/constants.hpp"
 #include "weilgen/base/text.hpp"
 #include "weilgen/base/units.hpp"
 #include "weilgen/machine/description.hpp"
 #include "weilgen/machine/iso_names.hpp"
 
 namespace weilgen::machine_detail {
-
-constexpr double kPi = 3.14159265358979323846;
 
 // The units a field accepts, by their table spelling (weilgen/base/units.hpp holds the factors;
 // µm and µrad are accepted for um and urad).

@@ -6,12 +6,12 @@
 #include <cstdlib>
 #include <stdexcept>
 
+#include "weilgen/base/constants.hpp"
 #include "weilgen/base/text.hpp"
 
 namespace weilgen {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr int kMaxOrder = 200;
 
 std::string num(double v) {

@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "weilgen/base/constants.hpp"
 #include "weilgen/base/format.hpp"
 #include "weilgen/base/text.hpp"
 #include "weilgen/base/units.hpp"
@@ -14,8 +15,6 @@
 namespace weilgen {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // Angles closer than this (deg) are the same point of the circle.
 constexpr double kSameAngleDeg = 1e-9;
 
@@ -644,6 +643,16 @@ BallbarEvaluation evaluate_ballbar(const std::vector<double>& angle_deg,
   e.circular_deviation_um = *chi - *clo;
   e.radial_deviation_max_um = *chi;
   e.radial_deviation_min_um = *clo;
+  if (cover.distinct.size() >= 4) {
+    const MinimumZone z = minimum_zone(angle_deg, dr_um);
+    e.mz_centre_offset_um = z.centre_um;
+    e.mz_circular_deviation_um = z.width_um;
+    e.mz_radius_deviation_um = z.mid_um;
+  } else {
+    e.mz_centre_offset_um = e.centre_offset_um;
+    e.mz_circular_deviation_um = e.circular_deviation_um;
+    e.mz_radius_deviation_um = 0.5 * (*chi + *clo);
+  }
   // Harmonics need the circle sampled finer than half the period of the highest order.
   e.squareness_urad = e.scale_mismatch_um_per_m = kNaN;
   const auto needed = static_cast<std::size_t>(2 * max_harmonic + 1);
@@ -666,6 +675,94 @@ BallbarEvaluation evaluate_ballbar(const std::vector<double>& angle_deg,
     }
   }
   return e;
+}
+
+MinimumZone minimum_zone(const std::vector<double>& angle_deg, const std::vector<double>& dr_um) {
+  if (angle_deg.size() != dr_um.size())
+    throw std::invalid_argument("ballbar: angles and radial deviations differ in size");
+  if (angle_cover(angle_deg).distinct.size() < 4)
+    throw std::invalid_argument("ballbar: the minimum zone needs at least 4 distinct angles");
+  // The dual of  min h  s.t. |dr_i − m − a cos θ_i − b sin θ_i| <= h:
+  //   max Σ dr_i (p_i − q_i)  s.t.  Σ (p − q) = Σ (p − q) cos θ = Σ (p − q) sin θ = 0,
+  //   Σ (p + q) = 1, p, q >= 0;  its four rows' prices are (m, a, b, h). Revised simplex with
+  //   four artificial columns (big M) and Bland's rule, which cannot cycle.
+  const std::size_t n = dr_um.size(), cols = 2 * n + 4;
+  double scale = 1;
+  for (double v : dr_um) scale = std::max(scale, std::abs(v));
+  const double big = 1e3 * scale, tol = 1e-11 * scale;
+  std::vector<double> cosines(n), sines(n);
+  for (std::size_t i = 0; i < n; ++i)
+    cosines[i] = std::cos(rad(angle_deg[i])), sines[i] = std::sin(rad(angle_deg[i]));
+  auto column = [&](std::size_t j) {
+    Eigen::Vector4d a = Eigen::Vector4d::Zero();
+    if (j >= 2 * n) {
+      a(static_cast<Eigen::Index>(j - 2 * n)) = 1;
+      return a;
+    }
+    const double sign = j < n ? 1.0 : -1.0;
+    a << sign, sign * cosines[j % n], sign * sines[j % n], 1;
+    return a;
+  };
+  auto cost = [&](std::size_t j) { return j >= 2 * n ? -big : (j < n ? dr_um[j] : -dr_um[j - n]); };
+  std::array<std::size_t, 4> basis = {2 * n, 2 * n + 1, 2 * n + 2, 2 * n + 3};
+  Eigen::Vector4d x(0, 0, 0, 1);
+  Eigen::Matrix4d inverse = Eigen::Matrix4d::Identity();
+  Eigen::RowVector4d price;
+  for (std::size_t iteration = 0; iteration < 100 * cols; ++iteration) {
+    Eigen::RowVector4d cb;
+    for (int i = 0; i < 4; ++i) cb(i) = cost(basis[static_cast<std::size_t>(i)]);
+    price = cb * inverse;
+    std::size_t enter = cols;
+    for (std::size_t j = 0; j < cols && enter == cols; ++j) {
+      if (std::find(basis.begin(), basis.end(), j) != basis.end()) continue;
+      if (cost(j) - price.dot(column(j)) > tol) enter = j;
+    }
+    if (enter == cols) break;  // optimal
+    const Eigen::Vector4d w = inverse * column(enter);
+    int leave = -1;
+    double best = INFINITY;
+    for (int i = 0; i < 4; ++i) {
+      if (w(i) <= 1e-12) continue;
+      const double ratio = x(i) / w(i);
+      if (ratio < best - 1e-15 ||
+          (ratio <= best + 1e-15 && leave >= 0 &&
+           basis[static_cast<std::size_t>(i)] < basis[static_cast<std::size_t>(leave)]))
+        best = ratio, leave = i;
+    }
+    if (leave < 0) throw std::runtime_error("ballbar: the minimum-zone programme is unbounded");
+    basis[static_cast<std::size_t>(leave)] = enter;
+    Eigen::Matrix4d B;
+    for (int i = 0; i < 4; ++i) B.col(i) = column(basis[static_cast<std::size_t>(i)]);
+    inverse = B.inverse();
+    x = inverse * Eigen::Vector4d(0, 0, 0, 1);
+  }
+  // The zone from the prices' centre, evaluated on the data (exact whatever the last rounding).
+  MinimumZone z;
+  z.centre_um = {price(1), price(2)};
+  double lo = INFINITY, hi = -INFINITY;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double t = rad(angle_deg[i]);
+    const double r = dr_um[i] - z.centre_um[0] * std::cos(t) - z.centre_um[1] * std::sin(t);
+    lo = std::min(lo, r), hi = std::max(hi, r);
+  }
+  z.width_um = hi - lo;
+  z.mid_um = 0.5 * (hi + lo);
+  return z;
+}
+
+std::vector<int> ballbar_travel_direction(const std::vector<double>& angle_deg, int feed,
+                                          int axis) {
+  if (feed != 1 && feed != -1) throw std::invalid_argument("ballbar: feed must be +1 or -1");
+  // The motion just before the point: first = c1 + R cos θ moves as −feed sin θ, second as
+  // feed cos θ.
+  std::vector<int> out;
+  out.reserve(angle_deg.size());
+  for (double a : angle_deg) {
+    const double t = rad(a) - feed * 1e-7;
+    const double v = axis == 0 ? -feed * std::sin(t) : feed * std::cos(t);
+    out.push_back(v >= 0 ? 1 : -1);
+  }
+  return out;
 }
 
 BallbarEvaluation evaluate_ballbar(const BallbarTrace& trace, double radius_mm, int max_harmonic) {
@@ -754,6 +851,8 @@ BallbarComparison compare_ballbar(const BallbarTrace& measured, const BallbarTra
     throw std::invalid_argument("ballbar: the measured trace is empty or inconsistent");
   }
   BallbarComparison c;
+  c.feed = measured.feed;
+  c.cycle = measured.cycle;
   c.angle_deg = measured.angle_deg;
   c.measured_um = measured.dr_um;
   c.predicted_um =

@@ -3,12 +3,12 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "weilgen/base/constants.hpp"
 #include "weilgen/base/format.hpp"
 
 namespace weilgen {
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kMmPerInch = 25.4;
 }  // namespace
 
@@ -58,7 +58,9 @@ CompTable comp_table_from_iso(const Iso230_2StudyResult& r, const CompTableOptio
   if (options.source == "drift") {
     if (!r.drift)
       throw std::invalid_argument(
-          "--comp-source drift: no drift-eliminated evaluation (it needs at least 2 targets)");
+          r.iso_only ? "--comp-source drift: --iso-only computes no drift-eliminated evaluation"
+                     : "--comp-source drift: no drift-eliminated evaluation (it needs at least 2 "
+                       "targets)");
     figures = &r.drift->figures;
   }
   // Deviations µm -> mm, µrad -> deg; the axis column is in mm (deg for a rotary axis).

@@ -13,6 +13,7 @@
 #include <tuple>
 
 #include "weilgen/base/atomic_file.hpp"
+#include "weilgen/base/constants.hpp"
 #include "weilgen/base/error.hpp"
 #include "weilgen/base/format.hpp"
 #include "weilgen/base/text.hpp"
@@ -23,7 +24,6 @@ namespace weilgen {
 
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 const char* const kDegree = "\xC2\xB0";   // °
 const char* const kOrdinal = "\xC2\xBA";  // º, often typed for °
 
@@ -138,6 +138,14 @@ bool is_target_name(const std::string& n) {
          n == "nominal position" || n == "nominal";
 }
 
+// A column numbering the targets ("Target No.", "Point"): it carries no measurement.
+bool is_index_name(const std::string& n) {
+  return n == "target no." || n == "target no" || n == "target number" || n == "target #" ||
+         n == "no." || n == "no" || n == "#" || n == "index" || n == "point" || n == "point no." ||
+         n == "point no" || n == "point number" || n == "position no." || n == "position no" ||
+         n == "position number" || n == "step";
+}
+
 // Strict number; `decimal_comma` accepts "1,5" for 1.5 (semicolon- or tab-separated exports).
 bool parse_number(std::string text, bool decimal_comma, double& v) {
   if (decimal_comma && text.find('.') == std::string::npos) {
@@ -156,6 +164,7 @@ struct WideColumn {
   std::string tidy;            // the tidy column it feeds
   long cycle = 0;              // 0: every run of the row; else the run (cycle) id
   std::vector<double> values;  // one per wide row, tidy units
+  int header_column = 0;       // 1-based character column of its source header cell
 };
 
 struct Wide {
@@ -175,6 +184,10 @@ MeasurementTable tidy_from_wide(const Wide& w) {
   t.file = w.meta.file;
   t.header_keys = w.meta.header_keys;
   t.header_key_lines = w.meta.header_key_lines;
+  // The tidy table is no longer wide: a '# format: wide' key carried into it would make the
+  // readers take the tidy file for a wide one.
+  t.header_keys.erase("format");
+  t.header_key_lines.erase("format");
   t.header_line = w.meta.header_line;
   t.warnings = w.meta.warnings;
   std::vector<std::string> names;
@@ -191,6 +204,9 @@ MeasurementTable tidy_from_wide(const Wide& w) {
     t.columns.push_back(n);
     t.info.push_back(classify_column(n, w.read));
     t.values[n];
+    for (const auto& c : w.columns)
+      if (c.tidy == n && c.header_column > 0 && !t.header_columns.count(n))
+        t.header_columns[n] = c.header_column;
   }
   for (std::size_t r = 0; r < w.lines.size(); ++r) {
     for (long j : cycles) {
@@ -223,7 +239,18 @@ MeasurementTable tidy_from_wide(const Wide& w) {
 
 // ---- CARTO ------------------------------------------------------------------------------------
 
-enum class Quantity { Target, Direction, Deviation, AirT, AirP, AirH, MaterialT, Time, Unknown };
+enum class Quantity {
+  Target,
+  TargetNumber,  // a running number of the target ("Target No."): checked, not carried
+  Direction,
+  Deviation,
+  AirT,
+  AirP,
+  AirH,
+  MaterialT,
+  Time,
+  Unknown
+};
 
 struct Conversion {
   double factor = 1, offset = 0;
@@ -285,10 +312,9 @@ Conversion deviation_unit(const std::string& unit, bool rotary, const std::strin
   if (u == "micron" || u == "microns") u = "um";
   if (u == "\"" || u == "sec" || u == "arc sec" || u == "arc-sec") u = "arcsec";
   if (u == kDegree || u == kOrdinal) u = "deg";
-  if (u.empty()) u = rotary ? "" : "um";
   if (u.empty())
-    throw std::invalid_argument(where +
-                                "no unit: a rotary axis' runs need one (arcsec, urad, deg)");
+    throw std::invalid_argument(where + "no unit (" +
+                                (rotary ? "arcsec, urad, deg" : "um, mm, nm") + ")");
   UnitFactor f;
   try {
     f = parse_unit(u);
@@ -341,6 +367,7 @@ CartoColumn classify_carto(const Cell& cell) {
     }
   }
   if (c.run == 0 && is_target_name(name)) c.q = Quantity::Target;
+  if (c.run == 0 && unit.empty() && is_index_name(name)) c.q = Quantity::TargetNumber;
   if (c.run == 0 && (name == "direction" || name == "dir")) c.q = Quantity::Direction;
   if (name == "air temperature" || name == "air temp") c.q = Quantity::AirT;
   if (name == "air pressure" || name == "pressure" || name == "barometric pressure")
@@ -380,9 +407,11 @@ int direction_of(const std::string& text) {
   return 0;
 }
 
-// `Key,Value` metadata: the tidy header key and the value converted to its unit.
+// `Key,Value` metadata: the tidy header key and the value converted to its unit. A key weilgen
+// does not know is kept as its slug, or dropped ({"", ""}) when `only_known` (the "Key: Value"
+// lines of a LaserXL-style header, which a title line may resemble).
 std::pair<std::string, std::string> carto_key(const std::string& key, const std::string& value,
-                                              const std::string& where) {
+                                              const std::string& where, bool only_known = false) {
   std::string name, unit;
   std::tie(name, unit) = name_and_unit(key);
   auto one_of = [&](std::initializer_list<const char*> names) {
@@ -431,6 +460,23 @@ std::pair<std::string, std::string> carto_key(const std::string& key, const std:
     return {"air_pressure_Pa", number(pressure_unit(unit.empty() ? "mbar" : unit, where))};
   if (one_of({"humidity", "relative humidity", "air humidity"}))
     return {"air_humidity_pct", number(Conversion{})};
+  // Whether the instrument's software corrected the readings to 20 degC with its coefficient.
+  if (one_of({"material compensation", "material comp", "material comp.",
+              "material temperature compensation", "expansion compensation",
+              "thermal expansion compensation", "material expansion compensation"})) {
+    const std::string v = normalise(value);
+    if (v == "on" || v == "applied" || v == "automatic" || v == "auto" || v == "yes" ||
+        v == "enabled" || v == "manual" || v == "instrument")
+      return {"material_compensation", "instrument"};
+    if (v == "off" || v == "none" || v == "no" || v == "disabled" || v == "not applied")
+      return {"material_compensation", "none"};
+    throw std::invalid_argument(where + "'" + value +
+                                "' (expected on/applied/automatic/manual or off/none)");
+  }
+  // The unit of runs whose header gives none ("Run 1").
+  if (one_of({"units", "unit", "deviation units", "deviation unit", "error units", "error unit",
+              "units of error", "linear units", "result units"}))
+    return {"deviation_unit", value};
   if (one_of({"air compensation", "environmental compensation", "compensation"})) {
     const std::string v = normalise(value);
     if (v == "on" || v == "applied" || v == "automatic" || v == "auto" || v == "yes" ||
@@ -444,6 +490,7 @@ std::pair<std::string, std::string> carto_key(const std::string& key, const std:
   }
   if (one_of({"wavelength", "laser wavelength"})) return {"laser_wavelength_nm", number({})};
   if (one_of({"datum", "datum position"})) return {"datum_mm", number({})};
+  if (only_known) return {"", ""};
   std::string slug;
   for (char ch : name) slug += std::isalnum(static_cast<unsigned char>(ch)) ? ch : '_';
   while (slug.find("__") != std::string::npos) slug.erase(slug.find("__"), 1);
@@ -476,8 +523,9 @@ std::string axis_letter(const std::string& value) {
   return found == "?" ? "" : found;
 }
 
-// The header row of a CARTO export and its separator: the first line whose first cell is a target
-// column; -1 when there is none in the first 200 lines.
+// The header row of a CARTO export and its separator: the first line with a target column and,
+// unless the target column comes first, a direction or run column beside it (a leading "Target
+// No." column is allowed); -1 when there is none in the first 200 lines.
 int find_carto_header(const std::vector<Line>& lines, char& delim) {
   int seen = 0;
   for (std::size_t k = 0; k < lines.size() && seen < 200; ++k) {
@@ -491,8 +539,14 @@ int find_carto_header(const std::vector<Line>& lines, char& delim) {
       } catch (const InputError&) {
         continue;
       }
-      if (cells.empty() || !is_target_name(name_and_unit(cells[0].text).first)) continue;
-      if (cells.size() > best) best = cells.size(), delim = d;
+      bool first = false, target = false, other = false;
+      for (std::size_t i = 0; i < cells.size(); ++i) {
+        const Quantity q = classify_carto(cells[i]).q;
+        first |= i == 0 && q == Quantity::Target;
+        target |= q == Quantity::Target;
+        other |= q == Quantity::Direction || q == Quantity::Deviation;
+      }
+      if ((first || (target && other)) && cells.size() > best) best = cells.size(), delim = d;
     }
     if (best > 0) return static_cast<int>(k);
   }
@@ -527,21 +581,39 @@ ImportResult parse_carto(const std::vector<Line>& lines, const std::string& file
       if (key.empty() || key.find(' ') != std::string::npos) continue;
     } else {
       const std::vector<Cell> cells = split_csv(L.text, delim, file, L.no);
-      if (cells.size() < 2 || cells[0].text.empty()) continue;  // a title line
-      key_col = cells[0].column;
-      key = cells[0].text;
-      std::vector<std::string> rest;
-      for (std::size_t i = 1; i < cells.size(); ++i)
-        if (!cells[i].text.empty()) rest.push_back(cells[i].text);
-      if (rest.empty()) continue;
-      value = rest.size() == 1 ? rest[0] : join(rest);
-      const std::string where = "'" + key + "': ";
-      try {
-        std::tie(key, value) = carto_key(key, value, where);
-      } catch (const std::invalid_argument& e) {
-        throw InputError(SourceLoc{file, L.no, cells[1].column}, e.what());
+      if (cells.size() == 1 && cells[0].text.find(':') != std::string::npos) {
+        // "Material Compensation: On" (LaserXL-style): only keys weilgen knows, so that a title
+        // line with a colon is not read as one.
+        const std::string& c = cells[0].text;
+        const std::size_t colon = c.find(':');
+        const std::string where = "'" + trim(c.substr(0, colon)) + "': ";
+        try {
+          std::tie(key, value) =
+              carto_key(trim(c.substr(0, colon)), trim(c.substr(colon + 1)), where, true);
+        } catch (const std::invalid_argument& e) {
+          throw InputError(SourceLoc{file, L.no, cells[0].column + static_cast<int>(colon) + 1},
+                           e.what());
+        }
+        if (key.empty() || trim(c.substr(colon + 1)).empty()) continue;
+        key_col = cells[0].column;
+      } else if (cells.size() < 2 || cells[0].text.empty()) {
+        continue;  // a title line
+      } else {
+        key_col = cells[0].column;
+        key = cells[0].text;
+        std::vector<std::string> rest;
+        for (std::size_t i = 1; i < cells.size(); ++i)
+          if (!cells[i].text.empty()) rest.push_back(cells[i].text);
+        if (rest.empty()) continue;
+        value = rest.size() == 1 ? rest[0] : join(rest);
+        const std::string where = "'" + key + "': ";
+        try {
+          std::tie(key, value) = carto_key(key, value, where);
+        } catch (const std::invalid_argument& e) {
+          throw InputError(SourceLoc{file, L.no, cells[1].column}, e.what());
+        }
+        if (key.empty()) continue;
       }
-      if (key.empty()) continue;
     }
     if (w.meta.header_keys.count(key))
       throw InputError(SourceLoc{file, L.no, key_col},
@@ -549,6 +621,13 @@ ImportResult parse_carto(const std::vector<Line>& lines, const std::string& file
                            std::to_string(w.meta.header_key_lines[key]) + ")");
     w.meta.header_keys[key] = value;
     w.meta.header_key_lines[key] = L.no;
+  }
+  // A laser export says whether its software corrected the material's expansion; without such a
+  // line the state is unstated, which the normalisation treats differently from weilgen's own
+  // tidy files (weilgen/measure/normalisation.hpp).
+  if (!w.meta.header_keys.count("material_compensation")) {
+    w.meta.header_keys["material_compensation"] = "unstated";
+    w.meta.header_key_lines["material_compensation"] = 0;
   }
   // The axis.
   std::string axis = o.axis;
@@ -582,6 +661,11 @@ ImportResult parse_carto(const std::vector<Line>& lines, const std::string& file
   std::vector<Conversion> conv;
   std::set<std::string> seen;
   bool has_direction = false, has_run = false;
+  int targets = 0;
+  // The unit of runs whose header gives none, from a 'Units' line.
+  const auto units_key = w.meta.header_keys.find("deviation_unit");
+  const std::string default_unit =
+      units_key == w.meta.header_keys.end() ? std::string() : units_key->second;
   for (const Cell& cell : header) {
     CartoColumn c = classify_carto(cell);
     auto fail = [&](const std::string& msg) {
@@ -600,14 +684,21 @@ ImportResult parse_carto(const std::vector<Line>& lines, const std::string& file
     try {
       switch (c.q) {
         case Quantity::Target:
+          ++targets;
           cv = target_unit(c.unit, rotary, where);
+          break;
+        case Quantity::TargetNumber:
           break;
         case Quantity::Direction:
           has_direction = true;
           break;
         case Quantity::Deviation:
           has_run = true;
-          cv = deviation_unit(c.unit, rotary, where);
+          if (c.unit.empty() && default_unit.empty())
+            throw std::invalid_argument(
+                where + "no unit: the deviations could be in um, mm or nm; write it in the " +
+                "header ('" + cell.text + " (um)') or give a 'Units,um' line before the table");
+          cv = deviation_unit(c.unit.empty() ? default_unit : c.unit, rotary, where);
           break;
         case Quantity::AirT:
         case Quantity::MaterialT:
@@ -639,8 +730,14 @@ ImportResult parse_carto(const std::vector<Line>& lines, const std::string& file
     cols.push_back(c);
     conv.push_back(cv);
   }
-  if (cols.empty() || cols[0].q != Quantity::Target)
-    throw InputError(SourceLoc{file, lines[h].no, 1}, "the first column must be the target");
+  if (targets != 1) {
+    int second = 0;
+    for (const auto& c : cols)
+      if (c.q == Quantity::Target && second++ > 0) second = c.column;
+    throw InputError(SourceLoc{file, lines[h].no, targets == 0 ? 0 : second},
+                     targets == 0 ? "no target column ('Target Position (mm)')"
+                                  : "two target columns: give one");
+  }
   if (!has_direction)
     throw InputError(SourceLoc{file, lines[h].no, 0},
                      "no Direction column: each row needs its approach direction (Forward or "
@@ -681,6 +778,9 @@ ImportResult parse_carto(const std::vector<Line>& lines, const std::string& file
       case Quantity::Time:
         tidy = "t_s";
         break;
+      case Quantity::TargetNumber:
+        res.mapping.push_back("'" + c.header + "' -> (the target's number: checked, not carried)");
+        break;
       case Quantity::Unknown:
         break;
     }
@@ -688,6 +788,7 @@ ImportResult parse_carto(const std::vector<Line>& lines, const std::string& file
     WideColumn wc;
     wc.tidy = tidy;
     wc.cycle = c.run;
+    wc.header_column = c.column;
     w.columns.push_back(wc);
     std::string m = "'" + c.header + "' -> " + tidy;
     if (c.run > 0) m += " of cycle " + std::to_string(c.run);
@@ -707,10 +808,18 @@ ImportResult parse_carto(const std::vector<Line>& lines, const std::string& file
     const std::vector<Cell> cells = split_csv(L.text, delim, file, L.no);
     std::size_t n = cells.size();
     while (n > header.size() && cells[n - 1].text.empty()) --n;  // trailing separators
-    if (n != header.size())
-      throw InputError(SourceLoc{file, L.no, 0}, std::to_string(n) + " fields, the header (line " +
-                                                     std::to_string(lines[h].no) + ") has " +
-                                                     std::to_string(header.size()));
+    if (n != header.size()) {
+      // A decimal comma in a comma-separated export splits every number in two.
+      const std::string hint =
+          delim == ',' && n > header.size()
+              ? " (decimal commas in a comma-separated file split every number: export with ';' "
+                "or a tab between the fields, or with a decimal point)"
+              : "";
+      throw InputError(SourceLoc{file, L.no, n > header.size() ? cells[header.size()].column : 0},
+                       std::to_string(n) + " fields, the header (line " +
+                           std::to_string(lines[h].no) + ") has " + std::to_string(header.size()) +
+                           hint);
+    }
     std::size_t wc = 0;
     for (std::size_t i = 0; i < cols.size(); ++i) {
       const Cell& cell = cells[i];
@@ -721,6 +830,13 @@ ImportResult parse_carto(const std::vector<Line>& lines, const std::string& file
       if (cols[i].q == Quantity::Unknown) {
         if (cols[i].header.empty() && !cell.text.empty())
           throw InputError(SourceLoc{file, L.no, cell.column}, "a value under no column name");
+        continue;
+      }
+      if (cols[i].q == Quantity::TargetNumber) {
+        double number = 0;
+        if (!cell.text.empty() &&
+            !(parse_number(cell.text, false, number) && number == std::floor(number)))
+          throw fail("'" + cell.text + "' is not a whole number");
         continue;
       }
       double v = kNaN;
@@ -864,7 +980,23 @@ ImportResult parse_instrument_text(const std::string& text, const std::string& f
   const InstrumentFormat f = o.format ? *o.format : detect_instrument_format(text);
   if (f == InstrumentFormat::Tidy) {
     ImportResult r;
-    r.table = parse_measurements(text, filename, o.read);
+    try {
+      r.table = parse_measurements(text, filename, o.read);
+    } catch (const InputError& e) {
+      // A header row without a comma is a title line: the file is likely an export whose table
+      // was not recognised, and the tidy reader's complaint about it would mislead.
+      const std::vector<Line> lines = split_lines(text);
+      const auto first = std::find_if(lines.begin(), lines.end(),
+                                      [](const Line& L) { return !blank_or_comment(L.text); });
+      if (o.format || first == lines.end() || first->no != e.loc().line ||
+          first->text.find_first_of(",;\t") != std::string::npos)
+        throw;
+      throw InputError(e.loc(), e.message() +
+                                    " (the first line is text without a separator: an instrument "
+                                    "export whose table was not found? Its header row needs a "
+                                    "target column such as 'Target Position (mm)'; --format "
+                                    "carto or wide; docs/data-format.md, 'Instrument files')");
+    }
     r.source_rows = r.table.rows();
     return r;
   }

@@ -8,6 +8,7 @@
 #include <map>
 #include <stdexcept>
 
+#include "weilgen/base/constants.hpp"
 #include "weilgen/base/format.hpp"
 #include "weilgen/base/text.hpp"
 #include "weilgen/base/units.hpp"
@@ -15,8 +16,6 @@
 namespace weilgen {
 
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 std::string mm(double v) { return format_number(v) + " mm"; }
 

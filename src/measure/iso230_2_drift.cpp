@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <tuple>
 
+#include "weilgen/base/constants.hpp"
 #include "weilgen/base/format.hpp"
 #include "weilgen/base/units.hpp"
 #include "weilgen/measure/iso230_2.hpp"
@@ -14,8 +15,6 @@
 namespace weilgen {
 
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // Within-group least-squares slope of y against u (one intercept per group) and its standard
 // error. groups[g] = {(u, y)...}.

@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <stdexcept>
 
+#include "weilgen/base/format.hpp"
 #include "weilgen/base/text.hpp"
 
 namespace weilgen {
@@ -79,11 +80,109 @@ std::vector<ToleranceCheck> check_iso_tolerance(const IsoTolerance& tol, const I
   return out;
 }
 
+const char* to_string(Decision d) {
+  switch (d) {
+    case Decision::DoesNotConform:
+      return "does not conform";
+    case Decision::NotProven:
+      return "not proven";
+    case Decision::Conforms:
+      break;
+  }
+  return "conforms";
+}
+
+std::vector<ConformanceIssue> iso230_2_conformance(const IsoRuns& runs, const IsoColumns& cols,
+                                                   const NormalisationResult& n) {
+  std::vector<ConformanceIssue> out;
+  const std::size_t m = runs.targets();
+  const bool linear = cols.unit == "um";
+  // Clause 5.3: at least five targets, and five per metre of travel up to 2000 mm (one per
+  // 250 mm beyond); a rotary axis at least five.
+  const double travel = m ? runs.positions_mm.back() - runs.positions_mm.front() : 0;
+  std::size_t needed = 5;
+  std::string rule = "at least 5";
+  if (linear && travel <= 2000) {
+    needed =
+        std::max<std::size_t>(5, static_cast<std::size_t>(std::ceil(5 * travel / 1000 - 1e-9)));
+    rule = "at least 5, and 5 per metre of travel";
+  } else if (linear) {
+    needed = static_cast<std::size_t>(std::ceil(travel / 250 - 1e-9));
+    rule = "one per 250 mm of travel beyond 2000 mm";
+  }
+  if (m < needed)
+    out.push_back({"targets", std::to_string(m) + " target" + (m == 1 ? "" : "s") + " over " +
+                                  format_number(travel) + (linear ? " mm" : " deg") +
+                                  "; ISO 230-2 asks for " + std::to_string(needed) + " (" + rule +
+                                  ")"});
+  const std::size_t up = runs.cycles[kUp].size(), down = runs.cycles[kDown].size();
+  if (up < 5 || down < 5)
+    out.push_back({"cycles", std::to_string(up) + " cycles forward and " + std::to_string(down) +
+                                 " reverse; ISO 230-2 asks for 5 in each direction"});
+  if (up == 0 || down == 0)
+    out.push_back({"bidirectional", "ISO 230-2 approaches every target from both directions"});
+  if (linear && !n.air_applied && n.air != AirCompensation::Instrument)
+    out.push_back({"air", std::string("the refractive index of the air is not compensated (") +
+                              (n.air == AirCompensation::Unstated ? "the file does not say"
+                                                                  : "stated as not compensated") +
+                              "): the readings may be off by about 271 um per metre of travel"});
+  if (linear && !n.material_applied && n.material_compensation != "instrument" &&
+      n.material_temperature_C.empty())
+    out.push_back({"temperature",
+                   "no material temperature recorded and no normalisation to 20 degC: the "
+                   "nominal differential expansion is neither corrected nor stated (ISO 230-2, "
+                   "5.3)"});
+  return out;
+}
+
+void decide_iso_tolerance(Iso230_2StudyResult& r) {
+  // Without air compensation the readings carry a scale error of about 271 um/m: the figures
+  // between targets (E, M, A, the band) prove nothing; R and B compare one target with itself.
+  bool air = false;
+  for (const ConformanceIssue& i : r.conformance) air |= i.check == "air";
+  bool fails = false, unproven = false, air_open = false;
+  std::vector<std::string> open;
+  for (ToleranceCheck& c : r.tolerance) {
+    if (std::isfinite(c.U))
+      c.decision = c.value + c.U <= c.limit  ? Decision::Conforms
+                   : c.value - c.U > c.limit ? Decision::DoesNotConform
+                                             : Decision::NotProven;
+    else
+      c.decision = c.pass ? Decision::Conforms : Decision::DoesNotConform;
+    const bool scaled =
+        c.name == "band" || c.name[0] == 'E' || c.name[0] == 'M' || c.name[0] == 'A';
+    if (air && scaled) {
+      c.decision = Decision::NotProven;
+      air_open = true;
+      continue;
+    }
+    fails |= c.decision == Decision::DoesNotConform;
+    if (c.decision == Decision::NotProven) {
+      unproven = true;
+      open.push_back(c.name);
+    }
+  }
+  r.verdict = fails                  ? Decision::DoesNotConform
+              : unproven || air_open ? Decision::NotProven
+                                     : Decision::Conforms;
+  std::vector<std::string> why;
+  if (!open.empty())
+    why.push_back(join(open) + ": the value +- U straddles the limit (ISO 14253-1)");
+  if (air_open)
+    why.push_back(
+        "the refractive index of the air is not compensated: E, M, A and the band may be off by "
+        "about 271 um per metre of travel");
+  r.verdict_reason.clear();
+  for (std::size_t k = 0; r.verdict == Decision::NotProven && k < why.size(); ++k)
+    r.verdict_reason += (k ? "; " : "") + why[k];
+}
+
 void Iso230_2StudyOptions::validate() const {
   if (!(drift.alpha > 0 && drift.alpha < 1))
     throw std::invalid_argument("--alpha must be in (0, 1)");
   if (!(target_tolerance_mm > 0)) throw std::invalid_argument("--target-tolerance must be > 0");
   normalisation.validate();
+  if (uncertainty) uncertainty->validate();
 }
 
 Iso230_2Study::Iso230_2Study(Iso230_2StudyOptions options) : options_(std::move(options)) {
@@ -98,15 +197,29 @@ Iso230_2StudyResult Iso230_2Study::run(const MeasurementTable& table) const {
   r.normalisation = normalise_observations(
       table, obs, normalisation_with_header_keys(options_.normalisation, table), r.columns.unit);
   r.runs = group_iso_runs(obs, table.file, options_.target_tolerance_mm);
-  r.classical = Iso230_2Evaluation().run(r.runs);
-  if (r.runs.targets() >= 2) {
+  r.iso_only = options_.iso_only;
+  Iso230_2Options classical;
+  classical.student = !options_.iso_only;
+  r.classical = Iso230_2Evaluation(classical).run(r.runs);
+  if (r.runs.targets() >= 2 && !options_.iso_only) {
     DriftOptions d = options_.drift;
     d.tolerance_mm = options_.target_tolerance_mm;
     r.drift = DriftElimination(d).run(r.runs);
   } else if (options_.drift.reference_position_mm || options_.drift.reference_cycle) {
-    throw std::invalid_argument("--reference-position/--reference-cycle need >= 2 targets");
+    throw std::invalid_argument(
+        options_.iso_only ? "--reference-position/--reference-cycle: --iso-only has no drift "
+                            "elimination"
+                          : "--reference-position/--reference-cycle need >= 2 targets");
   }
+  if (options_.uncertainty)
+    r.uncertainty = Iso230_2Uncertainty(*options_.uncertainty)
+                        .run(r.runs, r.classical.figures, r.normalisation, r.columns.unit);
   r.tolerance = check_iso_tolerance(options_.tolerance, r.classical.figures);
+  if (r.uncertainty)
+    for (ToleranceCheck& c : r.tolerance)
+      if (const FigureUncertainty* f = r.uncertainty->figure(c.name)) c.U = f->U;
+  r.conformance = iso230_2_conformance(r.runs, r.columns, r.normalisation);
+  decide_iso_tolerance(r);
   return r;
 }
 

@@ -6,14 +6,13 @@
 #include <limits>
 
 #include "weilgen/base/atomic_file.hpp"
+#include "weilgen/base/constants.hpp"
 #include "weilgen/base/format.hpp"
 #include "weilgen/base/text.hpp"
 
 namespace weilgen {
 
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 bool is_ident_char(char c) {
   return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_';
@@ -167,6 +166,11 @@ SourceLoc MeasurementTable::cell(std::size_t row, const std::string& name) const
   return at;
 }
 
+SourceLoc MeasurementTable::header_cell(const std::string& name) const {
+  const auto it = header_columns.find(name);
+  return SourceLoc{file, header_line, it == header_columns.end() ? 0 : it->second};
+}
+
 const ColumnInfo& MeasurementTable::info_of(const std::string& name) const {
   for (std::size_t i = 0; i < columns.size(); ++i)
     if (columns[i] == name) return info[i];
@@ -200,7 +204,7 @@ void check_radians(const MeasurementTable& t, std::size_t c, double min, double 
                    std::vector<std::string>& warnings) {
   const std::string& name = t.columns[c];
   const std::vector<double>& v = t.values.at(name);
-  constexpr double kPi = 3.14159265358979323846, kDeg = 180 / kPi;
+  constexpr double kDeg = 180 / kPi;
   if (max - min < 90) return;
   std::vector<double> seen;
   std::size_t at = 0;  // the row of the largest magnitude
@@ -376,6 +380,7 @@ MeasurementTable parse_measurements(const std::string& text, const std::string& 
         t.columns.push_back(name);
         t.info.push_back(std::move(info));
         t.values[name];
+        t.header_columns[name] = fields[i].column;
       }
       if (!unknown.empty() && !options.allow_unknown)
         throw fail(line_no, 0,

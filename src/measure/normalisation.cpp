@@ -6,6 +6,7 @@
 #include <functional>
 #include <stdexcept>
 
+#include "weilgen/base/constants.hpp"
 #include "weilgen/base/error.hpp"
 #include "weilgen/base/format.hpp"
 #include "weilgen/base/text.hpp"
@@ -13,8 +14,6 @@
 namespace weilgen {
 
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 struct Limits {
   double lo, hi;
@@ -85,6 +84,7 @@ class SourceReader {
     }
   }
   bool known() const { return source_.given(); }
+  const std::vector<std::string>& columns() const { return source_.columns; }
   double at(std::size_t row) const {
     if (source_.value) return *source_.value;
     if (row >= table_.rows()) return kNaN;
@@ -137,6 +137,185 @@ EnvironmentSource resolve(const EnvironmentSource& given, const MeasurementTable
   return s;
 }
 
+// "file:line" of a header key, or the file alone when the import wrote the key.
+std::string key_place(const MeasurementTable& t, int line) {
+  return line > 0 ? t.file + ":" + std::to_string(line) : t.file;
+}
+
+// Whether weilgen corrects the material's expansion, and why (docs/iso230-2.md, "Instrument
+// compensation state").
+void decide_material(const NormalisationOptions& o, const MeasurementTable& t,
+                     NormalisationResult& r) {
+  const std::string& state = o.material_compensation;
+  const std::string place = key_place(t, o.material_compensation_line);
+  if (!o.expansion_ppm_per_K) {
+    r.material_decision =
+        state == "instrument"
+            ? place + " says material_compensation: instrument"
+            : "no expansion coefficient (--expansion or the header key expansion_ppm_per_K)";
+    return;
+  }
+  const double alpha = *o.expansion_ppm_per_K;
+  const bool flag = r.expansion_origin.rfind("header", 0) != 0;
+  const std::string alpha_text = format_number(alpha) + " um/(m K) (" + r.expansion_origin + ")";
+  if (alpha == 0) {
+    r.material_decision =
+        "expansion coefficient 0 (" + r.expansion_origin + "): no expansion correction";
+    return;
+  }
+  switch (o.mode) {
+    case NormaliseMode::Never:
+      if (flag)
+        throw std::invalid_argument("--expansion " + format_number(alpha) +
+                                    ": --normalise never applies no correction; drop one of them");
+      r.material_decision = "not corrected (alpha " + alpha_text + ")";
+      return;
+    case NormaliseMode::Force:
+      r.material_applied = true;
+      r.material_decision =
+          "corrected with alpha " + alpha_text +
+          (state == "instrument"
+               ? ", although " + place + " says the instrument already corrected the material"
+               : std::string());
+      return;
+    case NormaliseMode::Auto:
+      break;
+  }
+  if (state == "instrument") {
+    if (flag)
+      throw std::invalid_argument(
+          "--expansion " + format_number(alpha) + ": " + place +
+          " says the instrument already corrected the readings to 20 degC "
+          "(material_compensation: instrument); a second correction doubles it (" +
+          format_number(alpha) + " um/m per K); --normalise force applies it anyway");
+    r.material_decision = place + " says material_compensation: instrument (alpha " + alpha_text +
+                          "); not corrected again";
+  } else if (state == "none") {
+    r.material_applied = true;
+    r.material_decision =
+        place + " says material_compensation: none; corrected with alpha " + alpha_text;
+  } else if (state == "unstated" && !flag) {
+    r.material_decision =
+        "the file gives alpha " + alpha_text +
+        " but not whether the instrument applied it; a laser export's coefficient is the one its "
+        "material compensation uses, so weilgen does not correct again (--normalise force "
+        "corrects; a 'Material Compensation,Off' line says the instrument did not)";
+  } else {
+    r.material_applied = true;
+    r.material_decision =
+        "corrected with alpha " + alpha_text +
+        (state == "unstated" ? "; the file does not say whether the instrument corrected it"
+                             : std::string());
+  }
+}
+
+// Whether weilgen corrects the air's refractive index, and why. `force` lifts the refusal of a
+// correction the file says the instrument applied; it corrects nothing nobody asked for.
+void decide_air(const NormalisationOptions& o, const MeasurementTable& t, bool values_known,
+                NormalisationResult& r) {
+  const bool flag = o.air != AirCompensation::Unstated && o.air_origin.rfind("header", 0) != 0;
+  const std::string place = key_place(t, o.air_in_file_line);
+  const std::string in_file = std::string("air_compensation: ") + to_string(o.air_in_file);
+  const bool twice = o.air_in_file == AirCompensation::Instrument;
+  auto apply = [&](const std::string& why) {
+    r.air_applied = true;
+    r.air = AirCompensation::Edlen;
+    r.air_decision = why;
+  };
+  if (o.mode == NormaliseMode::Never) {
+    if (flag && o.air == AirCompensation::Edlen)
+      throw std::invalid_argument(
+          "--air-compensation edlen: --normalise never applies no correction; drop one of them");
+    r.air_decision = "--normalise never";
+    return;
+  }
+  if (flag) {
+    if (o.air == AirCompensation::Edlen) {
+      if (twice && o.mode == NormaliseMode::Auto)
+        throw std::invalid_argument(
+            "--air-compensation edlen: " + place +
+            " says the instrument already compensated the air (" + in_file +
+            "); a second correction doubles it (about 271 um/m); --normalise force applies it "
+            "anyway");
+      apply("--air-compensation edlen" + (twice ? ", --normalise force: although " + place +
+                                                      " says the instrument already compensated it"
+                                                : std::string()));
+      return;
+    }
+    r.air_decision = std::string("--air-compensation ") + to_string(o.air);
+    return;
+  }
+  switch (o.air_in_file) {
+    case AirCompensation::Instrument:
+      r.air_decision = place + " says " + in_file;
+      return;
+    case AirCompensation::Edlen:
+      apply("header key air_compensation: edlen (" + place + ")");
+      return;
+    case AirCompensation::None:
+      if (values_known) {
+        apply(place + " says " + in_file + "; corrected from the recorded air values");
+        return;
+      }
+      r.air_decision = place + " says " + in_file +
+                       " and the file records no air temperature, pressure and " + "humidity";
+      return;
+    case AirCompensation::Unstated:
+      break;
+  }
+  r.air_decision = "the file does not say whether the instrument compensated the air";
+}
+
+// Sensors that disagree with their siblings by more than 5 K (a degF column taken as degC, a
+// sensor off the machine), and temperatures far from a test's 20 degC: warnings naming the
+// column's header cell.
+void check_sensors(const MeasurementTable& t, const std::vector<IsoObservation>& obs,
+                   const SourceReader& source, const std::string& what,
+                   std::vector<std::string>& warnings) {
+  const std::vector<std::string>& cols = source.columns();
+  std::vector<double> means;
+  for (const std::string& c : cols) {
+    double sum = 0;
+    int n = 0;
+    for (const auto& x : obs)
+      if (x.row < t.rows() && std::isfinite(t.column(c)[x.row])) sum += t.column(c)[x.row], ++n;
+    means.push_back(n ? sum / n : kNaN);
+  }
+  auto cell = [&](std::size_t i) { return t.header_cell(cols[i]).str(); };
+  if (cols.size() == 2 && std::abs(means[0] - means[1]) > 5) {
+    warnings.push_back(cell(1) + ": " + what + " sensors '" + cols[0] + "' and '" + cols[1] +
+                       "' differ by " + format_fixed(std::abs(means[0] - means[1]), 1) +
+                       " K on average (" + format_fixed(means[0], 1) + " and " +
+                       format_fixed(means[1], 1) +
+                       " degC): check their units and placement; their mean is used");
+    return;
+  }
+  std::vector<double> finite;
+  for (double m : means)
+    if (std::isfinite(m)) finite.push_back(m);
+  std::sort(finite.begin(), finite.end());
+  const std::size_t h = finite.size() / 2;
+  const double median = finite.empty()      ? kNaN
+                        : finite.size() % 2 ? finite[h]
+                                            : 0.5 * (finite[h - 1] + finite[h]);
+  for (std::size_t i = 0; cols.size() > 2 && i < cols.size(); ++i)
+    if (std::abs(means[i] - median) > 5)
+      warnings.push_back(cell(i) + ": " + what + " sensor '" + cols[i] + "' reads " +
+                         format_fixed(means[i], 1) + " degC on average beside " +
+                         format_fixed(median, 1) + " degC, the median of the " + what +
+                         " sensors: check its unit (degF read as degC?); it pulls the mean used "
+                         "for the correction");
+  if (cols.empty()) return;
+  double sum = 0;
+  int n = 0;
+  for (double m : means)
+    if (std::isfinite(m)) sum += m, ++n;
+  if (n && (sum / n < 10 || sum / n > 35))
+    warnings.push_back(t.header_cell(cols[0]).str() + ": the " + what + " temperature reads " +
+                       format_fixed(sum / n, 1) +
+                       " degC on average, far from a test's 20 degC: check the unit");
+}
+
 }  // namespace
 
 const char* to_string(AirCompensation mode) {
@@ -151,6 +330,28 @@ const char* to_string(AirCompensation mode) {
       break;
   }
   return "unstated";
+}
+
+const char* to_string(NormaliseMode mode) {
+  switch (mode) {
+    case NormaliseMode::Force:
+      return "force";
+    case NormaliseMode::Never:
+      return "never";
+    case NormaliseMode::Auto:
+      break;
+  }
+  return "auto";
+}
+
+NormaliseMode parse_normalise_mode(const std::string& text) {
+  const std::string t = lower(trim(text));
+  if (t == "auto") return NormaliseMode::Auto;
+  if (t == "force") return NormaliseMode::Force;
+  if (t == "never") return NormaliseMode::Never;
+  throw std::invalid_argument("--normalise " + text +
+                              ": expected auto (never a correction the file says the instrument "
+                              "applied), force (every correction the data allow) or never");
 }
 
 AirCompensation parse_air_compensation(const std::string& text, const std::string& what) {
@@ -244,14 +445,31 @@ NormalisationOptions normalisation_with_header_keys(NormalisationOptions o,
     check_value(x, lo, hi, unit, "header key " + key);
     return x;
   };
+  if (o.expansion_ppm_per_K && o.expansion_origin.empty()) o.expansion_origin = "--expansion";
   if (!o.expansion_ppm_per_K)
     key_of("expansion_ppm_per_K", [&](const std::string& v) {
       o.expansion_ppm_per_K = number("expansion_ppm_per_K", v, -10, 100, "ppm/K");
+      o.expansion_origin = "header key expansion_ppm_per_K";
     });
-  if (o.air == AirCompensation::Unstated)
-    key_of("air_compensation", [&](const std::string& v) {
-      o.air = parse_air_compensation(v, "header key air_compensation");
-    });
+  key_of("material_compensation", [&](const std::string& v) {
+    const std::string state = lower(trim(v));
+    if (state != "instrument" && state != "none" && state != "unstated")
+      throw std::invalid_argument("header key material_compensation: '" + v +
+                                  "' (expected instrument: the instrument corrected the "
+                                  "readings to 20 degC; none: it did not; unstated)");
+    o.material_compensation = state;
+    o.material_compensation_line = t.header_key_lines.at("material_compensation");
+  });
+  if (o.air != AirCompensation::Unstated && o.air_origin.empty())
+    o.air_origin = "--air-compensation";
+  key_of("air_compensation", [&](const std::string& v) {
+    o.air_in_file = parse_air_compensation(v, "header key air_compensation");
+    o.air_in_file_line = t.header_key_lines.at("air_compensation");
+  });
+  if (o.air == AirCompensation::Unstated && o.air_in_file != AirCompensation::Unstated) {
+    o.air = o.air_in_file;
+    o.air_origin = "header key air_compensation";
+  }
   if (!o.wavelength_nm)
     key_of("laser_wavelength_nm", [&](const std::string& v) {
       o.wavelength_nm =
@@ -293,17 +511,17 @@ NormalisationResult normalise_observations(const MeasurementTable& table,
                                            std::vector<IsoObservation>& obs,
                                            const NormalisationOptions& o, const std::string& unit) {
   NormalisationResult r;
+  r.mode = o.mode;
   r.reference_temperature_C = o.reference_temperature_C;
+  r.material_compensation = o.material_compensation;
   r.air = o.air;
-  r.air_applied = o.air == AirCompensation::Edlen;
+  r.air_in_file = o.air_in_file;
   r.wavelength_nm = o.wavelength_nm.value_or(kHeNeWavelength_nm);
   r.assumed_index = o.assumed_index.value_or(1.0);
   r.expansion_ppm_per_K = o.expansion_ppm_per_K.value_or(kNaN);
+  if (o.expansion_ppm_per_K)
+    r.expansion_origin = o.expansion_origin.empty() ? "--expansion" : o.expansion_origin;
   r.correction_um.assign(obs.size(), 0.0);
-  if (obs.empty()) return r;
-  double lowest = obs[0].position_mm;
-  for (const auto& x : obs) lowest = std::min(lowest, x.position_mm);
-  r.datum_mm = o.datum_mm.value_or(lowest);
 
   const SourceReader material(table,
                               resolve(o.material_temperature, table, [](const std::string& c) {
@@ -315,7 +533,12 @@ NormalisationResult normalise_observations(const MeasurementTable& table,
       table, resolve(o.air_pressure, table, [](const std::string& c) { return c == "p_air_Pa"; }));
   const SourceReader air_h(table, resolve(o.air_humidity, table,
                                           [](const std::string& c) { return c == "RH_air_pct"; }));
-  r.material_applied = o.expansion_ppm_per_K.has_value();
+  decide_material(o, table, r);
+  decide_air(o, table, air_t.known() && air_p.known() && air_h.known(), r);
+  if (obs.empty()) return r;
+  double lowest = obs[0].position_mm;
+  for (const auto& x : obs) lowest = std::min(lowest, x.position_mm);
+  r.datum_mm = o.datum_mm.value_or(lowest);
   if (r.material_applied && !material.known())
     throw InputError(SourceLoc{table.file, table.header_line, 0},
                      "an expansion coefficient is given but no material temperature: add a "
@@ -326,8 +549,8 @@ NormalisationResult normalise_observations(const MeasurementTable& table,
         {&air_t, "temperature: a column T_air, --air-temperature or header key air_temperature_C"},
         {&air_p, "pressure: a column p_air_Pa, --air-pressure or header key air_pressure_Pa"},
         {&air_h, "humidity: a column RH_air_pct, --air-humidity or header key air_humidity_pct"}};
-    for (const auto& [s, what] : need)
-      if (!s->known())
+    for (const auto& [src, what] : need)
+      if (!src->known())
         throw InputError(SourceLoc{table.file, table.header_line, 0},
                          std::string("air compensation 'edlen' needs the air ") + what);
   }
@@ -340,6 +563,8 @@ NormalisationResult normalise_observations(const MeasurementTable& table,
   if (air_t.known()) r.air_temperature_source = air_t.describe();
   if (air_p.known()) r.air_pressure_source = air_p.describe();
   if (air_h.known()) r.air_humidity_source = air_h.describe();
+  check_sensors(table, obs, material, "material", r.warnings);
+  check_sensors(table, obs, air_t, "air", r.warnings);
 
   const Limits lm = limits_of(EnvironmentQuantity::MaterialTemperature);
   const Limits lt = limits_of(EnvironmentQuantity::AirTemperature);
@@ -365,6 +590,13 @@ NormalisationResult normalise_observations(const MeasurementTable& table,
       const double tm = material.needed(row, lm, "material temperature");
       material_um = -*o.expansion_ppm_per_K * (tm - r.reference_temperature_C) *
                     (reading_mm + air_um * 1e-3) * 1e-3;
+    }
+    if (has_row && !r.air_applied && air_t.known() && air_p.known() && air_h.known()) {
+      // The index of the recorded air, for the statements and the uncertainty budget.
+      const AirConditions air{air_t.at(row), air_p.at(row), air_h.at(row)};
+      if (air.temperature_C >= lt.lo && air.temperature_C <= lt.hi && air.pressure_Pa >= lp.lo &&
+          air.pressure_Pa <= lp.hi && air.humidity_pct >= lh.lo && air.humidity_pct <= lh.hi)
+        r.air_refractivity.add(air_refractivity(air, r.wavelength_nm));
     }
     if (has_row) {
       if (material.known()) r.material_temperature_C.add(material.at(row));

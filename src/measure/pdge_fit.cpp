@@ -10,10 +10,11 @@
 #include <map>
 #include <stdexcept>
 
+#include "weilgen/base/constants.hpp"
+
 namespace weilgen {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
 using Rows = std::vector<std::size_t>;
 
 std::string num(double v, int digits = 6) {

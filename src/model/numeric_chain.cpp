@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "weilgen/base/constants.hpp"
 #include "weilgen/machine/derived.hpp"
 
 namespace weilgen {
@@ -64,7 +65,7 @@ Eigen::Matrix4d NumericChain::body_transform(int body, const std::vector<double>
   for (int i = 0; i < 3; ++i) t[i] = b.offset.translation[i].eval(params_);
   Eigen::Matrix4d m = translation(t);
   for (const auto& r : b.offset.rotations)
-    m = m * rotation(vec(r.axis), r.angle_deg.eval(params_) * M_PI / 180.0);
+    m = m * rotation(vec(r.axis), r.angle_deg.eval(params_) * kPi / 180.0);
 
   Eigen::Matrix4d joint = Eigen::Matrix4d::Identity();
   if (b.joint.type != JointType::Fixed) {

@@ -3,11 +3,14 @@
 // documents are the ones the verbs use.
 #include "binding.hpp"
 #include "weilgen/analysis/axis_comp_table.hpp"
+#include "weilgen/analysis/ballbar_request.hpp"
 #include "weilgen/analysis/gap_request.hpp"
 #include "weilgen/analysis/identify_request.hpp"
 #include "weilgen/base/atomic_file.hpp"
+#include "weilgen/measure/instrument_import.hpp"
 #include "weilgen/measure/iso230_2_study.hpp"
 #include "weilgen/measure/pdge_fit_study.hpp"
+#include "weilgen/report/ballbar_document.hpp"
 #include "weilgen/report/comp_table_document.hpp"
 #include "weilgen/report/gap_document.hpp"
 #include "weilgen/report/identify_document.hpp"
@@ -28,12 +31,9 @@ std::vector<const char*> with_model(std::initializer_list<const char*> own) {
   return v;
 }
 
-// The keywords identify and gap share: the machine and model keywords, --allow-unknown and the
-// circle --plane --centre --radius --feed (centre also as a dict: {"X": 250, "Y": 0}); the
-// readers' warnings go to `messages`.
-void measurement_keywords(py::handle machine, const Keywords& kw, MeasurementRequest& rq,
-                          Messages& messages) {
-  model_request(machine, kw, rq.model, rq.opened);
+// The ballbar circle --plane --centre --radius --feed (centre also as a dict: {"X": 250,
+// "Y": 0}), --allow-unknown, and the readers' warnings to `messages`.
+void circle_keywords(const Keywords& kw, MeasurementRequest& rq, Messages& messages) {
   rq.allow_unknown = kw.flag("allow_unknown");
   kw.set("plane", rq.circle.plane);
   const std::vector<std::string> centre = kw.items("centre", true);
@@ -41,6 +41,13 @@ void measurement_keywords(py::handle machine, const Keywords& kw, MeasurementReq
   kw.set("radius", rq.circle.radius);
   kw.set("feed", rq.circle.feed);
   rq.warn = messages.warn();
+}
+
+// The keywords identify and gap share: the machine and model keywords and circle_keywords.
+void measurement_keywords(py::handle machine, const Keywords& kw, MeasurementRequest& rq,
+                          Messages& messages) {
+  model_request(machine, kw, rq.model, rq.opened);
+  circle_keywords(kw, rq, messages);
 }
 
 // --comp-table FILE and its flags (docs/controllers.md), checked like the CLI checks them:
@@ -80,10 +87,10 @@ std::string data_path(py::handle data, const char* what) {
 }
 
 py::object iso230_2(py::handle data, const py::kwargs& kwargs) {
-  const Keywords kw(
-      "iso230_2", kwargs,
-      {"axis", "column", "reference_position", "reference_cycle", "alpha", "target_tolerance",
-       "allow_unknown", "plot", "comp_table", "comp_type", "comp_units", "comp_source"});
+  const Keywords kw("iso230_2", kwargs,
+                    {"axis", "column", "reference_position", "reference_cycle", "alpha",
+                     "target_tolerance", "allow_unknown", "plot", "comp_table", "comp_type",
+                     "comp_units", "comp_source", "normalise", "iso_only", "uncertainty"});
   const std::string path = data_path(data, "data file");
   Iso230_2StudyOptions so;
   kw.set("axis", so.axis);
@@ -92,24 +99,34 @@ py::object iso230_2(py::handle data, const py::kwargs& kwargs) {
   kw.set("target_tolerance", so.target_tolerance_mm);
   if (auto p = kw.number("reference_position")) so.drift.reference_position_mm = *p;
   if (auto c = kw.integer("reference_cycle")) so.drift.reference_cycle = *c;
+  // --normalise, --iso-only, --uncertainty (issue 29's flags).
+  std::string normalise, uncertainty;
+  kw.set("normalise", normalise);
+  if (!normalise.empty()) so.normalisation.mode = parse_normalise_mode(normalise);
+  so.iso_only = kw.flag("iso_only");
+  kw.set("uncertainty", uncertainty);
+  if (!uncertainty.empty()) so.uncertainty = uncertainty_budget_from_flag(uncertainty);
   const Iso230_2Study study(so);  // validates
-  ReadOptions ro;
-  ro.allow_unknown = kw.flag("allow_unknown");
+  // Laser exports too (format auto, as the CLI's default): their compensation state counts.
+  ImportOptions io;
+  io.read.allow_unknown = kw.flag("allow_unknown");
+  io.axis = so.axis;
   std::string plot;
   kw.set("plot", plot);
   if (!plot.empty()) check_plot_target(plot);
   const CompTableCall comp(kw, false, {{"data file", path}});
   Messages messages(true);
   const nlohmann::json doc = without_gil([&] {
-    const MeasurementTable table = read_measurements(path, ro);
-    for (const auto& w : table.warnings) messages.warn()(w);
-    const Iso230_2StudyResult r = study.run(table);
+    const ImportResult imported = read_instrument_file(path, io);
+    for (const auto& w : imported.table.warnings) messages.warn()(w);
+    const Iso230_2StudyResult r = study.run(imported.table);
+    for (const auto& w : r.normalisation.warnings) messages.warn()(w);
     const CompTable comp_table =
         comp.path.empty() ? CompTable{} : comp_table_from_iso(r, comp.options.table);
     if (!plot.empty())
       write_plot(plot, iso230_2_panels(r), "ISO 230-2, " + r.columns.axis + ": " + path);
     comp.write(comp_table);
-    return iso230_2_json(path, r);
+    return iso230_2_json(path, r, to_string(imported.format));
   });
   messages.issue();
   return to_python(doc);
@@ -220,14 +237,60 @@ py::object gap(py::handle machine, const py::kwargs& kwargs) {
 
 }  // namespace
 
+// weilgen ballbar (issue 29): a trace on its own, or through a machine's model (machine=).
+py::object ballbar(py::handle trace, const py::kwargs& kwargs) {
+  std::vector<const char*> names = {"machine", "feedrate", "alpha",  "min_contribution",
+                                    "pdge",    "plot",     "report", "plane",
+                                    "centre",  "radius",   "feed",   "allow_unknown"};
+  for (const char* k : model_keywords()) names.push_back(k);
+  const Keywords kw("ballbar", kwargs, names);
+  BallbarRequest rq;
+  Messages messages(kw.flag("quiet"));
+  rq.trace = data_path(trace, "trace file");
+  if (kwargs.contains("machine") && !kwargs["machine"].is_none()) {
+    model_request(kwargs["machine"], kw, rq.model, rq.opened);
+  } else {
+    for (const char* k : {"order", "engine", "compiler", "param", "pdge"})
+      if (kw.given(k))
+        throw std::invalid_argument(kw.flag_name(k) + ": the model's terms need machine=");
+    rq.model.log = messages.log();
+  }
+  circle_keywords(kw, rq, messages);
+  kw.set("feedrate", rq.feedrate);
+  kw.set("alpha", rq.alpha);
+  kw.set("min_contribution", rq.min_contribution_um);
+  if (kw.given("pdge")) rq.pdge = kw.items("pdge", false);
+  std::string plot, report;
+  kw.set("plot", plot);
+  kw.set("report", report);
+  rq.validate();
+  rq.check_outputs("", plot, report);
+  const nlohmann::json doc = without_gil([&] {
+    const BallbarStudy st = run_ballbar(rq);
+    if (!plot.empty()) write_file_atomically(plot, ballbar_polar_svg(st));
+    if (!report.empty()) write_file_atomically(report, ballbar_html(st));
+    return ballbar_json(st);
+  });
+  messages.issue();
+  return to_python(doc);
+}
+
 void register_data_functions(py::module_& m) {
   m.def("iso230_2", &iso230_2, py::arg("data"),
         R"doc(weilgen iso230-2: ISO 230-2 positioning figures of one axis, with the
 thermal-drift-eliminated evaluation.
 
 iso230_2(data, *, axis, column, reference_position, reference_cycle, alpha, target_tolerance,
-         allow_unknown, plot, comp_table, comp_type, comp_units, comp_source) -> dict: the document `weilgen iso230-2 --json` writes
+         allow_unknown, plot, comp_table, comp_type, comp_units, comp_source, normalise,
+         iso_only, uncertainty) -> dict: the document `weilgen iso230-2 --json` writes
 (docs/iso230-2.md). None: the CLI's default.)doc");
+  m.def("ballbar", &ballbar, py::arg("trace"),
+        R"doc(weilgen ballbar: a ballbar trace on its own — ISO 230-4 G (least-squares and minimum
+zone), F, H per run, and the usual causes fitted on the trace and ranked.
+
+ballbar(trace, *, radius, plane, centre, feed, feedrate, alpha, min_contribution, plot, report,
+        allow_unknown, machine, pdge, order, engine, compiler, param, quiet) -> dict: the
+document `weilgen ballbar --json` writes (docs/ballbar.md). plot= an .svg, report= an .html.)doc");
   m.def("fit_pdge", &fit_pdge, py::arg("data"),
         R"doc(weilgen fit-pdge: fits of position-dependent errors, order by cross-validation.
 

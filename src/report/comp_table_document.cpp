@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <sstream>
 
+#include "weilgen/base/constants.hpp"
 #include "weilgen/base/format.hpp"
 
 namespace weilgen {
@@ -22,8 +23,7 @@ std::string linuxcnc_comp_file(const CompTable& table, int type) {
 std::string comp_table_text(const CompTable& table, int type, const std::string& path) {
   const bool angle = table.unit == "deg";
   // Deviations in µm (µrad for an angle: deg -> µrad), the scale of the data.
-  const double to_micro =
-      angle ? 3.14159265358979323846 / 180.0 * 1e6 : (table.unit == "inch" ? 25.4e3 : 1e3);
+  const double to_micro = angle ? kPi / 180.0 * 1e6 : (table.unit == "inch" ? 25.4e3 : 1e3);
   const auto range = [&](const std::vector<double>& v) {
     const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
     return format_fixed(*lo * to_micro, 3) + " .. " + format_fixed(*hi * to_micro, 3);

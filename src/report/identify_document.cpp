@@ -13,7 +13,6 @@
 namespace weilgen {
 
 namespace {
-std::string fmt(double v, int precision = 3) { return format_significant(v, precision); }
 // "_um" or "_urad": the JSON key suffix of an observation kind's figures.
 std::string unit_suffix(std::size_t kind) {
   return std::string(observation_unit(kind)) == "µrad" ? "_urad" : "_um";
@@ -113,27 +112,28 @@ std::string identify_text(const Model& model, const ErrorParameterisation& param
   for (const auto& [k, n] : kinds) os << (first ? "" : ", ") << n << " " << k, first = false;
   os << ")";
   if (r.free_parameters < param.size()) os << ", " << param.size() - r.free_parameters << " fixed";
-  os << "\nrank " << r.rank << " of " << r.free_parameters << " (condition " << fmt(r.condition)
-     << ")";
+  os << "\nrank " << r.rank << " of " << r.free_parameters << " (condition "
+     << format_significant(r.condition, 3) << ")";
   if (!r.unidentifiable.empty())
     os << ": " << r.unidentifiable.size() << " combination"
        << (r.unidentifiable.size() > 1 ? "s" : "") << " not identifiable (below)";
-  os << "\nresidual sigma " << fmt(r.residual_sigma) << " (µm, µrad as measured)";
+  os << "\nresidual sigma " << format_significant(r.residual_sigma, 3) << " (µm, µrad as measured)";
   if (r.gauss_newton_iterations) os << ", " << r.gauss_newton_iterations << " Gauss-Newton steps";
   os << "\n\noutput  rms before  rms after  max after\n";
   for (std::size_t u = 0; u < kObservationKinds; ++u) {
     if (!r.count[u]) continue;
     os << std::left << std::setw(8) << observation_name(u) << std::right << std::setw(10)
-       << fmt(r.rms_before[u]) << std::setw(11) << fmt(r.rms_after[u]) << std::setw(11)
-       << fmt(r.max_after[u]) << "  " << observation_unit(u) << "\n";
+       << format_significant(r.rms_before[u], 3) << std::setw(11)
+       << format_significant(r.rms_after[u], 3) << std::setw(11)
+       << format_significant(r.max_after[u], 3) << "  " << observation_unit(u) << "\n";
   }
   os << "\nparameter" << std::string(16, ' ') << "value      ± s.e.  unit\n";
   for (std::size_t p = 0; p < param.size(); ++p) {
     const IdentParameter& ip = param.parameters()[p];
     os << std::left << std::setw(24) << ip.label << std::right << std::setw(10)
-       << (r.fixed[p] ? "fixed" : fmt(r.theta[p], 4)) << std::setw(10)
-       << (r.identifiable[p] ? fmt(r.standard_error[p], 2) : std::string("n.i.")) << "  " << ip.unit
-       << "\n";
+       << (r.fixed[p] ? "fixed" : format_significant(r.theta[p], 4)) << std::setw(10)
+       << (r.identifiable[p] ? format_significant(r.standard_error[p], 2) : std::string("n.i."))
+       << "  " << ip.unit << "\n";
   }
   if (!r.unidentifiable.empty()) {
     os << "\nNot identifiable from these data (n.i.): adding any multiple of a combination "

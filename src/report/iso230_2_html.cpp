@@ -4,7 +4,9 @@
 #include <cmath>
 #include <set>
 #include <sstream>
+#include <tuple>
 
+#include "html_page.hpp"
 #include "weilgen/base/format.hpp"
 #include "weilgen/base/version.hpp"
 #include "weilgen/report/iso230_2_document.hpp"
@@ -18,48 +20,15 @@ const char* const kUpColour = "#1f77b4";    // forward (↑)
 const char* const kDownColour = "#d62728";  // reverse (↓)
 
 std::string h(const std::string& s) { return xml_escape(s); }
-std::string num(double v, int decimals = 3) { return format_fixed(v, decimals); }
-
-bool word_char(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }
-
-// The ASCII units of the shared statements in print: um -> µm, urad -> µrad, degC -> °C,
-// +- -> ±, alpha -> α, ".." -> "…" (whole words only).
-std::string pretty(const std::string& s) {
-  static const std::pair<const char*, const char*> words[] = {{"um", "\xC2\xB5m"},
-                                                              {"urad", "\xC2\xB5rad"},
-                                                              {"degC",
-                                                               "\xC2\xB0"
-                                                               "C"},
-                                                              {"alpha", "\xCE\xB1"}};
-  std::string out;
-  for (std::size_t i = 0; i < s.size();) {
-    bool done = false;
-    for (const auto& [from, to] : words) {
-      const std::size_t n = std::char_traits<char>::length(from);
-      if (s.compare(i, n, from) == 0 &&
-          (i == 0 || !std::isalpha(static_cast<unsigned char>(s[i - 1]))) &&
-          (i + n >= s.size() || !word_char(s[i + n]))) {
-        out += to;
-        i += n;
-        done = true;
-        break;
-      }
-    }
-    if (done) continue;
-    if (s.compare(i, 2, "+-") == 0) {
-      out += "\xC2\xB1";
-      i += 2;
-    } else if (s.compare(i, 4, " .. ") == 0) {
-      out += " \xE2\x80\xA6 ";
-      i += 4;
-    } else {
-      out += s[i++];
-    }
-  }
-  return out;
-}
 
 std::string unit_html(const std::string& u) { return pretty(u); }
+
+std::string decision_class(Decision d) {
+  return d == Decision::Conforms ? "pass" : d == Decision::DoesNotConform ? "fail" : "open";
+}
+std::string decision_text(Decision d) {
+  return d == Decision::Conforms ? "PASS" : d == Decision::DoesNotConform ? "FAIL" : "NOT PROVEN";
+}
 
 // One figures table (bidirectional, forward, reverse) with data attributes naming the JSON keys.
 std::string figures_table(const IsoFigures& F, const std::string& set, const std::string& u,
@@ -90,14 +59,14 @@ std::string figures_table(const IsoFigures& F, const std::string& set, const std
     if (!checks || !key) return "";
     for (const auto& c : *checks)
       if (c.name == key)
-        return " <span class=\"" + std::string(c.pass ? "pass" : "fail") + "\">" +
+        return " <span class=\"" + decision_class(c.decision) + "\">" +
                (c.pass ? "\xE2\x89\xA4 " : "&gt; ") + format_number(c.limit) + "</span>";
     return "";
   };
   auto cell = [&](const char* key, double IsoFigures::*f) {
     if (!key) return std::string("<td class=\"num na\">\xE2\x80\x93</td>");
     return "<td class=\"num\"><span data-set=\"" + set + "\" data-key=\"" + key + "_um\">" +
-           num(F.*f) + "</span>" + limit_of(key) + "</td>";
+           format_fixed(F.*f, 3) + "</span>" + limit_of(key) + "</td>";
   };
   std::ostringstream o;
   o << "<table class=\"figures\"><thead><tr><th>Figure (" << unit_html(u)
@@ -108,7 +77,8 @@ std::string figures_table(const IsoFigures& F, const std::string& set, const std
       << cell(r.bi, r.f_bi) << cell(r.up, r.f_up) << cell(r.down, r.f_down) << "</tr>\n";
   }
   o << "<tr class=\"k\"><td>Coverage factor</td><td class=\"sym\">k</td><td></td><td class=\"num\">"
-    << num(F.k_up, 2) << "</td><td class=\"num\">" << num(F.k_down, 2) << "</td></tr>\n";
+    << format_fixed(F.k_up, 2) << "</td><td class=\"num\">" << format_fixed(F.k_down, 2)
+    << "</td></tr>\n";
   o << "</tbody></table>\n";
   return o.str();
 }
@@ -188,7 +158,8 @@ void environment_table(std::ostream& o, const NormalisationResult& n) {
     std::string source;
   };
   const std::string air_source =
-      n.air_applied ? "Edl\xC3\xA9n (Birch & Downs), " + num(n.wavelength_nm, 3) + " nm" : "";
+      n.air_applied ? "Edl\xC3\xA9n (Birch & Downs), " + format_fixed(n.wavelength_nm, 3) + " nm"
+                    : "";
   const Row rows[] = {
       {"Material temperature", n.material_temperature_C, 1, 2,
        "\xC2\xB0"
@@ -205,7 +176,7 @@ void environment_table(std::ostream& o, const NormalisationResult& n) {
       {"Air correction \xCE\xB4<sub>air</sub>", n.air_correction_um, 1, 3, "\xC2\xB5m", ""},
       {"Expansion correction \xCE\xB4<sub>T</sub>", n.material_correction_um, 1, 3, "\xC2\xB5m",
        n.material_applied
-           ? "\xCE\xB1 = " + num(n.expansion_ppm_per_K, 2) + " \xC2\xB5m/(m\xC2\xB7K)"
+           ? "\xCE\xB1 = " + format_fixed(n.expansion_ppm_per_K, 2) + " \xC2\xB5m/(m\xC2\xB7K)"
            : ""}};
   bool any = false;
   for (const Row& r : rows) any |= !r.v.empty();
@@ -216,44 +187,86 @@ void environment_table(std::ostream& o, const NormalisationResult& n) {
     if (r.v.empty()) continue;
     o << "<tr><td>" << r.name << "</td>";
     for (double v : {r.v.min, r.v.mean, r.v.max})
-      o << "<td class=\"num\">" << num(v * r.scale, r.decimals) << "</td>";
+      o << "<td class=\"num\">" << format_fixed(v * r.scale, r.decimals) << "</td>";
     o << "<td>" << r.unit << "</td><td>" << h(r.source) << "</td></tr>\n";
   }
   o << "</table>\n";
 }
 
-const char* kStyle = R"(
-body { font-family: Helvetica, Arial, sans-serif; font-size: 13px; color: #222; margin: 0;
-       background: #fff; }
-main { max-width: 1160px; margin: 0 auto; padding: 18px 20px 30px; }
-header { border-bottom: 3px solid #1f3b63; margin-bottom: 10px; }
-h1 { font-size: 21px; margin: 0 0 4px; color: #1f3b63; }
-h2 { font-size: 16px; margin: 18px 0 6px; color: #1f3b63; border-bottom: 1px solid #c8d0dc; }
-h3 { font-size: 14px; margin: 6px 0; }
-.sub { color: #555; margin: 0 0 8px; }
-table { border-collapse: collapse; }
-td, th { border: 1px solid #c8d0dc; padding: 3px 7px; }
-th { background: #eef2f7; text-align: left; }
-td.num { text-align: right; font-variant-numeric: tabular-nums; white-space: nowrap; }
-td.sym { text-align: center; font-style: italic; }
-td.na { color: #aaa; text-align: center; }
-table.meta td:first-child { background: #f6f8fb; width: 150px; }
-.pair { display: flex; gap: 16px; align-items: flex-start; }
-.pair > div { flex: 1 1 0; min-width: 0; }
-figure { margin: 8px 0; }
-figcaption { color: #555; font-size: 12px; margin-top: 2px; }
-.pass { color: #1a7f37; font-weight: bold; }
-.fail { color: #c62828; font-weight: bold; }
-.verdict { font-size: 15px; margin: 8px 0; }
-ul.statements li { margin: 3px 0; }
-table.env { margin-bottom: 4px; }
-table.targets { font-size: 12px; }
-.signature { display: flex; gap: 40px; margin-top: 28px; }
-.signature div { flex: 1; border-top: 1px solid #444; padding-top: 4px; color: #444; }
-footer { margin-top: 22px; color: #666; font-size: 11px; border-top: 1px solid #c8d0dc;
-         padding-top: 6px; }
-@media print { main { max-width: none; } .pair { break-inside: avoid; } }
-)";
+// The uncertainty of the figures and their budget (ISO 230-9, GUM; Monte Carlo after GUM
+// Supplement 1).
+void uncertainty_section(std::ostream& o, const Iso230_2StudyResult& res) {
+  const UncertaintyResult& U = *res.uncertainty;
+  const std::string u = pretty(res.columns.unit);
+  o << "<section id=\"uncertainty\"><h2>Measurement uncertainty</h2>\n<p>After ISO 230-9 and "
+       "the GUM: every contribution with its distribution and sensitivity, combined (u) and "
+       "expanded with k = "
+    << format_number(U.coverage_factor) << " (U); the same budget propagated by Monte Carlo "
+    << "(GUM Supplement 1, " << U.trials << " trials). Instrument class " << h(U.instrument_class)
+    << ", budget: " << h(U.source) << ".</p>\n";
+  o << "<table class=\"uncertainty\"><thead><tr><th>Figure</th><th>Value (" << u << ")</th><th>u ("
+    << u << ")</th><th>U (" << u << ")</th><th>Monte Carlo u (" << u << ")</th><th>95 % interval ("
+    << u << ")</th></tr></thead><tbody>\n";
+  std::vector<std::string> shown = iso230_2_budget_figures();
+  for (const ToleranceCheck& c : res.tolerance)
+    if (std::find(shown.begin(), shown.end(), c.name) == shown.end()) shown.push_back(c.name);
+  bool unvalidated = false;
+  for (const std::string& name : shown) {
+    const FigureUncertainty* f = U.figure(name);
+    if (!f) continue;
+    const bool flag = U.trials > 0 && !f->validated;
+    unvalidated |= flag;
+    o << "<tr><td>" << h(name) << "</td><td class=\"num\">" << format_fixed(f->value, 3)
+      << "</td><td class=\"num\" data-uncertainty=\"" << h(name) << "\" data-field=\"u_um\">"
+      << format_fixed(f->u, 3) << "</td><td class=\"num\" data-uncertainty=\"" << h(name)
+      << "\" data-field=\"U_um\">" << format_fixed(f->U, 3) << "</td><td class=\"num\">"
+      << format_fixed(f->mc_u, 3) << (flag ? " *" : "") << "</td><td class=\"num\">"
+      << (std::isfinite(f->mc_low)
+              ? format_fixed(f->mc_low, 3) + " \xE2\x80\xA6 " + format_fixed(f->mc_high, 3)
+              : std::string("\xE2\x80\x93"))
+      << "</td></tr>\n";
+  }
+  o << "</tbody></table>\n";
+  if (unvalidated)
+    o << "<p class=\"note\">* The Monte Carlo u differs from the linearised one by more than 5 % "
+         "(GUM Supplement 1, 8): an extreme of the figure switches between targets within the "
+         "uncertainty, and the Monte Carlo interval describes it better; the verdicts use U.</p>\n";
+  o << "<table class=\"budget\"><thead><tr><th rowspan=\"2\">Contribution</th><th "
+       "rowspan=\"2\">Distribution</th><th rowspan=\"2\">u(x)</th>";
+  for (const std::string& f : iso230_2_budget_figures()) o << "<th colspan=\"2\">" << f << "</th>";
+  o << "</tr><tr>";
+  for (std::size_t k = 0; k < iso230_2_budget_figures().size(); ++k)
+    o << "<th>c</th><th>|c| u (" << u << "), share</th>";
+  o << "</tr></thead><tbody>\n";
+  for (const UncertaintyContribution& c : U.contributions) {
+    o << "<tr><td title=\"" << h(pretty(c.input)) << "\">" << h(c.name) << "</td><td>"
+      << (c.kind == ContributionKind::TypeA ? "type A" : to_string(c.distribution))
+      << "</td><td class=\"num\">"
+      << (std::isfinite(c.u) ? format_significant(c.u, 3) + " " + pretty(c.unit)
+                             : std::string("\xE2\x80\x93"))
+      << "</td>";
+    for (const std::string& name : iso230_2_budget_figures()) {
+      const double sens = c.sensitivity.at(name), part = c.contribution_um.at(name);
+      const double total = U.figure(name)->u;
+      o << "<td class=\"num\">"
+        << (std::isfinite(sens)
+                ? format_significant(sens, 3) + (c.kind == ContributionKind::Scale ? " m" : "")
+                : std::string("\xE2\x80\x93"))
+        << "</td><td class=\"num\" data-budget=\"" << h(name) << "\">" << format_fixed(part, 3)
+        << " ("
+        << (total > 0 ? format_fixed(100 * part * part / (total * total), 1) : std::string("0"))
+        << " %)</td>";
+    }
+    o << "</tr>\n";
+  }
+  o << "</tbody></table>\n";
+  if (!U.notes.empty()) {
+    o << "<ul class=\"statements\">\n";
+    for (const std::string& note : U.notes) o << "<li>" << h(pretty(note)) << "</li>\n";
+    o << "</ul>\n";
+  }
+  o << "</section>\n";
+}
 
 }  // namespace
 
@@ -276,25 +289,44 @@ std::string iso230_2_html(const std::string& data, const Iso230_2StudyResult& re
   o << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
     << "<meta name=\"generator\" content=\"weilgen " << kVersion << "\">\n<title>ISO 230-2 "
     << h(cols.axis) << (machine.empty() ? "" : " \xE2\x80\x93 " + h(machine)) << "</title>\n<style>"
-    << kStyle << "</style>\n</head>\n<body>\n<main>\n";
-  // ---- Heading and identification.
-  o << "<header><h1>Positioning accuracy and repeatability \xE2\x80\x93 ISO 230-2:2014</h1>"
+    << report_style() << "</style>\n</head>\n<body>\n<main>\n";
+  // ---- Heading, conformance and identification.
+  o << "<header><h1 data-key=\"title\">Positioning accuracy and repeatability \xE2\x80\x93 "
+    << (res.iso_conforming() ? std::string("ISO 230-2:2014")
+                             : std::string("evaluated after ISO 230-2:2014, not to ISO 230-2"))
+    << "</h1>"
     << "<p class=\"sub\">Axis " << h(cols.axis)
     << (machine.empty() ? "" : " \xC2\xB7 " + h(machine))
     << (key("date").empty() ? "" : " \xC2\xB7 " + h(key("date"))) << "</p></header>\n";
+  if (!res.iso_conforming()) {
+    o << "<section id=\"conformance\" class=\"banner\"><p>Not to ISO 230-2:2014: the run does not "
+         "meet the standard's test conditions.</p><ul>\n";
+    for (const ConformanceIssue& i : res.conformance)
+      o << "<li data-check=\"" << h(i.check) << "\">" << h(pretty(i.message)) << "</li>\n";
+    o << "</ul></section>\n";
+  }
+  if (!res.normalisation.warnings.empty()) {
+    o << "<section id=\"warnings\" class=\"warnings\"><ul>\n";
+    for (const std::string& w : res.normalisation.warnings)
+      o << "<li>" << h(pretty(w)) << "</li>\n";
+    o << "</ul></section>\n";
+  }
   o << "<section id=\"identification\"><h2>Test identification</h2>\n<table class=\"meta\">\n";
-  auto meta_row = [&](const std::string& label, const std::string& value, const std::string& k) {
-    if (value.empty()) return;
-    o << "<tr><td>" << label << "</td><td" << (k.empty() ? "" : " data-key=\"" + k + "\"") << ">"
-      << h(value) << "</td></tr>\n";
+  // Rows a signed report needs are kept when the file leaves them empty: blank, to fill in.
+  auto meta_row = [&](const std::string& label, const std::string& value, const std::string& k,
+                      bool keep_blank = false) {
+    if (value.empty() && !keep_blank) return;
+    o << "<tr><td>" << label << "</td><td" << (k.empty() ? "" : " data-key=\"" + k + "\"")
+      << (value.empty() ? " class=\"fill\"" : "") << ">" << h(value) << "</td></tr>\n";
   };
-  const std::pair<const char*, const char*> known[] = {
-      {"machine", "Machine"},   {"serial", "Serial number"}, {"title", "Test"},
-      {"customer", "Customer"}, {"location", "Location"},    {"date", "Test date"},
-      {"operator", "Operator"}, {"instrument", "Instrument"}};
+  const std::tuple<const char*, const char*, bool> known[] = {
+      {"machine", "Machine", true},   {"serial", "Serial number", true},
+      {"title", "Test", false},       {"customer", "Customer", false},
+      {"location", "Location", true}, {"date", "Test date", true},
+      {"operator", "Operator", true}, {"instrument", "Instrument", true}};
   std::set<std::string> shown;
-  for (const auto& [k, label] : known) {
-    meta_row(label, key(k), k);
+  for (const auto& [k, label, blank] : known) {
+    meta_row(label, key(k), k, blank);
     shown.insert(k);
   }
   meta_row("Axis", cols.axis + " (deviation " + cols.deviation + ", " + pretty(u) + ")", "axis");
@@ -318,6 +350,8 @@ std::string iso230_2_html(const std::string& data, const Iso230_2StudyResult& re
                                                   "laser_wavelength_nm",
                                                   "air_index_assumed",
                                                   "datum_mm",
+                                                  "material_compensation",
+                                                  "deviation_unit",
                                                   "format"};
     if (!shown.count(k) && !handled.count(k)) meta_row(k, v, k);
   }
@@ -363,11 +397,16 @@ std::string iso230_2_html(const std::string& data, const Iso230_2StudyResult& re
   }
   o << "<section id=\"results\"><h2>Results</h2>\n";
   if (!res.tolerance.empty()) {
-    bool pass = true;
-    for (const auto& c : res.tolerance) pass = pass && c.pass;
+    const bool pass = res.verdict == Decision::Conforms;
+    bool with_u = false;
+    for (const auto& c : res.tolerance) with_u |= std::isfinite(c.U);
     o << "<p class=\"verdict\" data-key=\"tolerance_pass\" data-value=\""
       << (pass ? "true" : "false") << "\">Verdict against the tolerances: <span class=\""
-      << (pass ? "pass\">PASS" : "fail\">FAIL") << "</span> (classical figures, k = 2)</p>\n";
+      << decision_class(res.verdict) << "\">" << decision_text(res.verdict) << "</span> ("
+      << (with_u ? "classical figures, k = 2, with their expanded uncertainty, ISO 14253-1"
+                 : "classical figures, k = 2, without their uncertainty")
+      << (res.verdict_reason.empty() ? std::string() : "; " + h(pretty(res.verdict_reason)))
+      << ")</p>\n";
   }
   o << "<div class=\"pair\">\n<div><h3>ISO 230-2 evaluation (k = 2)</h3>\n"
     << figures_table(F, "classical", u, &res.tolerance) << "<figure>" << svg_chart(classical)
@@ -383,31 +422,34 @@ std::string iso230_2_html(const std::string& data, const Iso230_2StudyResult& re
          "2. "
          "Thermal drift between cycles is removed; drift within a pass is not.</figcaption>"
          "</figure>\n</div>\n";
-  } else {
+  } else if (!res.iso_only) {
     o << "<div><h3>Drift-eliminated evaluation</h3><p>Needs at least 2 targets.</p></div>\n";
   }
   o << "</div>\n";
   if (res.classical.student) {
     const IsoFigures& S = *res.classical.student;
     o << "<p>With the Student-t coverage factor for " << runs.cycles[kUp].size()
-      << " cycles (k = " << num(S.k_up, 2) << " / " << num(S.k_down, 2)
-      << "): A = <span data-set=\"student\" data-key=\"A_um\">" << num(S.A) << "</span> "
-      << pretty(u) << ", R = <span data-set=\"student\" data-key=\"R_um\">" << num(S.R)
-      << "</span> " << pretty(u) << ".</p>\n";
+      << " cycles (k = " << format_fixed(S.k_up, 2) << " / " << format_fixed(S.k_down, 2)
+      << "): A = <span data-set=\"student\" data-key=\"A_um\">" << format_fixed(S.A, 3)
+      << "</span> " << pretty(u) << ", R = <span data-set=\"student\" data-key=\"R_um\">"
+      << format_fixed(S.R, 3) << "</span> " << pretty(u) << ".</p>\n";
   }
   if (!res.tolerance.empty()) {
     o << "<table class=\"tolerance\"><thead><tr><th>Tolerance</th><th>Value (" << pretty(u)
-      << ")</th><th>Limit (" << pretty(u) << ")</th><th>Result</th></tr></thead><tbody>\n";
+      << ")</th><th>U (" << pretty(u) << ")</th><th>Limit (" << pretty(u)
+      << ")</th><th>Result</th></tr></thead><tbody>\n";
     for (const auto& c : res.tolerance)
       o << "<tr><td>"
         << (c.name == "band" ? std::string("every x\xCC\x84 \xC2\xB1 2s within \xC2\xB1 limit")
                              : h(c.name))
         << "</td><td class=\"num\" data-set=\"tolerance\" data-key=\"" << h(c.name) << "\">"
-        << num(c.value) << "</td><td class=\"num\">" << format_number(c.limit)
-        << "</td><td class=\"" << (c.pass ? "pass\">pass" : "fail\">FAIL") << "</td></tr>\n";
+        << format_fixed(c.value, 3) << "</td><td class=\"num\">" << format_fixed(c.U, 3)
+        << "</td><td class=\"num\">" << format_number(c.limit) << "</td><td class=\""
+        << decision_class(c.decision) << "\">" << decision_text(c.decision) << "</td></tr>\n";
     o << "</tbody></table>\n";
   }
   o << "</section>\n";
+  if (res.uncertainty) uncertainty_section(o, res);
   // ---- Per target.
   o << "<section id=\"targets\"><h2>Per target (" << pretty(u) << ", k = 2)</h2>\n"
     << "<table class=\"targets\"><thead><tr><th>Target (" << pos_unit
@@ -422,7 +464,7 @@ std::string iso230_2_html(const std::string& data, const Iso230_2StudyResult& re
   for (std::size_t i = 0; i < m; ++i) {
     auto td = [&](const char* k, double v) {
       return "<td class=\"num\" data-set=\"classical\" data-key=\"" + std::string(k) +
-             "\" data-index=\"" + std::to_string(i) + "\">" + num(v) + "</td>";
+             "\" data-index=\"" + std::to_string(i) + "\">" + format_fixed(v, 3) + "</td>";
     };
     o << "<tr><td class=\"num\">" << format_number(P[i]) << "</td>"
       << td("mean_up_um", F.mean_up[i]) << td("mean_down_um", F.mean_down[i])
@@ -430,9 +472,10 @@ std::string iso230_2_html(const std::string& data, const Iso230_2StudyResult& re
       << td("R_i_up_um", F.R_i_up[i]) << td("R_i_down_um", F.R_i_down[i]) << td("R_i_um", F.R_i[i])
       << td("mean_bi_um", F.mean_bi[i]);
     if (D)
-      o << "<td class=\"num\">" << num(D->chart[kUp].value[i]) << "</td><td class=\"num\">"
-        << num(D->chart[kUp].s[i]) << "</td><td class=\"num\">" << num(D->chart[kDown].value[i])
-        << "</td><td class=\"num\">" << num(D->chart[kDown].s[i]) << "</td>";
+      o << "<td class=\"num\">" << format_fixed(D->chart[kUp].value[i], 3)
+        << "</td><td class=\"num\">" << format_fixed(D->chart[kUp].s[i], 3)
+        << "</td><td class=\"num\">" << format_fixed(D->chart[kDown].value[i], 3)
+        << "</td><td class=\"num\">" << format_fixed(D->chart[kDown].s[i], 3) << "</td>";
     o << "</tr>\n";
   }
   o << "</tbody></table></section>\n";
@@ -452,11 +495,11 @@ std::string iso230_2_html(const std::string& data, const Iso230_2StudyResult& re
     cyc.width = 760;
     cyc.height = 300;
     o << "<section id=\"drift\"><h2>Thermal drift</h2>\n<figure>" << svg_chart(cyc)
-      << "</figure>\n<p>Drift rate " << num(C.rate_per_cycle, 4) << " \xC2\xB1 "
-      << num(C.rate_per_cycle_se, 4) << " " << pretty(u) << " per cycle";
+      << "</figure>\n<p>Drift rate " << format_fixed(C.rate_per_cycle, 4) << " \xC2\xB1 "
+      << format_fixed(C.rate_per_cycle_se, 4) << " " << pretty(u) << " per cycle";
     if (std::isfinite(C.rate_per_h))
-      o << ", " << num(C.rate_per_h, 4) << " \xC2\xB1 " << num(C.rate_per_h_se, 4) << " "
-        << pretty(u) << "/h";
+      o << ", " << format_fixed(C.rate_per_h, 4) << " \xC2\xB1 " << format_fixed(C.rate_per_h_se, 4)
+        << " " << pretty(u) << "/h";
     o << " (within-group least squares, standard error). Anomaly test (F test of each adjacent "
          "difference, Bonferroni over "
       << D->tests << " tests, \xCE\xB1 = " << format_number(D->alpha) << "): ";

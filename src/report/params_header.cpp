@@ -4,20 +4,14 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "weilgen/base/constants.hpp"
+#include "weilgen/base/format.hpp"
 #include "weilgen/machine/model_key.hpp"
 
 namespace weilgen {
 
 namespace {
 
-// Round-trip exact, locale independent.
-std::string num(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  std::string s = buf;
-  if (s.find_first_of(".eEn") == std::string::npos) s += ".0";
-  return s;
-}
 
 // The basis evaluators, written once per header (templated on the scalar).
 const char* kEvaluators =
@@ -106,7 +100,7 @@ std::string params_header(const Model& model, const ErrorParameterisation& param
     h << (p ? ", " : "") << d.parameters[p].name << " " << d.parameters[p].unit;
   h << ").\ninline constexpr std::array<double, kNumParams> kParams = {{";
   for (std::size_t p = 0; p < model.parameters().size(); ++p)
-    h << (p ? ", " : "") << num(model.parameters()[p]);
+    h << (p ? ", " : "") << format_literal17(model.parameters()[p]);
   h << "}};\n\n" << kEvaluators << "\n";
 
   // Coefficient tables in base units.
@@ -119,7 +113,7 @@ std::string params_header(const Model& model, const ErrorParameterisation& param
     const auto& basis = param.basis_of(k);
     const std::string unit = e.base_unit();
     if (!basis) {
-      h << "inline constexpr double k" << e.name << " = " << num(theta[first[k]] * e.to_base)
+      h << "inline constexpr double k" << e.name << " = " << format_literal17(theta[first[k]] * e.to_base)
         << ";  // " << unit << "\n";
       body << "  e[" << k << "] = Scalar(k" << e.name << ");\n";
       continue;
@@ -133,15 +127,15 @@ std::string params_header(const Model& model, const ErrorParameterisation& param
       throw std::invalid_argument("--emit-params: " + e.name +
                                   " runs along the linked coordinate " + coord +
                                   ", which the params header cannot evaluate");
-    h << "// " << e.name << "(" << coord << "): " << basis->name() << " on [" << num(basis->a)
-      << ", " << num(basis->b) << "], " << unit << "\n";
+    h << "// " << e.name << "(" << coord << "): " << basis->name() << " on [" << format_literal17(basis->a)
+      << ", " << format_literal17(basis->b) << "], " << unit << "\n";
     h << "inline constexpr std::array<double, " << basis->size() << "> k" << e.name << " = {{";
     for (std::size_t t = 0; t < basis->size(); ++t)
-      h << (t ? ", " : "") << num(theta[first[k] + t] * e.to_base);
+      h << (t ? ", " : "") << format_literal17(theta[first[k] + t] * e.to_base);
     h << "}};\n";
     const std::string x = "axes[" + std::to_string(a) + "]";
-    const std::string u = "(Scalar(2) * " + x + " - Scalar(" + num(basis->a + basis->b) +
-                          ")) / Scalar(" + num(basis->b - basis->a) + ")";
+    const std::string u = "(Scalar(2) * " + x + " - Scalar(" + format_literal17(basis->a + basis->b) +
+                          ")) / Scalar(" + format_literal17(basis->b - basis->a) + ")";
     switch (basis->kind) {
       case BasisKind::Polynomial:
         body << "  e[" << k << "] = PolySum(k" << e.name << ", " << u << ");\n";
@@ -154,7 +148,7 @@ std::string params_header(const Model& model, const ErrorParameterisation& param
         break;
       case BasisKind::Fourier:
         body << "  e[" << k << "] = FourierSum(k" << e.name << ", Scalar("
-             << num(2 * M_PI / basis->period()) << ") * " << x << ");\n";
+             << format_literal17(2 * kPi / basis->period()) << ") * " << x << ");\n";
         break;
     }
   }

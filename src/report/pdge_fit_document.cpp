@@ -17,7 +17,6 @@ namespace {
 using nlohmann::json;
 
 // Table cells: fixed decimals, or significant digits (4 unless said); "-" when not computed.
-std::string fmt(double v, int decimals) { return format_fixed(v, decimals); }
 std::string fmt_g(double v, int digits = 4) { return format_significant(v, digits); }
 
 // Mean of y at each distinct x (sorted): the data line of the plot.
@@ -176,20 +175,20 @@ std::string pdge_fit_text(const PdgeFitStudyOptions& o, const PdgeFitStudyResult
            << (std::to_string(f.basis.order) + (fr.order_choice == "fixed" ? "" : "*"))
            << std::setw(7) << f.params() << std::setw(11)
            << (f.basis.kind == BasisKind::Fourier && f.basis.order > 0
-                   ? fmt(f.basis.period(), 2) + (fr.period_at_bound ? "!" : "")
+                   ? format_fixed(f.basis.period(), 2) + (fr.period_at_bound ? "!" : "")
                    : std::string("-"))
-           << std::setw(12) << fmt(f.metrics.e_max, 3) << std::setw(9) << fmt(f.metrics.r2, 4)
-           << std::setw(13) << fmt_g(f.metrics.sse, 5) << std::setw(11) << fmt(f.metrics.rmse, 3)
-           << std::setw(14) << fmt(fr.cv.rmse, 3) << (k == best ? "  <- least CV error" : "")
+           << std::setw(12) << format_fixed(f.metrics.e_max, 3) << std::setw(9) << format_fixed(f.metrics.r2, 4)
+           << std::setw(13) << fmt_g(f.metrics.sse, 5) << std::setw(11) << format_fixed(f.metrics.rmse, 3)
+           << std::setw(14) << format_fixed(fr.cv.rmse, 3) << (k == best ? "  <- least CV error" : "")
            << "\n";
       os << line.str();
       if (curves) {
         for (const CvCurvePoint& c : fr.curve) {
           os << "      order " << std::setw(2) << c.order << ": train RMSE " << std::setw(8)
-             << fmt(c.train_rmse, 3) << "  CV RMSE " << std::setw(9) << fmt(c.cv.rmse, 3)
+             << format_fixed(c.train_rmse, 3) << "  CV RMSE " << std::setw(9) << format_fixed(c.cv.rmse, 3)
              << " (MSE se " << fmt_g(c.cv.mse_se, 3) << ")";
           if (std::isfinite(c.period_mm) && c.order > 0)
-            os << "  L " << fmt(c.period_mm, 2) << " mm";
+            os << "  L " << format_fixed(c.period_mm, 2) << " mm";
           if (!c.feasible) os << "  not feasible: " << c.reason;
           os << "\n";
         }

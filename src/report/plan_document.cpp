@@ -16,12 +16,6 @@ using nlohmann::json;
 
 namespace {
 
-std::string fmt(double v, int precision = 3) { return format_significant(v, precision); }
-
-const Joint& joint_of(const Description& d, std::size_t axis) {
-  return d.bodies[static_cast<std::size_t>(d.axes()[axis])].joint;
-}
-
 const char* unit_word(Instrument i) {
   switch (i) {
     case Instrument::Ballbar:
@@ -35,14 +29,14 @@ const char* unit_word(Instrument i) {
 
 json pose_object(const Description& d, const std::vector<double>& pose) {
   json p = json::object();
-  for (std::size_t a = 0; a < pose.size(); ++a) p[joint_of(d, a).coordinate] = pose[a];
+  for (std::size_t a = 0; a < pose.size(); ++a) p[d.axis_joint(a).coordinate] = pose[a];
   return p;
 }
 
 std::string pose_line(const Description& d, const std::vector<double>& pose) {
   std::string s;
   for (std::size_t a = 0; a < pose.size(); ++a)
-    s += (a ? " " : "") + joint_of(d, a).coordinate + "=" + format_number(pose[a]);
+    s += (a ? " " : "") + d.axis_joint(a).coordinate + "=" + format_number(pose[a]);
   return s;
 }
 
@@ -232,8 +226,9 @@ std::string plan_text(const PlanRun& run, const std::vector<std::string>& files)
      << r.candidate_rank << " combinations";
   if (!r.unidentifiable.empty())
     os << " (" << r.unidentifiable.size() << " not identifiable by any candidate set, below)";
-  os << "\nplan: rank " << r.plan.rank << ", condition " << fmt(r.plan.condition) << ", log det "
-     << fmt(r.plan.log_det, 6) << ", " << r.plan.observations << " observations; "
+  os << "\nplan: rank " << r.plan.rank << ", condition " << format_significant(r.plan.condition, 3)
+     << ", log det " << format_significant(r.plan.log_det, 6) << ", " << r.plan.observations
+     << " observations; "
      << "at least " << r.minimum_units << " " << unit_word(r.instrument)
      << " for full rank (the sequential design needed " << r.greedy_units << ")\n";
   os << "noise:";
@@ -252,19 +247,22 @@ std::string plan_text(const PlanRun& run, const std::vector<std::string>& files)
         break;
     }
     if (used)
-      os << " " << observation_name(k) << " " << fmt(r.noise[k]) << " " << observation_unit(k);
+      os << " " << observation_name(k) << " " << format_significant(r.noise[k], 3) << " "
+         << observation_unit(k);
   }
   os << "\n\nlayout                      units  rank  prediction SD  vs plan   O1        O2        "
         "O3        O4        O5\n";
   auto row = [&](const LayoutFigures& f, bool is_plan) {
     os << std::left << std::setw(26) << f.name << std::right << std::setw(7) << f.layout.size()
-       << std::setw(6) << f.rank << std::setw(12) << fmt(f.prediction_sd_um) << " um"
-       << std::setw(9)
-       << (is_plan ? std::string("")
-                   : fmt(100 * (1 - r.plan.prediction_sd_um / f.prediction_sd_um), 2) + " %");
+       << std::setw(6) << f.rank << std::setw(12) << format_significant(f.prediction_sd_um, 3)
+       << " um" << std::setw(9)
+       << (is_plan
+               ? std::string("")
+               : format_significant(100 * (1 - r.plan.prediction_sd_um / f.prediction_sd_um), 2) +
+                     " %");
     for (double v : {f.observability.o1, f.observability.o2, f.observability.o3, f.observability.o4,
                      f.observability.o5})
-      os << std::setw(10) << fmt(v);
+      os << std::setw(10) << format_significant(v, 3);
     os << "\n";
   };
   row(r.plan, true);
@@ -280,16 +278,18 @@ std::string plan_text(const PlanRun& run, const std::vector<std::string>& files)
     os << "bound (continuous design, " << r.bound_iterations
        << " iterations): no design of this size on these candidates reaches a prediction SD "
           "below "
-       << fmt(r.prediction_sd_bound_um) << " um";
+       << format_significant(r.prediction_sd_bound_um, 3) << " um";
     if (run.options.criterion != DesignCriterion::E)
       os << "; criterion " << design_criterion_name(run.options.criterion) << " bound "
-         << fmt(r.criterion_bound, 6) << " (plan " << fmt(r.plan.criterion, 6) << ")";
+         << format_significant(r.criterion_bound, 6) << " (plan "
+         << format_significant(r.plan.criterion, 6) << ")";
     os << "\n";
   }
   if (run.options.target_sd_um > 0) {
-    os << "\n--target-sd " << fmt(run.options.target_sd_um) << " um: tried";
+    os << "\n--target-sd " << format_significant(run.options.target_sd_um, 3) << " um: tried";
     for (const auto& [n, sd] : r.target_search)
-      os << " " << n << " (" << (std::isfinite(sd) ? fmt(sd) + " um" : std::string("rank short"))
+      os << " " << n << " ("
+         << (std::isfinite(sd) ? format_significant(sd, 3) + " um" : std::string("rank short"))
          << ")";
     os << "; the fewest reaching it: " << r.plan.layout.size() << "\n";
   }
@@ -299,8 +299,8 @@ std::string plan_text(const PlanRun& run, const std::vector<std::string>& files)
     const PlanSetup& s = r.candidates.setups[u.setup];
     os << "  " << std::setw(3) << i + 1 << "  ";
     if (s.instrument == Instrument::Ballbar)
-      os << s.circle.plane << " circle R " << fmt(s.circle.radius_mm) << " mm, centre "
-         << pose_line(d, u.pose) << "\n";
+      os << s.circle.plane << " circle R " << format_significant(s.circle.radius_mm, 3)
+         << " mm, centre " << pose_line(d, u.pose) << "\n";
     else if (s.instrument == Instrument::Line6d)
       os << s.axis << " = " << format_number(u.position) << " mm\n";
     else
@@ -310,7 +310,7 @@ std::string plan_text(const PlanRun& run, const std::vector<std::string>& files)
   for (std::size_t p = 0; p < run.param->size(); ++p) {
     const IdentParameter& ip = run.param->parameters()[p];
     os << "  " << std::left << std::setw(28) << ip.label << std::right << std::setw(12)
-       << (std::isfinite(r.plan.parameter_sd[p]) ? fmt(r.plan.parameter_sd[p])
+       << (std::isfinite(r.plan.parameter_sd[p]) ? format_significant(r.plan.parameter_sd[p], 3)
                                                  : std::string("n.i."))
        << "  " << ip.unit << "\n";
   }
@@ -320,9 +320,9 @@ std::string plan_text(const PlanRun& run, const std::vector<std::string>& files)
     for (std::size_t i = 0; i < r.unidentifiable.size(); ++i)
       os << "  " << i + 1 << ". " << r.unidentifiable[i].str(run.param->parameters()) << "\n";
   }
-  os << "\nplanner: " << fmt(r.seconds) << " s (" << run.options.restarts << " restarts, best "
-     << r.exchange.best_restart << ", " << r.exchange.passes << " passes, " << r.exchange.exchanges
-     << " exchanges)\n";
+  os << "\nplanner: " << format_significant(r.seconds, 3) << " s (" << run.options.restarts
+     << " restarts, best " << r.exchange.best_restart << ", " << r.exchange.passes << " passes, "
+     << r.exchange.exchanges << " exchanges)\n";
   for (const std::string& f : files) os << "wrote " << f << "\n";
   return os.str();
 }
@@ -335,8 +335,8 @@ std::vector<Panel> plan_panels(const PlanRun& run) {
   const SdMap& m = r.sd_map;
   std::size_t ax = 0, ay = 0;
   for (std::size_t a = 0; a < d.axes().size(); ++a) {
-    if (joint_of(d, a).coordinate == m.x_axis) ax = a;
-    if (joint_of(d, a).coordinate == m.y_axis) ay = a;
+    if (d.axis_joint(a).coordinate == m.x_axis) ax = a;
+    if (d.axis_joint(a).coordinate == m.y_axis) ay = a;
   }
   StyledLinePlot scatter;
   scatter.plot.title =

@@ -18,6 +18,7 @@
 #include <stdexcept>
 
 #include "weilgen/base/atomic_file.hpp"
+#include "weilgen/base/format.hpp"
 #include "weilgen/base/text.hpp"
 
 namespace weilgen {
@@ -57,12 +58,11 @@ std::string field(const std::string& s) {
   return out.empty() ? std::string(" ") : out;
 }
 
-std::string num(double v) {
+// gnuplot reads NaN and Inf by these names.
+std::string gnuplot_number(double v) {
   if (std::isnan(v)) return "NaN";
   if (std::isinf(v)) return v > 0 ? "Inf" : "-Inf";
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
+  return format_number(v);
 }
 
 std::string short_num(double v) {
@@ -131,6 +131,11 @@ void check(const LinePlot& l) {
                        std::to_string(l.x.size()) + " x values");
     }
   }
+  for (const LineBand& b : l.bands)
+    if (b.lo.size() != l.x.size() || b.hi.size() != l.x.size())
+      bad(l.title, "band \"" + b.label + "\" has not one lo and hi per x");
+  for (const LineRule& r : l.rules)
+    if (!std::isfinite(r.y)) bad(l.title, "rule \"" + r.label + "\" is not finite");
 }
 
 void check(const StyledLinePlot& l) {
@@ -197,8 +202,8 @@ void bar_script(std::ostringstream& s, const fs::path& dir, int index, const Bar
           highest = std::max(highest, x);
         }
       }
-      d << "\t" << num(v) << "\t" << num(bars ? series.lo[i] : v) << "\t"
-        << num(bars ? series.hi[i] : v);
+      d << "\t" << gnuplot_number(v) << "\t" << gnuplot_number(bars ? series.lo[i] : v) << "\t"
+        << gnuplot_number(bars ? series.hi[i] : v);
     }
     d << "\n";
   }
@@ -277,8 +282,9 @@ void heat_script(std::ostringstream& s, const fs::path& dir, int index, const He
     for (std::size_t ix = 0; ix < h.x.size(); ++ix) {
       const double z = h.z[iy * h.x.size() + ix];
       const double t = hi > lo ? (z - lo) / (hi - lo) : 0.5;
-      d << num(h.x[ix]) << "\t" << num(h.y[iy]) << "\t" << num(hx[ix]) << "\t" << num(hy[iy])
-        << "\t" << num(z) << "\t" << short_num(z) << "\t" << (t > 0.6 ? 1 : 0) << "\n";
+      d << gnuplot_number(h.x[ix]) << "\t" << gnuplot_number(h.y[iy]) << "\t"
+        << gnuplot_number(hx[ix]) << "\t" << gnuplot_number(hy[iy]) << "\t" << gnuplot_number(z)
+        << "\t" << short_num(z) << "\t" << (t > 0.6 ? 1 : 0) << "\n";
       xmin = std::min(xmin, h.x[ix] - hx[ix]);
       xmax = std::max(xmax, h.x[ix] + hx[ix]);
       ymin = std::min(ymin, h.y[iy] - hy[iy]);
@@ -294,13 +300,13 @@ void heat_script(std::ostringstream& s, const fs::path& dir, int index, const He
   s << "set cblabel " << gq(h.zlabel) << "\n";
   s << "set palette defined (0 '#fff7ec', 0.25 '#fdd49e', 0.5 '#fc8d59', 0.75 '#d7301f', "
        "1 '#7f0000')\n";
-  s << "set xrange [" << num(xmin) << ":" << num(xmax) << "]\n";
-  s << "set yrange [" << num(ymin) << ":" << num(ymax) << "]\n";
+  s << "set xrange [" << gnuplot_number(xmin) << ":" << gnuplot_number(xmax) << "]\n";
+  s << "set yrange [" << gnuplot_number(ymin) << ":" << gnuplot_number(ymax) << "]\n";
   if (any && hi > lo) {
-    s << "set cbrange [" << num(lo) << ":" << num(hi) << "]\n";
+    s << "set cbrange [" << gnuplot_number(lo) << ":" << gnuplot_number(hi) << "]\n";
   } else if (any) {
-    s << "set cbrange [" << num(lo - 0.5 * std::abs(lo) - 1e-300) << ":"
-      << num(hi + 0.5 * std::abs(hi) + 1e-300) << "]\n";
+    s << "set cbrange [" << gnuplot_number(lo - 0.5 * std::abs(lo) - 1e-300) << ":"
+      << gnuplot_number(hi + 0.5 * std::abs(hi) + 1e-300) << "]\n";
   } else {
     s << "set cbrange [0:1]\n";
   }
@@ -340,11 +346,13 @@ void line_script(std::ostringstream& s, const fs::path& dir, int index, const Li
   std::ostringstream d;
   bool all_nan = true;
   for (std::size_t i = 0; i < l.x.size(); ++i) {
-    d << num(l.x[i]);
+    d << gnuplot_number(l.x[i]);
     for (const auto& line : l.lines) {
-      d << "\t" << num(line.second[i]);
+      d << "\t" << gnuplot_number(line.second[i]);
       all_nan = all_nan && !std::isfinite(line.second[i]);
     }
+    for (const LineBand& b : l.bands)
+      d << "\t" << gnuplot_number(b.lo[i]) << "\t" << gnuplot_number(b.hi[i]);
     d << "\n";
   }
   write_data(data, d.str());
@@ -356,11 +364,24 @@ void line_script(std::ostringstream& s, const fs::path& dir, int index, const Li
   s << "set offsets graph 0.02, graph 0.02, graph 0.05, graph 0.05\n";
   if (all_nan) s << "set yrange [0:1]\n";
   s << "plot ";
-  for (std::size_t k = 0; k < l.lines.size(); ++k) {
-    s << (k == 0 ? gq(data.string()) : std::string("''")) << " using 1:" << k + 2 << " with "
-      << style_text(styles.empty() ? LineStyle::LinesPoints : styles[k]) << " title "
-      << gq(l.lines[k].first) << (k + 1 < l.lines.size() ? ", \\\n     " : "\n");
+  // Bands first, under the lines; their columns follow the lines' in the data file.
+  for (std::size_t k = 0; k < l.bands.size(); ++k) {
+    const std::size_t lo = l.lines.size() + 2 + 2 * k;
+    s << (k == 0 ? gq(data.string()) : std::string("''")) << " using 1:" << lo << ":" << lo + 1
+      << " with filledcurves fs transparent solid 0.18 noborder"
+      << (l.bands[k].line < l.lines.size() ? " lt " + std::to_string(l.bands[k].line + 1) : "")
+      << " title " << gq(l.bands[k].label) << ", \\\n     ";
   }
+  for (std::size_t k = 0; k < l.lines.size(); ++k) {
+    s << (k == 0 && l.bands.empty() ? gq(data.string()) : std::string("''")) << " using 1:" << k + 2
+      << " with " << style_text(styles.empty() ? LineStyle::LinesPoints : styles[k]) << " lt "
+      << k + 1 << " title " << gq(l.lines[k].first)
+      << (k + 1 < l.lines.size() || !l.rules.empty() ? ", \\\n     " : "\n");
+  }
+  for (std::size_t k = 0; k < l.rules.size(); ++k)
+    s << gnuplot_number(l.rules[k].y) << " with lines dt 2 lw 1.5 lc rgb '#000000' "
+      << (l.rules[k].label.empty() ? std::string("notitle") : "title " + gq(l.rules[k].label))
+      << (k + 1 < l.rules.size() ? ", \\\n     " : "\n");
 }
 
 bool find_on_path(const std::string& program) {

@@ -71,7 +71,7 @@ nlohmann::json evaluation_json(const BallbarEvaluation& e) {
 
 void print_evaluation(std::ostream& os, const char* what, const BallbarEvaluation& e,
                       const BallbarCircle& c) {
-  os << "  " << std::left << std::setw(10) << what << std::right << "G " << std::setw(7)
+  os << "  " << std::left << std::setw(16) << what << std::right << "G " << std::setw(7)
      << format_short(e.circular_deviation_um) << " µm   centre offset (" << c.first << " "
      << format_short(e.centre_offset_um[0]) << ", " << c.second << " "
      << format_short(e.centre_offset_um[1]) << ") µm   radius "
@@ -88,7 +88,10 @@ std::string ballbar_prediction_text(const BallbarPrediction& p) {
   print_evaluation(os, "predicted", p.predicted_evaluation, c);
   for (std::size_t i = 0; i < p.compared.size(); ++i) {
     const BallbarComparison& k = p.compared[i];
-    print_evaluation(os, "measured", k.measured, c);
+    // Every measured run named by its direction (and cycle, when the file has several).
+    const std::string run = std::string(k.feed > 0 ? "ccw" : "cw") +
+                            (k.cycle != 0 ? " " + std::to_string(k.cycle) : std::string());
+    print_evaluation(os, ("measured " + run).c_str(), k.measured, c);
     os << "  measured - predicted: rms " << format_short(k.raw.rms_um) << " µm, max "
        << format_short(k.raw.max_abs_um) << " µm; centred rms " << format_short(k.centred.rms_um)
        << " µm, correlation " << format_short(k.centred.correlation)
@@ -101,7 +104,9 @@ std::string ballbar_prediction_text(const BallbarPrediction& p) {
 nlohmann::json ballbar_prediction_json(const BallbarPrediction& p) {
   nlohmann::json compared = nlohmann::json::array();
   for (const BallbarComparison& k : p.compared)
-    compared.push_back({{"measured", evaluation_json(k.measured)},
+    compared.push_back({{"feed", k.feed > 0 ? "ccw" : "cw"},
+                        {"cycle", k.cycle},
+                        {"measured", evaluation_json(k.measured)},
                         {"difference", evaluation_json(k.difference)},
                         {"rms_difference_um", json_number(k.raw.rms_um)},
                         {"max_difference_um", json_number(k.raw.max_abs_um)},

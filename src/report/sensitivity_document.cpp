@@ -5,14 +5,13 @@
 #include <iomanip>
 #include <sstream>
 
+#include "weilgen/base/constants.hpp"
 #include "weilgen/report/csv_table.hpp"
 #include "weilgen/report/json_common.hpp"
 
 namespace weilgen {
 
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // Display scale: outputs in µm or µrad.
 double display_scale(OutputId o) { return 1e3 * (output_is_angle(o) ? 1e3 : 1.0); }

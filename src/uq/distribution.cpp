@@ -7,11 +7,12 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "weilgen/base/constants.hpp"
+
 namespace weilgen {
 
 namespace {
 const boost::math::normal_distribution<double> kStdNormal(0.0, 1.0);
-constexpr double kInf = std::numeric_limits<double>::infinity();
 
 std::string number(double v) {
   std::ostringstream s;

@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <limits>
 
+#include "weilgen/base/constants.hpp"
 #include "weilgen/uq/distribution.hpp"
 
 namespace weilgen {
@@ -110,8 +111,6 @@ inline double tail(double q, double tail_p) {
   const double z = r <= 5.0 ? tail_near(r) : tail_far(r);
   return q < 0 ? -z : z;
 }
-
-constexpr double kInf = std::numeric_limits<double>::infinity();
 
 }  // namespace
 

@@ -5,13 +5,13 @@
 #include <cmath>
 #include <limits>
 
+#include "weilgen/base/constants.hpp"
 #include "weilgen/uq/reliability.hpp"
 
 namespace weilgen::reliability_detail {
 
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
 // Beyond this distance from the origin Phi(-|u|) underflows: the side has no failure point.
 constexpr double kFarAway = 37.5;
 

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <limits>
 
+#include "weilgen/base/constants.hpp"
 #include "weilgen/base/parallel.hpp"
 #include "weilgen/uq/reliability.hpp"
 
@@ -14,7 +15,6 @@ namespace weilgen::reliability_detail {
 
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr std::size_t kLinesPerBlock = 64;
 // A root is accepted without bracketing when |g| / |grad g*| is below this (u units).
 constexpr double kRootAccept = 1e-13;

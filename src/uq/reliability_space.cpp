@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "splitmix64.hpp"
 #include "weilgen/uq/reliability.hpp"
 
 namespace weilgen::reliability_detail {
@@ -10,13 +11,6 @@ namespace weilgen::reliability_detail {
 namespace {
 // Central differences: step = cbrt(machine epsilon) times the input's scale.
 constexpr double kRelativeStep = 6e-6;
-
-std::uint64_t splitmix64(std::uint64_t& state) {
-  std::uint64_t z = (state += 0x9e3779b97f4a7c15ULL);
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  return z ^ (z >> 31);
-}
 
 std::uint64_t rotl(std::uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
 }  // namespace

@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "sobol_detail.hpp"
+#include "weilgen/base/constants.hpp"
 #include "weilgen/base/parallel.hpp"
 
 namespace weilgen {
@@ -21,8 +22,6 @@ using sobol_detail::kBlock;
 using sobol_detail::sum_width;
 
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // Type-7 (linear interpolation) quantile of sorted values.
 double sorted_quantile(const std::vector<double>& v, double p) {

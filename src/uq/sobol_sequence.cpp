@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "splitmix64.hpp"
+
 namespace weilgen {
 
 namespace {
@@ -13,13 +15,6 @@ namespace {
 constexpr unsigned kBits = 64;
 using Lattice = boost::random::qrng_detail::sobol_lattice<std::uint64_t, kBits,
                                                           boost::random::default_sobol_table>;
-
-std::uint64_t splitmix64(std::uint64_t& state) {
-  std::uint64_t z = (state += 0x9e3779b97f4a7c15ULL);
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  return z ^ (z >> 31);
-}
 
 // The leading 53 bits of a 64-bit word as a double in [0, 1); 0 becomes 2^-54.
 inline double to_unit(std::uint64_t x) {

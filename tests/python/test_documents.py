@@ -76,6 +76,39 @@ def test_iso230_2_equals_cli(cli):
     same_document(weilgen.iso230_2(data, alpha=0.05, reference_cycle=2), want)
 
 
+def test_iso230_2_normalise_iso_only_uncertainty_equal_cli(cli, tmp_path):
+    data = source("examples", "data", "iso230_2_small.csv")
+    budget = tmp_path / "budget.yaml"
+    budget.write_text("class: laser-compensated\neve_um: 0.4\nmonte_carlo_trials: 5000\n")
+    want = cli.json("iso230-2", data, "--normalise", "never", "--iso-only", "--uncertainty",
+                    str(budget))
+    doc = weilgen.iso230_2(data, normalise="never", iso_only=True, uncertainty=budget)
+    same_document(doc, want)
+    assert doc["student"] is None and doc["drift_eliminated"] is None
+    assert doc["normalisation"]["mode"] == "never"
+    assert doc["uncertainty"]["figures"]["E"]["U_um"] > 0
+    # A laser export: its compensation state decides, as on the CLI.
+    carto = source("examples", "data", "carto_x.csv")
+    doc = weilgen.iso230_2(carto, uncertainty="laser-compensated")
+    same_document(doc, cli.json("iso230-2", carto, "--uncertainty", "laser-compensated"))
+    assert doc["source_format"] == "carto"
+    assert doc["normalisation"]["material"]["instrument_state"] == "none"
+
+
+def test_ballbar_equals_cli(cli, tmp_path):
+    data = source("examples", "data", "ballbar_xy.csv")
+    same_document(weilgen.ballbar(data), cli.json("ballbar", data))
+    svg, html = tmp_path / "p.svg", tmp_path / "r.html"
+    want = cli.json("ballbar", data, "--machine", "vmc_3axis", "--alpha", "0.05", "--feedrate",
+                    "300 mm/min")
+    doc = weilgen.ballbar(data, machine="vmc_3axis", alpha=0.05, feedrate="300 mm/min", plot=svg,
+                          report=html, quiet=True)
+    same_document(doc, want)
+    assert doc["diagnosis"]["causes"][0]["id"] == "squareness"
+    assert svg.read_text().startswith("<svg")
+    assert "ISO 230-4" in html.read_text()
+
+
 def test_fit_pdge_equals_cli(cli):
     data = source("examples", "data", "line6d_x.csv")
     same_document(weilgen.fit_pdge(data), cli.json("fit-pdge", data))

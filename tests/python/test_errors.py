@@ -68,6 +68,15 @@ def test_bad_flags_carry_the_cli_message(cli):
                     "fit-pdge", data, "--rule", "max")
     raises_like_cli(cli, A, lambda: weilgen.iso230_2(data, comp_type=1),
                     "iso230-2", data, "--comp-type", "1")
+    raises_like_cli(cli, A, lambda: weilgen.iso230_2(data, normalise="sometimes"),
+                    "iso230-2", data, "--normalise", "sometimes")
+    raises_like_cli(cli, A, lambda: weilgen.iso230_2(data, uncertainty="lasr"),
+                    "iso230-2", data, "--uncertainty", "lasr")
+    trace = source("examples", "data", "ballbar_xy.csv")
+    raises_like_cli(cli, A, lambda: weilgen.ballbar(trace, alpha=2),
+                    "ballbar", trace, "--alpha", "2")
+    raises_like_cli(cli, A, lambda: weilgen.ballbar(trace, plot="p.png"),
+                    "ballbar", trace, "--plot", "p.png")
     raises_like_cli(cli, A, lambda: weilgen.identify("vmc_3axis", data=POINTS, axis="X"),
                     "identify", "vmc_3axis", "--data", POINTS, "--axis", "X")
     raises_like_cli(cli, A, lambda: weilgen.identify("vmc_3axis", data=POINTS, comp_table=POINTS,

@@ -1,5 +1,6 @@
-"""weilgen.Model against the generated C++ headers (bit for bit, through a program that includes
-them and nothing else) and against the reliability seed's closed form of the gantry grinder."""
+"""weilgen.Model against the generated C++ headers (to 1e-12 of each output's
+largest value, bit for bit without FP contraction; through a program that includes them and
+nothing else) and against the reliability seed's closed form of the gantry grinder."""
 import glob
 import os
 import subprocess
@@ -47,8 +48,18 @@ def errors(model, n, rng):
     return rng.standard_normal((n, len(model.errors))) * scale
 
 
-def bits(a):
-    return np.ascontiguousarray(a).view(np.uint64)
+def same_values(got, want):
+    """True when `got` equals `want` up to floating-point contraction: the module evaluates the
+    header through the batch ABI, the reference calls it directly; compiled with -ffp-contract=fast
+    or -march=native the compiler fuses a*b + c differently in the two inlining contexts (half an
+    ulp per operation, a few hundred operations, cancellation in small outputs), so the bound is
+    1e-12 of the largest magnitude of the output column. Without contraction the two are
+    identical bit for bit (scripts/test_fp_variants.sh runs both)."""
+    got, want = np.asarray(got), np.asarray(want)
+    if got.shape != want.shape:
+        return False
+    scale = np.abs(want).max(axis=0, keepdims=True) if want.ndim > 1 else np.abs(want).max()
+    return bool(np.all(np.abs(got - want) <= 1e-12 * scale))
 
 
 def test_shipped_machines_are_listed():
@@ -69,7 +80,7 @@ def test_names_and_units_are_the_headers(machine):
 
 
 @pytest.mark.parametrize("machine", MACHINES)
-def test_deviation_of_1e5_poses_is_the_headers_bit_for_bit(machine, tmp_path):
+def test_deviation_of_1e5_poses_is_the_headers(machine, tmp_path):
     m = weilgen.Model(machine)
     rng = np.random.default_rng(20240611)
     n = 100_000
@@ -77,19 +88,19 @@ def test_deviation_of_1e5_poses_is_the_headers_bit_for_bit(machine, tmp_path):
     dev, coeff = reference(machine, q, e, m.param_values, tmp_path)
     got = m.deviation(q, e)
     assert got.shape == (n, 6) and got.dtype == np.float64
-    assert np.array_equal(bits(got), bits(dev))
+    assert same_values(got, dev)
     got_c = m.coefficients(q[:2000])
     assert got_c.shape == (2000, 6, len(m.errors))
-    assert np.array_equal(bits(got_c), bits(coeff[:2000]))
+    assert same_values(got_c, coeff[:2000])
     if m.params:  # other parameter values: by name or in .params order
         p = m.param_values + 37.25
         dev_p, coeff_p = reference(machine, q[:5000], e[:5000], p, tmp_path)
-        assert np.array_equal(bits(m.deviation(q[:5000], e[:5000], params=p)), bits(dev_p))
+        assert same_values(m.deviation(q[:5000], e[:5000], params=p), dev_p)
         named = dict(zip(m.params, p))
-        assert np.array_equal(bits(m.deviation(q[:5000], e[:5000], params=named)), bits(dev_p))
-        assert np.array_equal(bits(m.coefficients(q[:5000], params=p)), bits(coeff_p))
+        assert same_values(m.deviation(q[:5000], e[:5000], params=named), dev_p)
+        assert same_values(m.coefficients(q[:5000], params=p), coeff_p)
         opened = weilgen.Model(machine, param={k: float(v) for k, v in named.items()})
-        assert np.array_equal(bits(opened.deviation(q[:5000], e[:5000])), bits(dev_p))
+        assert same_values(opened.deviation(q[:5000], e[:5000]), dev_p)
 
 
 def test_one_row_and_broadcasting():

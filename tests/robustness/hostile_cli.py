@@ -36,6 +36,7 @@ FIT = "fit-pdge l.csv --json keep.json"
 IDENT = "identify vmc_3axis --data p.csv --quiet --json keep.json"
 GAP = "gap vmc_3axis --data p.csv --quiet --json keep.json"
 BALL = "identify vmc_3axis --data p.csv --predict b.csv --quiet --json keep.json"
+BB = "ballbar b.csv --json keep.json"
 
 # Values no numeric flag accepts.
 NOT_NUMBERS = ["abc", "nan", "inf", "-inf", "1e999", "12abc", "0x10", "''", "' 5'", "1,5", "--"]
@@ -64,6 +65,8 @@ NUMERIC = [
     (ISO, "--target-tolerance", ["0", "-1e-6", "1e9"]),
     (ISO, "--reference-cycle", ["1.5", "1e99"]),
     (ISO, "--reference-position", []),
+    (BB, "--alpha", ["0", "1", "-1", "2"]),
+    (BB, "--min-contribution", ["-1", "1e9"]),
     (FIT, "--min-order", ["-1", "51"]),
     (FIT, "--max-order", ["-1", "51", "1000000"]),
     (FIT, "--folds", ["0", "1", "1001", "-3"]),
@@ -176,6 +179,24 @@ CASES = [
     ("iso230-2 d.csv --reference-cycle 99 --json keep.json", 2, ["--reference-cycle"]),
     ("iso230-2 d.csv --plot x.gif --json keep.json", 2, ["x.gif"]),
     ("iso230-2", 2, ["no data file"]),
+    ("iso230-2 d.csv --normalise sometimes --json keep.json", 2, ["--normalise"]),
+    ("iso230-2 d.csv --normalise never --expansion 11 --json keep.json", 2, ["--expansion"]),
+    ("iso230-2 d.csv --uncertainty lasr --json keep.json", 2, ["--uncertainty"]),
+    ("iso230-2 d.csv --uncertainty nothing.yaml --json keep.json", 3, ["nothing.yaml"]),
+    ("iso230-2 d.csv --uncertainty badbudget.yaml --json keep.json", 3,
+     ["badbudget.yaml:1:1", "unknown key 'eve'"]),
+    (BB + " --plot x.png", 2, ["--plot"]),
+    (BB + " --report x.pdf", 2, ["--report"]),
+    (BB + " --feedrate fast", 2, ["--feedrate"]),
+    (BB + " --feedrate 0", 2, ["--feedrate"]),
+    (BB + " --pdge poly:2", 2, ["--pdge"]),
+    (BB + " --plane XQ", 2, ["--plane"]),
+    (BB + " --radius -5", 2, ["--radius"]),
+    ("ballbar b.csv --json b.csv", 2, ["--json", "is the input"]),
+    ("ballbar b.csv --plot sub", 2, ["--plot"]),
+    ("ballbar", 2, ["no trace file"]),
+    ("ballbar nothing.csv --json keep.json", 3, ["nothing.csv: cannot read the data file"]),
+    ("ballbar d.csv --json keep.json", 3, ["d.csv:", "'# radius:' is missing"]),
     ("fit-pdge l.csv --basis spline:3 --json keep.json", 2, ["spline"]),
     ("fit-pdge l.csv --basis poly:-1 --json keep.json", 2, ["--basis"]),
     ("fit-pdge l.csv --basis poly:99999 --json keep.json", 2, ["--basis"]),
@@ -280,6 +301,7 @@ def fixtures(d):
     w("order0.yaml", two.replace("algebra: {order: 1}", "algebra: {order: 0}"))
     w("tabs.yaml", two.replace("  base: {}", "\tbase: {}"))
     w("badtol.yaml", "weilgen_tolerances: 1\nerrors:\n  E_XX: {sigma: -1, unit: mm}\n")
+    w("badbudget.yaml", "eve: 1\n")
     iso = open(os.path.join(SOURCE, "examples/data/iso230_2_small.csv")).read().split("\n")
     e = list(iso)
     e[9] = e[9].rsplit(",", 1)[0] + ","  # 200,-1,1,180,  (dx_um empty)

@@ -116,6 +116,28 @@ GapData gap_data(const MeasurementTable& table, const Description& desc,
     check_varies(c, t.column(c), "", false);
     if (!axis.empty()) g.dir[axis] = t.column(c);
   }
+  // A trace's axes reverse where the circle says: their directions of travel come from the
+  // angle and the feed (a `dir` column, else the circle's), so `reversal` sees a trace without
+  // dir_<axis> columns too.
+  if (trace && g.circle) {
+    const std::vector<double>& angle = t.column("angle_deg");
+    const std::vector<double>* feed = nullptr;
+    for (const std::string& c : t.columns_with(ColumnRole::Direction))
+      if (t.info_of(c).axis.empty()) feed = &t.column(c);
+    for (int which : {0, 1}) {
+      const std::string& axis = which == 0 ? g.circle->first : g.circle->second;
+      if (g.dir.count(axis)) continue;  // the file's own dir_<axis> wins
+      std::vector<double> dir(rows, kNaN);
+      for (std::size_t r = 0; r < rows; ++r) {
+        if (!std::isfinite(angle[r])) continue;
+        const int f =
+            feed && std::isfinite((*feed)[r]) ? static_cast<int>((*feed)[r]) : g.circle->feed;
+        dir[r] = ballbar_travel_direction({angle[r]}, f, which).front();
+      }
+      g.dir[axis] = dir;
+      g.derived_dir.push_back(axis);
+    }
+  }
   if (g.points.observations.size() < 10)
     throw InputError(SourceLoc{t.file, 0, 0}, "only " +
                                                   std::to_string(g.points.observations.size()) +

@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "effects.hpp"
+#include "weilgen/base/constants.hpp"
 
 namespace weilgen::gap_detail {
 
@@ -96,7 +97,7 @@ void add_periodic(const EffectContext& ctx, std::vector<Candidate>& out) {
   }
   if (c.variants.empty()) return;
   c.columns = [&d, errors](const Variant& v, const std::vector<double>&) {
-    const double w = 2 * M_PI / v.hyper[1];
+    const double w = 2 * kPi / v.hyper[1];
     return shaped(
         d, (*errors)[static_cast<std::size_t>(v.hyper[0])],
         {[w](double q) { return std::cos(w * q); }, [w](double q) { return std::sin(w * q); }});

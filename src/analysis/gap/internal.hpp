@@ -10,13 +10,13 @@
 #include <vector>
 
 #include "weilgen/analysis/gap.hpp"
+#include "weilgen/base/constants.hpp"
 
 namespace weilgen::gap_detail {
 
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
 using Index = Eigen::Index;
-inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // Upper tail of F(d1, d2); 1 for degenerate inputs.
 double f_sf(double f, double d1, double d2);

@@ -32,6 +32,9 @@ struct GapData {
   std::vector<double> time_s;                      // per row; NaN when absent
   std::vector<double> cycle;                       // per row; NaN when absent
   std::map<std::string, std::vector<double>> dir;  // axis -> ±1 per row (dir or dir_<axis>)
+  // The axes whose `dir` a ballbar trace's angle and feed gave (ballbar_travel_direction), not
+  // a column.
+  std::vector<std::string> derived_dir;
   std::map<std::string, std::vector<double>> temperature;  // T_<name> -> °C per row
   std::map<std::string, std::vector<double>> covariate;    // rpm, ... per row
   // Each covariate's unit as the measurement reader classifies its column (classify_column:

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "weilgen/analysis/study.hpp"
+#include "weilgen/base/constants.hpp"
 #include "weilgen/machine/outputs.hpp"
 #include "weilgen/uq/sobol_indices.hpp"
 
@@ -40,8 +41,7 @@ Sampling parse_sampling(const std::string& text);
 void set_sobol_intervals(SobolOptions& options, const long long* replicates,
                          const long long* bootstrap);
 
-struct SensitivityRecord {  // one pose, output and error; NaN where not computed
-  static constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+struct SensitivityRecord {     // one pose, output and error; NaN where not computed
   double coefficient = kNaN;   // c: output unit (mm, rad) per base unit of the error (mm, rad)
   double contribution = kNaN;  // c·σ, output unit
   double S = kNaN, S_lo = kNaN, S_hi = kNaN;     // first-order index and its interval
@@ -49,8 +49,7 @@ struct SensitivityRecord {  // one pose, output and error; NaN where not compute
   double S_exact = kNaN;                         // c²σ² / Σ c²σ² (linear model)
 };
 
-struct SensitivitySummary {  // one pose and output
-  static constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+struct SensitivitySummary {             // one pose and output
   double mean = kNaN, variance = kNaN;  // sampled (output unit, unit²)
   double variance_linear = kNaN;        // Σ c²σ² (unit²)
 };

@@ -11,11 +11,15 @@ std::string format_number(double v);
 // "%g" (6 significant digits): numbers inside messages.
 std::string format_short(double v);
 // Fixed-point with `decimals` digits after the point; "-" for NaN and infinities: table cells.
+// A value that rounds to zero has no sign ("0.000", never "-0.000").
 std::string format_fixed(double v, int decimals);
 // `digits` significant digits (std::setprecision); "-" for NaN and infinities: table cells.
 std::string format_significant(double v, int digits);
 // A C++ double literal: the shortest decimal (1 to 17 digits) that reads back as v, with ".0"
 // appended when it would otherwise read as an integer (generated code).
 std::string format_literal(double v);
+// A C++ double literal with all 17 significant digits ("-400.0", "0.0028541741934906256"): the
+// identified parameter header, whose readers compare it with a stated tolerance.
+std::string format_literal17(double v);
 
 }  // namespace weilgen

@@ -52,4 +52,8 @@ double parse_quantity(const std::string& text, const std::string& default_unit,
 double parse_duration_s(const std::string& text, const std::string& default_unit,
                         const std::string& what);
 
+// A feedrate in mm/min: "1000 mm/min", "16.7 mm/s", "1.2 m/min", "40 in/min", or a number
+// (mm/min); > 0. Throws std::invalid_argument "<what>: <why>".
+double parse_feedrate_mm_min(const std::string& text, const std::string& what);
+
 }  // namespace weilgen

@@ -149,6 +149,13 @@ struct BallbarEvaluation {
   double circular_deviation_um = 0;    // G = max − min of centred_um
   double radial_deviation_max_um = 0;  // F: max and min of centred_um (from nominal R)
   double radial_deviation_min_um = 0;
+  // The minimum zone (ISO 230-4's G with the minimum-zone centre): the centre (µm, as
+  // centre_offset_um) of the two concentric circles of least radial separation that enclose the
+  // trace (linearised, exact as a linear programme), that separation, and the radius deviation
+  // of the circle midway between them. G_mz <= G.
+  std::array<double, 2> mz_centre_offset_um{};
+  double mz_circular_deviation_um = 0;
+  double mz_radius_deviation_um = 0;
   // Joint LSQ fit of orders 0..max_harmonic; orders 2..max_harmonic reported. Empty unless
   // there are 2·max_harmonic + 1 distinct angles and no gap of 180°/max_harmonic or more.
   std::vector<BallbarHarmonic> harmonics;
@@ -167,6 +174,21 @@ BallbarEvaluation evaluate_ballbar(const std::vector<double>& angle_deg,
                                    int max_harmonic = 4);
 BallbarEvaluation evaluate_ballbar(const BallbarTrace& trace, double radius_mm,
                                    int max_harmonic = 4);
+
+// The minimum zone of dr(θ): min over (a, b) of max − min of dr − a cos θ − b sin θ, solved as a
+// linear programme (its dual has four rows: a revised simplex). Returns the centre (a, b), the
+// zone's width and its mid value; throws std::invalid_argument for fewer than 4 distinct angles.
+struct MinimumZone {
+  std::array<double, 2> centre_um{};
+  double width_um = 0, mid_um = 0;
+};
+MinimumZone minimum_zone(const std::vector<double>& angle_deg, const std::vector<double>& dr_um);
+
+// The direction of travel of an in-plane axis at each point of a trace (ISO 230-4 circles: the
+// first coordinate moves as cos θ, the second as sin θ): +1 or −1, the direction in which the axis
+// approached the point, so a point exactly at a reversal (θ = 0° or 180° for the first axis,
+// 90° or 270° for the second) belongs to the motion before it. `axis` 0: first, 1: second.
+std::vector<int> ballbar_travel_direction(const std::vector<double>& angle_deg, int feed, int axis);
 
 // Linear interpolation of a trace at `angles_deg`, periodic in 360°; points at the same angle
 // (an overrun) are averaged. Throws std::invalid_argument when the trace has a gap wider than
@@ -188,6 +210,7 @@ struct TraceDifference {
 };
 
 struct BallbarComparison {
+  int feed = 1, cycle = 0;  // the measured trace's direction (+1 ccw, -1 cw) and cycle
   std::vector<double> angle_deg, measured_um, predicted_um;  // the measured points, file order
   TraceDifference raw;                                       // as measured and predicted
   TraceDifference centred;  // each with its own LSQ centre (a, b) removed (the set-up offset)

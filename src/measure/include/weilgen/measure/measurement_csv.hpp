@@ -88,6 +88,9 @@ struct MeasurementTable {
   int header_line = 0;                                // 1-based line of the header row
   std::vector<std::string> warnings;  // "file:line: unknown column 'foo' ..." (allow_unknown)
   std::vector<std::vector<int>> cell_columns;  // per row, each cell's 1-based source column
+  // Column -> the 1-based character column of its header cell (an imported file: the source
+  // column it was read from); absent when unknown.
+  std::map<std::string, int> header_columns;
 
   std::size_t rows() const { return lines.size(); }
   bool has(const std::string& column) const { return values.count(column) != 0; }
@@ -97,6 +100,8 @@ struct MeasurementTable {
   // Where the cell of `row` in `column` is: file:line:column (the column 0 when unknown), for
   // messages about one cell, e.g. an empty one.
   SourceLoc cell(std::size_t row, const std::string& column) const;
+  // Where the header cell of `column` is: file:header_line:column (the column 0 when unknown).
+  SourceLoc header_cell(const std::string& column) const;
   // The classification of a column present in the table (throws like column()).
   const ColumnInfo& info_of(const std::string& name) const;
   // Names of the columns with this role, in file order.

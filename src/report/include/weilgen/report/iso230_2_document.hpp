@@ -23,6 +23,16 @@ nlohmann::json iso230_2_json(const std::string& data, const Iso230_2StudyResult&
 std::vector<std::string> iso230_2_normalisation_statement(const Iso230_2StudyResult& result);
 // The tolerance verdicts, one line each, and the overall verdict ("" without tolerances).
 std::vector<std::string> iso230_2_tolerance_statement(const Iso230_2StudyResult& result);
+// The uncertainty of the figures (empty without a budget): a table of E, M, A, B, R (and the
+// figures the tolerances limit) with u, U and the Monte Carlo's u and interval, then each of E,
+// M, A, B, R's budget (every contribution's distribution, u(x), sensitivity, |c| u and share of
+// u²) and the budget's notes.
+std::vector<std::string> iso230_2_uncertainty_text(const Iso230_2StudyResult& result);
+// The figures whose budgets the documents show: E, M, A, B, R.
+const std::vector<std::string>& iso230_2_budget_figures();
+// Whether the run meets ISO 230-2's test conditions: one line, or a heading and one "- check:
+// why" line per condition not met.
+std::vector<std::string> iso230_2_conformance_statement(const Iso230_2StudyResult& result);
 // The per-target table as CSV, one row per target: target_mm, the classical k = 2 columns
 // (mean_up_um ... R_i_um, mean_bi_um, the band lower_up_um = x̄↑ − 2s↑ ... upper_down_um) and,
 // with a drift-eliminated evaluation, chart_up_um, s_star_up_um, chart_down_um, s_star_down_um

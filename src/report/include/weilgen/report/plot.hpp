@@ -34,10 +34,23 @@ struct HeatMap {
   bool annotate = true;
 };
 enum class LineStyle { LinesPoints, Lines, Points };
+// A shaded area between lo and hi (same size as x), drawn under the lines (x̄ ± 2s).
+struct LineBand {
+  std::string label;
+  std::vector<double> lo, hi;
+  std::size_t line = static_cast<std::size_t>(-1);  // drawn in the colour of lines[line]
+};
+// A horizontal dashed line across the plot at y (a tolerance).
+struct LineRule {
+  std::string label;  // "" keeps it out of the key
+  double y = 0;
+};
 struct LinePlot {
   std::string title, xlabel, ylabel;
   std::vector<double> x;
   std::vector<std::pair<std::string, std::vector<double>>> lines;  // label, y (same size as x)
+  std::vector<LineBand> bands = {};
+  std::vector<LineRule> rules = {};
 };
 // A line plot whose lines have their own styles: measured points (Points skip NaN values, so
 // they can share a dense x grid) among fitted curves (Lines).
