@@ -1,7 +1,7 @@
 // Analysis throughput on the gantry grinder (issue 3, section 8): Sobol' indices with N = 2^16
-// (21 inputs, N (k+2) = 1.5 M model evaluations) at one pose, and reliability over the seed's
-// 75 grid poses (dx, dy, dz grids) by every method, through the weilgen CLI as a user runs it:
-// compiled (built-in) model against the numeric Eigen chain (--engine numeric). Wall time,
+// (21 inputs, N (k+2) = 1.5 M model evaluations) at one pose, and reliability over Wang & Yuan
+// 2021's 75 grid poses (dx, dy, dz grids) by every method, through the weilgen CLI as a user runs
+// it: compiled (built-in) model against the numeric Eigen chain (--engine numeric). Wall time,
 // model evaluations (from the --json output) and evaluations per second.
 //
 // Usage: weilgen_bench_analysis [path/to/weilgen] [--quick]

@@ -7,6 +7,9 @@
 //   generated_coeff         Coefficients (6 x n first-order coefficients)
 //   generated_dev+coeff     Deviation then Coefficients: two calls
 //   generated_combined      DeviationAndCoefficients: the same outputs in one call
+//   output_floor            the load/store floor of those outputs: their 6 + 6n values, computed
+//                           before timing, copied from an L1-resident table into the same arrays
+//                           by 16-byte loads and stores (no code producing them can be faster)
 //   eigen_dev               (a) the exact deviation from a fixed-size Eigen chain compiled from the
 //                           machine description at set-up (3x3 rotations and 3-vectors, no
 //                           allocation): actual and nominal pose, AngleAxis of R R0^T
@@ -21,10 +24,14 @@
 // chain's deviation equals NumericChain::deviation to rounding, the analytic Jacobian equals the
 // generated Coefficients to rounding, the generated deviation equals the exact one to O(e^2),
 // DeviationAndCoefficients equals the two separate calls. After the run a Markdown table of CPU
-// ns/pose and ratios is printed. pipe_cutter's output transform (linked jaws, derived quantities)
-// is not a serial chain: its baseline is written by hand for it (pipe_cutter_baseline.hpp).
+// ns/pose and ratios is printed, with DeviationAndCoefficients against its output floor.
+// pipe_cutter's output transform (linked jaws, derived quantities) is not a serial chain: its
+// baseline is written by hand for it (pipe_cutter_baseline.hpp).
 #include <benchmark/benchmark.h>
 #include <unistd.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -447,6 +454,65 @@ void BM_GeneratedCombined(benchmark::State& state) {
   state.SetItemsProcessed(static_cast<int64_t>(state.iterations()));
 }
 
+// The load/store floor of DeviationAndCoefficients' outputs: per pose, its 6 + 6n outputs
+// (computed before timing) copied from a table into the same four arrays the generated function
+// writes. No code that computes these outputs can store them faster; the table's loads are what
+// the generated code spends reading its n + axes inputs instead. The table holds the first
+// kFloorRows poses (a few KiB, in L1 like the generated code's inputs and constants: all 1024
+// would be 1-2 MiB and measure the cache instead).
+constexpr std::size_t kFloorRows = 4;
+
+// dst = src by 16-byte loads and stores (what a compiler emits for a known small array; a plain
+// assignment of these sizes becomes `rep movsq`, whose start-up costs more than the copy).
+template <std::size_t N>
+void copy_block(std::array<double, N>& dst, const std::array<double, N>& src) {
+#if defined(__SSE2__)
+  std::size_t i = 0;
+#pragma GCC unroll 256
+  for (; i + 2 <= N; i += 2) _mm_storeu_pd(dst.data() + i, _mm_loadu_pd(src.data() + i));
+  if (i < N) dst[i] = src[i];
+#else
+  for (std::size_t i = 0; i < N; ++i) dst[i] = src[i];
+#endif
+}
+
+template <typename M>
+struct OutputTable {
+  struct Row {
+    std::array<double, 3> position, orientation;
+    std::array<double, 3 * M::kNumErrors> position_coeff, orientation_coeff;
+  };
+  std::vector<Row> rows;
+  OutputTable() : rows(kFloorRows) {
+    const PoseSet<M>& s = poses<M>();
+    for (std::size_t p = 0; p < kFloorRows; ++p)
+      M::DeviationAndCoefficients(s.axes[p], s.errors[p], s.params, &rows[p].position,
+                                  &rows[p].orientation, &rows[p].position_coeff,
+                                  &rows[p].orientation_coeff);
+  }
+};
+
+template <typename M>
+void BM_OutputFloor(benchmark::State& state) {
+  static const OutputTable<M> table;
+  std::array<double, 3> position{}, orientation{};
+  std::array<double, 3 * M::kNumErrors> position_coeff{}, orientation_coeff{};
+  std::size_t p = 0;
+  for (auto _ : state) {
+    const auto& row = table.rows[p];
+    copy_block(position, row.position);
+    copy_block(orientation, row.orientation);
+    copy_block(position_coeff, row.position_coeff);
+    copy_block(orientation_coeff, row.orientation_coeff);
+    benchmark::DoNotOptimize(position);
+    benchmark::DoNotOptimize(orientation);
+    benchmark::DoNotOptimize(position_coeff);
+    benchmark::DoNotOptimize(orientation_coeff);
+    p = (p + 1) & (kFloorRows - 1);
+  }
+  state.SetItemsProcessed(static_cast<int64_t>(state.iterations()));
+}
+
 template <typename M>
 void BM_EigenDeviation(benchmark::State& state) {
   const PoseSet<M>& s = poses<M>();
@@ -584,6 +650,7 @@ void register_machine() {
   benchmark::RegisterBenchmark((m + "/generated_dev+coeff").c_str(),
                                BM_GeneratedDeviationCoefficients<M>);
   benchmark::RegisterBenchmark((m + "/generated_combined").c_str(), BM_GeneratedCombined<M>);
+  benchmark::RegisterBenchmark((m + "/output_floor").c_str(), BM_OutputFloor<M>);
   benchmark::RegisterBenchmark((m + "/eigen_dev").c_str(), BM_EigenDeviation<M>);
   benchmark::RegisterBenchmark((m + "/analytic_coeff").c_str(), BM_AnalyticCoefficients<M>);
   benchmark::RegisterBenchmark((m + "/eigen_dev+analytic_coeff").c_str(),
@@ -619,20 +686,22 @@ class SummaryReporter : public benchmark::ConsoleReporter {
     ConsoleReporter::Finalize();
     std::ostringstream main, extra;
     for (const auto& [machine, n] : machines_) {
+      const std::string& key = machine;  // clang < 16 cannot capture a structured binding
       const auto get = [&](const std::string& what) {
-        const auto it = cpu_ns_.find(machine + "/" + what);
+        const auto it = cpu_ns_.find(key + "/" + what);
         return it == cpu_ns_.end() ? 0.0 : it->second;
       };
       const double dev = get("generated_dev"), coeff = get("generated_coeff"),
                    two = get("generated_dev+coeff"), one = get("generated_combined"),
                    a = get("eigen_dev"), b = get("analytic_coeff"),
-                   ab = get("eigen_dev+analytic_coeff"), fd = get("extra_chain_dev+fd_coeff");
+                   ab = get("eigen_dev+analytic_coeff"), fd = get("extra_chain_dev+fd_coeff"),
+                   floor = get("output_floor");
       if (dev == 0 || coeff == 0 || two == 0 || one == 0 || a == 0 || b == 0 || ab == 0)
         continue;  // filtered out
       main << std::fixed << std::setprecision(1) << "| " << machine << " | " << n << " | " << dev
            << " | " << a << " | **" << a / dev << "x** | " << coeff << " | " << b << " | **"
            << b / coeff << "x** | " << one << " | " << two << " | " << ab << " | **" << ab / one
-           << "x** |\n";
+           << "x** | " << floor << " | " << (floor > 0 ? one / floor : 0.0) << "x |\n";
       if (fd != 0)
         extra << std::fixed << "| " << machine << " | " << std::setprecision(1) << one << " | "
               << std::setprecision(0) << fd << " | " << fd / one << "x |\n";
@@ -643,8 +712,10 @@ class SummaryReporter : public benchmark::ConsoleReporter {
         << "| machine | n | generated Deviation | (a) Eigen chain deviation | (a) / Deviation | "
            "generated Coefficients | (b) analytic Jacobian | (b) / Coefficients | generated "
            "DeviationAndCoefficients | generated Deviation + Coefficients (2 calls) | (a) + (b) "
-           "| (a + b) / DeviationAndCoefficients |\n"
-        << "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n"
+           "| (a + b) / DeviationAndCoefficients | output floor (copy of the 6 + 6n outputs) | "
+           "DeviationAndCoefficients / floor |\n"
+        << "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | "
+           "---: | ---: |\n"
         << main.str();
     if (!extra.str().empty())
       out << "\nExtra (not a competent baseline): the numeric chain with finite-difference "

@@ -7,17 +7,20 @@
 #   3. the full build of the test command (scripts/build.sh, everything) from scratch;
 # and, with --per-file, the compile CPU seconds of the 15 most expensive translation units.
 #
-# Usage: bench/build_time.sh [--per-file] [--unity-off] [REPO]   (REPO default: this checkout)
+# Usage: bench/build_time.sh [--per-file] [--unity-off] [--no-full] [REPO]
+#   (REPO default: this checkout; --no-full skips the third, longest row)
 # No ccache (CMAKE_*_COMPILER_LAUNCHER is cleared); the machine's load is printed beside the
 # numbers, because wall times on a shared machine mean little without it.
 set -euo pipefail
 export LC_ALL=C
 per_file=0
+full=1
 extra=()
 while [[ "${1:-}" == --* ]]; do
   case "$1" in
     --per-file) per_file=1 ;;
     --unity-off) extra+=(-DWEILGEN_UNITY_BUILD=OFF) ;;
+    --no-full) full=0 ;;
     *) echo "build_time.sh: unknown option $1" >&2; exit 2 ;;
   esac
   shift
@@ -39,14 +42,14 @@ measure() {
   t1=$EPOCHREALTIME
   c1=$(awk '{print $14+$15+$16+$17}' /proc/$me/stat)
   awk -v a="$t0" -v b="$t1" -v c="$c0" -v d="$c1" -v hz="$(getconf CLK_TCK)" \
-    'BEGIN {printf "%.0f | %.0f", b - a, (d - c) / hz}'
+    -v l="$(cut -d' ' -f1 /proc/loadavg)" 'BEGIN {printf "%.0f | %.0f | %s", b - a, (d - c) / hz, l}'
 }
 
 echo "machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//'), $jobs cores;" \
   "load before: $(cut -d' ' -f1-3 /proc/loadavg); commit $(git rev-parse --short HEAD)"
 echo
-echo "| what | wall s | CPU s |"
-echo "| --- | ---: | ---: |"
+echo "| what | wall s | CPU s | 1-min load at the end |"
+echo "| --- | ---: | ---: | ---: |"
 echo "| \`bash scripts/run_default.sh\` (clean clone, dependencies installed) | $(measure bash scripts/run_default.sh) |"
 rm -rf build
 launcher=()
@@ -63,7 +66,7 @@ fi
 cmake -S . -B build-cli -DCMAKE_BUILD_TYPE=Release -DWEILGEN_BUILD_TESTS=OFF -DWEILGEN_BUILD_PYTHON=OFF \
   -DWEILGEN_BUILD_BENCH=OFF "${launcher[@]}" "${extra[@]}" >/dev/null
 echo "| \`weilgen\` target from scratch, -j$jobs | $(measure cmake --build build-cli -j"$jobs" --target weilgen) |"
-echo "| full build of the test command (\`scripts/build.sh\`) from scratch, -j$jobs | $(BUILD_DIR=build-full measure bash scripts/build.sh "${extra[@]}") |"
+((full)) && echo "| full build of the test command (\`scripts/build.sh\`) from scratch, -j$jobs | $(BUILD_DIR=build-full measure bash scripts/build.sh "${extra[@]}") |"
 echo
 echo "load after: $(cut -d' ' -f1-3 /proc/loadavg)"
 if ((per_file)); then

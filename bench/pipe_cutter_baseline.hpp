@@ -1,5 +1,5 @@
 // The hand-written baseline for the dual-chuck pipe cutter (machines/pipe_cutter.yaml), written
-// as a competent engineer would for speed: the seed's construction (equations (3)-(10) as
+// as a competent engineer would for speed: Jiang et al. 2021's construction (equations (3)-(10) as
 // corrected in the machine file's notes) with error and parameter indices resolved once, rigid
 // poses as a 3x3 rotation and a 3-vector, each chuck's shared part evaluated once, no allocation.
 //   (a) deviation: exact (every error motion an exact rotation, the orientation the exact

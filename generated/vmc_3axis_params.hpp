@@ -22,6 +22,10 @@ inline constexpr std::size_t kNumErrors = 21;
 inline constexpr std::size_t kNumParams = 1;
 // Machine parameters the errors were identified with (tool_length mm).
 inline constexpr std::array<double, kNumParams> kParams = {{0.0}};
+// Where the errors were identified: the span of the measured poses along every axis (Y mm, X mm, Z mm).
+// Errors() holds every PDGE at its axis' span ends: a basis is never extrapolated.
+inline constexpr std::array<double, kNumAxes> kSpanMin = {{-400.0, 0.0, -300.0}};
+inline constexpr std::array<double, kNumAxes> kSpanMax = {{0.0, 500.0, 0.0}};
 
 // Basis sums (docs/fit-pdge.md): u = (2x - a - b) / (b - a) for the polynomial kinds.
 template <typename Scalar, std::size_t N>
@@ -66,71 +70,77 @@ Scalar FourierSum(const std::array<double, N>& c, Scalar w) {
          Scalar(c[2 * k]) * sin(Scalar(static_cast<double>(k)) * w);
   return s;
 }
+// Axis a's position held within its identified span (a NaN stays NaN: Compensate refuses it).
+template <typename Scalar>
+Scalar Held(const std::array<Scalar, kNumAxes>& axes, std::size_t a) {
+  const Scalar lo = Scalar(kSpanMin[a]), hi = Scalar(kSpanMax[a]);
+  return axes[a] < lo ? lo : axes[a] > hi ? hi : axes[a];
+}
 
 // E_XY(Y): poly:3 on [-400.0, 0.0], mm
-inline constexpr std::array<double, 4> kE_XY = {{0.0028541741934906256, -0.00098231688317303428, 0.00068202026208979028, 0.0020326556287311929}};
+inline constexpr std::array<double, 4> kE_XY = {{0.0028541741934906286, -0.00098231688317303341, 0.00068202026208978995, 0.0020326556287311899}};
 // E_YY(Y): poly:3 on [-400.0, 0.0], mm
-inline constexpr std::array<double, 4> kE_YY = {{0.0010027930533516543, 1.9984444444887025e-06, -0.012371078095238104, -0.007501467973856272}};
+inline constexpr std::array<double, 4> kE_YY = {{0.0010027930533516539, 1.99844444448924e-06, -0.012371078095238103, -0.0075014679738562712}};
 // E_ZY(Y): poly:3 on [-400.0, 0.0], mm
-inline constexpr std::array<double, 4> kE_ZY = {{-0.0017230076092742553, -0.0011257140019288053, -0.00096181440896359559, 0.00021728690787418546}};
+inline constexpr std::array<double, 4> kE_ZY = {{-0.0017230076092742538, -0.001125714001928804, -0.00096181440896359602, 0.00021728690787418376}};
 // E_AY(Y): poly:3 on [-400.0, 0.0], rad
-inline constexpr std::array<double, 4> kE_AY = {{3.1358856451065574e-06, 8.4552048148145203e-06, -1.8463761904761867e-06, 1.4071198257083602e-06}};
+inline constexpr std::array<double, 4> kE_AY = {{3.1358856451065566e-06, 8.4552048148145135e-06, -1.8463761904761804e-06, 1.4071198257083701e-06}};
 // E_BY(Y): poly:3 on [-400.0, 0.0], rad
-inline constexpr std::array<double, 4> kE_BY = {{-6.0430782371838827e-06, -1.5867650000000031e-05, -5.5399571428571966e-06, -8.9930666666664924e-06}};
+inline constexpr std::array<double, 4> kE_BY = {{-6.0430782371838827e-06, -1.5867650000000024e-05, -5.5399571428571915e-06, -8.9930666666665179e-06}};
 // E_CY(Y): poly:3 on [-400.0, 0.0], rad
-inline constexpr std::array<double, 4> kE_CY = {{-1.1151108783590465e-05, 4.2217137998631269e-06, 3.2235051896774974e-06, -3.8629444444442618e-06}};
+inline constexpr std::array<double, 4> kE_CY = {{-1.1151108783590462e-05, 4.2217137998631227e-06, 3.2235051896774906e-06, -3.8629444444442499e-06}};
 inline constexpr double kE_C0Y = 1.1151108783590467e-05;  // rad
 // E_XX(X): poly:3 on [0.0, 500.0], mm
-inline constexpr std::array<double, 4> kE_XX = {{0.0028541741934906264, 0.0043708883596683661, -0.00018179531249998981, -0.007443197669320837}};
+inline constexpr std::array<double, 4> kE_XX = {{0.0028541741934906264, 0.0043708883596683679, -0.00018179531249999157, -0.0074431976693208361}};
 // E_YX(X): poly:3 on [0.0, 500.0], mm
-inline constexpr std::array<double, 4> kE_YX = {{0.0010027930533516552, 0.00075623994238355923, 0.0012214037246695601, 0.00035524914354403969}};
+inline constexpr std::array<double, 4> kE_YX = {{0.0010027930533516548, 0.00075623994238356227, 0.0012214037246695642, 0.00035524914354403817}};
 // E_ZX(X): poly:3 on [0.0, 500.0], mm
-inline constexpr std::array<double, 4> kE_ZX = {{-0.0017230076092742534, -0.0034680094002281507, 0.0017414589142402909, 0.0026330836668253055}};
+inline constexpr std::array<double, 4> kE_ZX = {{-0.0017230076092742534, -0.0034680094002281546, 0.0017414589142402954, 0.0026330836668253142}};
 // E_AX(X): poly:3 on [0.0, 500.0], rad
-inline constexpr std::array<double, 4> kE_AX = {{3.135885645106557e-06, 1.1438350681725681e-05, 6.0081524725275168e-06, 3.8035345441596484e-06}};
+inline constexpr std::array<double, 4> kE_AX = {{3.1358856451065557e-06, 1.1438350681725686e-05, 6.0081524725275142e-06, 3.8035345441596463e-06}};
 // E_BX(X): poly:3 on [0.0, 500.0], rad
-inline constexpr std::array<double, 4> kE_BX = {{-8.264690031420638e-06, -5.0101768548462096e-06, -9.3007299107142716e-06, -1.9714925770998154e-06}};
+inline constexpr std::array<double, 4> kE_BX = {{-8.2646900314206431e-06, -5.0101768548461995e-06, -9.3007299107142953e-06, -1.97149257709982e-06}};
 // E_CX(X): poly:3 on [0.0, 500.0], rad
-inline constexpr std::array<double, 4> kE_CX = {{-6.6461062657016905e-06, 8.7849817022078581e-06, -4.8302176339285919e-06, -4.6822727042883937e-06}};
+inline constexpr std::array<double, 4> kE_CX = {{-6.6461062657016905e-06, 8.7849817022078632e-06, -4.8302176339285809e-06, -4.6822727042883988e-06}};
 // E_XZ(Z): poly:3 on [-300.0, 0.0], mm
-inline constexpr std::array<double, 4> kE_XZ = {{-0.0028541741934906256, -0.0025994206886659063, -0.00039805125000000639, -0.0013625474999999782}};
+inline constexpr std::array<double, 4> kE_XZ = {{-0.0028541741934906251, -0.0025994206886659054, -0.00039805125000000671, -0.0013625474999999804}};
 // E_YZ(Z): poly:3 on [-300.0, 0.0], mm
-inline constexpr std::array<double, 4> kE_YZ = {{-0.0010027930533516548, 0.0045542435993321398, -0.0020793787500000007, -0.0022329900000000015}};
+inline constexpr std::array<double, 4> kE_YZ = {{-0.0010027930533516548, 0.0045542435993321407, -0.0020793787500000007, -0.0022329900000000002}};
 // E_ZZ(Z): poly:3 on [-300.0, 0.0], mm
-inline constexpr std::array<double, 4> kE_ZZ = {{0.001723007609274254, 0.0054494737500000012, -0.00042832499999998505, -0.0037410637500000028}};
+inline constexpr std::array<double, 4> kE_ZZ = {{0.0017230076092742534, 0.0054494737500000012, -0.00042832499999998511, -0.0037410637500000028}};
 // E_AZ(Z): poly:3 on [-300.0, 0.0], rad
 inline constexpr std::array<double, 4> kE_AZ = {{0.0, 0.0, 0.0, 0.0}};
 // E_BZ(Z): poly:3 on [-300.0, 0.0], rad
 inline constexpr std::array<double, 4> kE_BZ = {{0.0, 0.0, 0.0, 0.0}};
 // E_CZ(Z): poly:3 on [-300.0, 0.0], rad
 inline constexpr std::array<double, 4> kE_CZ = {{0.0, 0.0, 0.0, 0.0}};
-inline constexpr double kE_B0Z = 6.0430782371838836e-06;  // rad
-inline constexpr double kE_A0Z = -1.5141121655631215e-05;  // rad
+inline constexpr double kE_B0Z = 6.0430782371838844e-06;  // rad
+inline constexpr double kE_A0Z = -1.5141121655631212e-05;  // rad
 
 // Every error at a pose (axes in kAxes order of the model header: mm, deg).
 template <typename Scalar>
 void Errors([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
             std::array<Scalar, kNumErrors>* errors) {
   auto& e = *errors;
-  e[0] = PolySum(kE_XY, (Scalar(2) * axes[0] - Scalar(-400.0)) / Scalar(400.0));
-  e[1] = PolySum(kE_YY, (Scalar(2) * axes[0] - Scalar(-400.0)) / Scalar(400.0));
-  e[2] = PolySum(kE_ZY, (Scalar(2) * axes[0] - Scalar(-400.0)) / Scalar(400.0));
-  e[3] = PolySum(kE_AY, (Scalar(2) * axes[0] - Scalar(-400.0)) / Scalar(400.0));
-  e[4] = PolySum(kE_BY, (Scalar(2) * axes[0] - Scalar(-400.0)) / Scalar(400.0));
-  e[5] = PolySum(kE_CY, (Scalar(2) * axes[0] - Scalar(-400.0)) / Scalar(400.0));
+  e[0] = PolySum(kE_XY, (Scalar(2) * Held(axes, 0) - Scalar(-400.0)) / Scalar(400.0));
+  e[1] = PolySum(kE_YY, (Scalar(2) * Held(axes, 0) - Scalar(-400.0)) / Scalar(400.0));
+  e[2] = PolySum(kE_ZY, (Scalar(2) * Held(axes, 0) - Scalar(-400.0)) / Scalar(400.0));
+  e[3] = PolySum(kE_AY, (Scalar(2) * Held(axes, 0) - Scalar(-400.0)) / Scalar(400.0));
+  e[4] = PolySum(kE_BY, (Scalar(2) * Held(axes, 0) - Scalar(-400.0)) / Scalar(400.0));
+  e[5] = PolySum(kE_CY, (Scalar(2) * Held(axes, 0) - Scalar(-400.0)) / Scalar(400.0));
   e[6] = Scalar(kE_C0Y);
-  e[7] = PolySum(kE_XX, (Scalar(2) * axes[1] - Scalar(500.0)) / Scalar(500.0));
-  e[8] = PolySum(kE_YX, (Scalar(2) * axes[1] - Scalar(500.0)) / Scalar(500.0));
-  e[9] = PolySum(kE_ZX, (Scalar(2) * axes[1] - Scalar(500.0)) / Scalar(500.0));
-  e[10] = PolySum(kE_AX, (Scalar(2) * axes[1] - Scalar(500.0)) / Scalar(500.0));
-  e[11] = PolySum(kE_BX, (Scalar(2) * axes[1] - Scalar(500.0)) / Scalar(500.0));
-  e[12] = PolySum(kE_CX, (Scalar(2) * axes[1] - Scalar(500.0)) / Scalar(500.0));
-  e[13] = PolySum(kE_XZ, (Scalar(2) * axes[2] - Scalar(-300.0)) / Scalar(300.0));
-  e[14] = PolySum(kE_YZ, (Scalar(2) * axes[2] - Scalar(-300.0)) / Scalar(300.0));
-  e[15] = PolySum(kE_ZZ, (Scalar(2) * axes[2] - Scalar(-300.0)) / Scalar(300.0));
-  e[16] = PolySum(kE_AZ, (Scalar(2) * axes[2] - Scalar(-300.0)) / Scalar(300.0));
-  e[17] = PolySum(kE_BZ, (Scalar(2) * axes[2] - Scalar(-300.0)) / Scalar(300.0));
-  e[18] = PolySum(kE_CZ, (Scalar(2) * axes[2] - Scalar(-300.0)) / Scalar(300.0));
+  e[7] = PolySum(kE_XX, (Scalar(2) * Held(axes, 1) - Scalar(500.0)) / Scalar(500.0));
+  e[8] = PolySum(kE_YX, (Scalar(2) * Held(axes, 1) - Scalar(500.0)) / Scalar(500.0));
+  e[9] = PolySum(kE_ZX, (Scalar(2) * Held(axes, 1) - Scalar(500.0)) / Scalar(500.0));
+  e[10] = PolySum(kE_AX, (Scalar(2) * Held(axes, 1) - Scalar(500.0)) / Scalar(500.0));
+  e[11] = PolySum(kE_BX, (Scalar(2) * Held(axes, 1) - Scalar(500.0)) / Scalar(500.0));
+  e[12] = PolySum(kE_CX, (Scalar(2) * Held(axes, 1) - Scalar(500.0)) / Scalar(500.0));
+  e[13] = PolySum(kE_XZ, (Scalar(2) * Held(axes, 2) - Scalar(-300.0)) / Scalar(300.0));
+  e[14] = PolySum(kE_YZ, (Scalar(2) * Held(axes, 2) - Scalar(-300.0)) / Scalar(300.0));
+  e[15] = PolySum(kE_ZZ, (Scalar(2) * Held(axes, 2) - Scalar(-300.0)) / Scalar(300.0));
+  e[16] = PolySum(kE_AZ, (Scalar(2) * Held(axes, 2) - Scalar(-300.0)) / Scalar(300.0));
+  e[17] = PolySum(kE_BZ, (Scalar(2) * Held(axes, 2) - Scalar(-300.0)) / Scalar(300.0));
+  e[18] = PolySum(kE_CZ, (Scalar(2) * Held(axes, 2) - Scalar(-300.0)) / Scalar(300.0));
   e[19] = Scalar(kE_B0Z);
   e[20] = Scalar(kE_A0Z);
 }

@@ -28,6 +28,8 @@ if [[ "$mode" != "--cli" ]]; then
     # headless chromium and PIL: the HTML reports' browser tests (tests/browser)
     chromium fonts-dejavu-core python3-pil
     python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest python3-matplotlib
+    # the Python package: DataFrames (weilgen.to_frame), `pip install .` into a venv (tests/python)
+    python3-pandas python3-pip python3-venv
   )
 fi
 # --bench: also the peer tools the benchmarks compare against (bench/openturns/run.sh,

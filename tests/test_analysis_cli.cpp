@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <set>
 
@@ -26,7 +27,7 @@ json read_json(const std::string& path) {
   return json::parse(text);
 }
 
-// Table 1 of the grinder seed (standard deviations; mm and rad).
+// Table 1 of Wang & Yuan 2021 (standard deviations; mm and rad).
 double grinder_sigma(const std::string& e) {
   static const std::map<std::string, double> s = {
       {"E_XX", 0.05 / 6},    {"E_YX", 0.05 / 6},    {"E_ZX", 0.05 / 6},     {"E_AX", 0.03 / 6000},
@@ -151,6 +152,34 @@ TEST_CASE("sensitivity CLI: replicate intervals by default, the bootstrap on req
                   out))
               .status == 0);
   CHECK(read_json(out)["settings"]["intervals"].is_null());
+}
+
+TEST_CASE("sensitivity CLI: at order 1 the linear form gives the model's Sobol' indices") {
+  // dx alone is evaluated as its linear form (offset + coefficients · errors); with dp beside it
+  // (not linear) every output comes from the model's batch evaluation. The same design and seed:
+  // the same indices to rounding.
+  const auto dir = test::fresh_dir("cli_sensitivity_linear");
+  const std::string a = (dir / "a.json").string(), b = (dir / "b.json").string();
+  const std::string common =
+      "sensitivity five_axis_ac --at X=100,Y=50,Z=-100,A=30,C=45 --method sobol --samples 2048 "
+      "--quiet --json ";
+  REQUIRE(run(cli(common + a + " --outputs dx,db")).status == 0);
+  REQUIRE(run(cli(common + b + " --outputs dx,db,dp")).status == 0);
+  const json ja = read_json(a), jb = read_json(b);
+  std::map<std::string, double> model;
+  for (const auto& rec : jb["results"])
+    if (rec["output"] != "dp")
+      model[rec["output"].get<std::string>() + "/" + rec["error"].get<std::string>()] = rec["S"];
+  std::size_t compared = 0;
+  for (const auto& rec : ja["results"]) {
+    const std::string key =
+        rec["output"].get<std::string>() + "/" + rec["error"].get<std::string>();
+    CAPTURE(key);
+    REQUIRE(model.count(key) == 1);
+    CHECK(rec["S"].get<double>() == doctest::Approx(model[key]).epsilon(1e-12).scale(1));
+    ++compared;
+  }
+  CHECK(compared == 2 * 43);
 }
 
 TEST_CASE("sensitivity CLI: the same seed gives the same numbers with 1 or 2 threads") {
@@ -332,7 +361,8 @@ TEST_CASE("allocate CLI: the seed's x-direction procedure, and its saved toleran
                         json_path + " --save-tolerances " + tol));
   REQUIRE(r.status == 0);
   const json j = read_json(json_path);
-  // The raw (per-unit) ranking picks exactly the seed's errors: eps_yx, eps_zx, eps_zz, S_xy.
+  // The raw (per-unit) ranking picks exactly Wang & Yuan 2021's errors: eps_yx, eps_zx, eps_zz,
+  // S_xy.
   std::set<std::string> chosen;
   for (const auto& e : j["chosen"]) chosen.insert(e.get<std::string>());
   CHECK(chosen == std::set<std::string>{"E_BX", "E_CX", "E_CZ", "E_C0X"});

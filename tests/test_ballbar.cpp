@@ -71,7 +71,7 @@ std::string arg_error(const std::function<void()>& f) {
 
 std::shared_ptr<Model> vmc_model() { return test::builtin_model("vmc_3axis"); }
 
-// The seed's circle (section 4).
+// Zhang & Chen 2021's circle (section 4).
 BallbarCircle seed_circle(const BallbarMachine& m) {
   BallbarFlags f;
   f.plane = "XY";
@@ -488,7 +488,7 @@ TEST_CASE("ballbar: comparison with a measured trace") {
   CHECK(cmp.raw.correlation < cmp.centred.correlation);
   CHECK(cmp.difference.centre_offset_um[0] == doctest::Approx(1.0).epsilon(1e-3));
   CHECK(cmp.difference.centre_offset_um[1] == doctest::Approx(-0.5).epsilon(1e-3));
-  CHECK(cmp.difference.circular_deviation_um < 5e-4);  // the seed's "ideal compensation"
+  CHECK(cmp.difference.circular_deviation_um < 5e-4);  // Zhang & Chen 2021's "ideal compensation"
   CHECK(cmp.measured.circular_deviation_um ==
         doctest::Approx(cmp.predicted.circular_deviation_um).epsilon(1e-3));
   // At the measured angles the prediction is used as is: no interpolation error.

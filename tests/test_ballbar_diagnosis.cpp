@@ -275,7 +275,8 @@ TEST_CASE(
     // The residual is the noise: the causes explain the rest.
     CHECK(r.residual_rms_um < 1.25 * c.truth.noise_um);
     for (const auto& [id, size] : c.expect) {
-      CAPTURE(id);
+      const auto& cause_id = id;  // clang < 16 cannot capture a structured binding
+      CAPTURE(cause_id);
       const BallbarCause& k = cause(r, id);
       CHECK(k.separable);
       CHECK(k.significant);

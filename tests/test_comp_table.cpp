@@ -192,7 +192,8 @@ TEST_CASE("identify --comp-table --axis: a positioning error alone is the table 
        {std::tuple<std::string, std::string, std::string, std::string>{"vmc_3axis", "X", "E_XX",
                                                                        "Y=-120,Z=-60"},
         {"five_axis_ac", "C", "E_CC", "X=40,Z=-100,Y=30,A=20"}}) {
-    CAPTURE(machine);
+    const std::string& machine_name = machine;  // clang < 16 cannot capture a structured binding
+    CAPTURE(machine_name);
     const std::shared_ptr<Model> model = test::builtin_model(machine);
     const Description& d = model->description();
     const ErrorParameterisation param(d, PdgeBasisChoice{});
@@ -215,14 +216,17 @@ TEST_CASE("identify --comp-table --axis: a positioning error alone is the table 
         d, {},
         {axis + "=" + std::to_string(d.bodies[static_cast<std::size_t>(axes[k])].joint.min) + ":" +
          std::to_string(d.bodies[static_cast<std::size_t>(axes[k])].joint.max) + ":9," + at});
+    // Both axes carry the workpiece: LinuxCNC's joint is minus the model's axis, the entries
+    // run the other way, and the deviation changes sign with the coordinate.
+    CHECK(t.joint == (rotary ? 4 : 0));
     double largest = 0;
     for (std::size_t i = 0; i < 9; ++i) {
       std::vector<double> errors(d.errors.size());
       param.errors_at(line.poses[i].data(), theta.data(), errors.data());
-      const double want = errors[static_cast<std::size_t>(e)] * (rotary ? 180.0 / M_PI : 1.0);
-      CHECK(t.nominal[i] == doctest::Approx(line.poses[i][k]));
-      CHECK(t.forward[i] == doctest::Approx(want).epsilon(1e-7).scale(1e-12));
-      CHECK(t.reverse[i] == t.forward[i]);
+      const double want = -errors[static_cast<std::size_t>(e)] * (rotary ? 180.0 / M_PI : 1.0);
+      CHECK(t.nominal[8 - i] == doctest::Approx(-line.poses[i][k]));
+      CHECK(t.forward[8 - i] == doctest::Approx(want).epsilon(1e-7).scale(1e-12));
+      CHECK(t.reverse[8 - i] == t.forward[8 - i]);
       largest = std::max(largest, std::fabs(want));
     }
     CHECK(largest > 0);
@@ -240,8 +244,9 @@ TEST_CASE("identify --comp-table --axis on the VMC's measured points, and bad ax
   CHECK(r.out.find("COMP_FILE_TYPE = 0") != std::string::npos);
   const LinuxCncComp comp(table, 0);
   REQUIRE(comp.nominal.size() == 11);
-  CHECK(comp.nominal.front() == 0.0);
-  CHECK(comp.nominal.back() == 500.0);
+  CHECK(comp.nominal.front() == -500.0);  // joint 0 = -X: X carries the workpiece
+  CHECK(comp.nominal.back() == 0.0);
+  CHECK(r.out.find("[JOINT_0]") != std::string::npos);
   double largest = 0;
   for (double v : comp.fwd_trim) largest = std::max(largest, std::fabs(v));
   CHECK(largest > 1e-4);  // µm-scale corrections

@@ -75,7 +75,7 @@ TEST_CASE("gap engine: a split's fit from block factors is the SVD fit of its tr
   const MatrixXd A = design(n, 3);
   const VectorXd y = values(A, 4);
   GapData d;
-  Engine e(d, A, y, 2);
+  DesignLeastSquares e(d, A, y, 2);
   e.splits = three_folds(n);
   e.fit_folds();
   CHECK(e.factors->rows.size() == 3);
@@ -94,7 +94,7 @@ TEST_CASE("gap engine: a split's fit from block factors is the SVD fit of its tr
     CHECK(rel(ff.lev_test, (Ate * VS).rowwise().squaredNorm()) < 1e-9);
   }
   // All data: blocks of at most 4096 rows; leverage of every row.
-  const FoldFit all = fit_fold(A, y, all_rows(n), 2);
+  const FoldFit all = fit_all_rows(A, y, all_rows(n), 2);
   const EquilibratedSvd svd(A, 1e-9, false);
   CHECK(rel(all.theta, svd.solve(y)) < 1e-9);
   const MatrixXd U = svd.U().leftCols(static_cast<Index>(svd.rank()));
@@ -107,7 +107,7 @@ TEST_CASE("gap engine: extra columns fitted by projection are the joint fit [A E
   const MatrixXd A = design(n, 5);
   const VectorXd y = values(A, 6);
   GapData d;
-  Engine e(d, A, y, 1);
+  DesignLeastSquares e(d, A, y, 1);
   e.splits = three_folds(n);
   e.fit_folds();
   std::mt19937 g(7);
@@ -235,7 +235,7 @@ TEST_CASE("gap engine: the held-out residuals' covariance is M Mᵀ, M from each
   const MatrixXd A = design(n, 11);
   const VectorXd y = values(A, 12);
   GapData d;
-  Engine e(d, A, y, 1);
+  DesignLeastSquares e(d, A, y, 1);
   e.splits = three_folds(n);
   e.fit_folds();
   MatrixXd M = MatrixXd::Zero(static_cast<Index>(n), static_cast<Index>(n));
@@ -291,7 +291,7 @@ TEST_CASE(
   VectorXd y = values(A, 32);
   auto estimable = [&](const VectorXd& values, VectorXd& r, VectorXd& h, std::size_t& removed) {
     GapData d;
-    Engine e(d, A, values, 1);
+    DesignLeastSquares e(d, A, values, 1);
     e.splits = splits;
     e.fit_folds();
     VectorXd h0;
@@ -310,7 +310,7 @@ TEST_CASE(
   // Dense: S = M Mᵀ of the plain held-out residual, M_f = I − U Uᵀ with U the left singular
   // vectors of A_test (I − A_tr⁺A_tr).
   GapData d;
-  Engine e(d, A, y, 1);
+  DesignLeastSquares e(d, A, y, 1);
   e.splits = splits;
   e.fit_folds();
   const HeldoutCovariance plain(e), est(e, true);

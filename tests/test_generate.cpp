@@ -172,7 +172,17 @@ int main(int argc, char** argv) {
   const std::string loop_header = gen::emit_cpp_header(o2, "machines/five_axis_ac.yaml", 0);
   REQUIRE(loop_header.find("kHigherTable.size(); k += 3) {\n      at +=") != std::string::npos);
   write_file_atomically((loop_dir / "five_axis_ac_o2.hpp").string(), loop_header);
-  for (const fs::path& include : {dir, loop_dir}) {
+  // And with MonomialCoefficients in parts of 40 statements (the form of a long one, emit_cpp.hpp
+  // SplitLimits): temporaries shared between parts, each part with its own inputs.
+  const fs::path split_dir = dir / "split";
+  fs::create_directories(split_dir);
+  const std::string split_header =
+      gen::emit_cpp_header(o2, "machines/five_axis_ac.yaml", gen::kMaxNestedHigherTerms, {0, 40});
+  REQUIRE(split_header.find("MonomialCoefficientsPart2<Scalar>(axes, params, _s.data()") !=
+          std::string::npos);
+  REQUIRE(split_header.find("  _s[0] = ") != std::string::npos);
+  write_file_atomically((split_dir / "five_axis_ac_o2.hpp").string(), split_header);
+  for (const fs::path& include : {dir, loop_dir, split_dir}) {
     CAPTURE(include.string());
     // Beside the header: a quoted include looks in the driver's directory first.
     write_file_atomically((include / "driver.cpp").string(), driver);
@@ -336,11 +346,26 @@ TEST_CASE("CLI: show prints closed forms in text, LaTeX, JSON and the seed's not
   CHECK(t.out.rfind("dx = -E_XX", 0) == 0);
   CHECK(t.out.find("dy") == std::string::npos);
   const Run a = run(cli("show vmc_3axis --notation alias --output dx"));
-  CHECK(a.out.find("- z·Sxz") != std::string::npos);  // S_xz = -E_B0Z, as the seed prints it
+  CHECK(a.out.find("- z·Sxz") !=
+        std::string::npos);  // S_xz = -E_B0Z, as Zhang & Chen 2021 prints it
   const Run l = run(cli("show gantry_grinder --format latex"));
   CHECK(l.out.find("E_{XX}") != std::string::npos);
   const Run j = run(cli("show gantry_grinder --format json"));
   CHECK(j.out.find("\"closed_form\"") != std::string::npos);
+  // Python syntax: the text form with * and ** (the Python package evaluates it against the
+  // model, tests/python/test_closed_form.py).
+  const Run y = run(cli("show five_axis_ac --format sympy --output dx"));
+  CHECK(y.status == 0);
+  CHECK(y.out.rfind("dx = cos(c)*E_XX + cos(a)*sin(c)*E_YX", 0) == 0);
+  CHECK(y.out.find("·") == std::string::npos);
+  CHECK(y.out.find('^') == std::string::npos);
+  // The flag table of every verb (the Python package's keywords): --order is a whole number
+  // from 1, --format defaults to text.
+  const Run f = run(cli("show --flags-json"));
+  CHECK(f.status == 0);
+  CHECK(f.out.find("\"name\": \"format\"") != std::string::npos);
+  CHECK(f.out.find("\"default\": \"text\"") != std::string::npos);
+  CHECK(f.out.find("\"text\": \"a whole number from 1 to ") != std::string::npos);
   CHECK(run(cli("--help")).status == 0);
   for (const char* verb : {"generate", "show", "list"})
     CHECK(run(cli(std::string(verb) + " --help")).status == 0);

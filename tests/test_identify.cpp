@@ -410,7 +410,7 @@ TEST_CASE("identify: the committed params header is current and evaluates the id
   // --emit-params generated/vmc_3axis_params.hpp` (scripts/regenerate_params.sh).
   const std::string committed =
       test::read_text(std::string(WEILGEN_SOURCE_DIR) + "/generated/vmc_3axis_params.hpp");
-  const std::string text = params_header(m, p, r.theta, identify_provenance(r));
+  const std::string text = params_header(m, p, r, identify_provenance(r));
   // Numbers within rounding (tests/golden/numeric_text.hpp), the text exactly.
   const std::string stale = golden::numeric_text_mismatch(committed, text, golden::kParamsRelTol);
   CHECK_MESSAGE(stale.empty(),

@@ -1,8 +1,8 @@
-// ISO 230-2 evaluation and the drift seed's thermal-drift elimination
+// ISO 230-2 evaluation and Stejskal et al. 2017's thermal-drift elimination
 // (weilgen/measure/iso230_2.hpp, docs/iso230-2.md): a hand-computed example with every figure
-// pinned, invariants on random data, drift recovery on synthetic data, the seed's sqrt(2) Monte
-// Carlo check, the anomaly test's false-positive rate and power, grouping errors, and the CLI end
-// to end.
+// pinned, invariants on random data, drift recovery on synthetic data, Stejskal et al. 2017's
+// sqrt(2) Monte Carlo check, the anomaly test's false-positive rate and power, grouping errors, and
+// the CLI end to end.
 #include <doctest/doctest.h>
 
 #include <Eigen/Dense>
@@ -395,7 +395,8 @@ TEST_CASE("iso230-2 drift: the rebuilt chart recovers the static profile within 
   CHECK(d.anomalous_positions.empty());
 }
 
-// The seed's eqs. (7)-(10): b_n = a_n - a_{n+1} of independent normal a_n has s_b / s_a = √2
+// Stejskal et al. 2017, eqs. (7)-(10): b_n = a_n - a_{n+1} of independent normal a_n has s_b / s_a
+// = √2
 // ("1.4076" from its Monte Carlo run on 1000 samples). One run of 1000 samples has a standard
 // error of about 0.04 on the ratio; the mean of 1000 such runs has about 0.0013: tolerance 0.01.
 TEST_CASE("iso230-2 drift: the seed's Monte Carlo check of s_b / s_a = sqrt(2)") {

@@ -1,5 +1,6 @@
-// 6D line measurements: the seed's Table 2 sign conversions, the eq. (1) straightness reference
-// line, the CSV variant (# format: line6d) and its errors, and fit-pdge on the example file.
+// 6D line measurements: Zhang & Chen 2021's Table 2 sign conversions, the eq. (1) straightness
+// reference line, the CSV variant (# format: line6d) and its errors, and fit-pdge on the example
+// file.
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -258,8 +259,8 @@ TEST_CASE("pdge line6d: the example file and fit-pdge on it") {
   CHECK(ecx->sign == -1);
   CHECK(ecx->values[50] - ecx->values[0] > 8);
 
-  // The seed's finding on its wave-shaped positioning error: a Fourier series fits it better
-  // than a polynomial with about as many coefficients (here by held-out error too).
+  // Zhang & Chen 2021's finding on its wave-shaped positioning error: a Fourier series fits it
+  // better than a polynomial with about as many coefficients (here by held-out error too).
   const Line6dProfile* exx = d.find("E_XX");
   REQUIRE(exx);
   const PdgeFitResult f3 =

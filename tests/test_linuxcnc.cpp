@@ -22,9 +22,10 @@ TEST_CASE("weilgen linuxcnc writes the component, its C API, Makefile and config
       test::cli("linuxcnc vmc_3axis --params " + params_header() + " --out " + dir.string()));
   INFO(r.out);
   REQUIRE(r.status == 0);
-  for (const char* f : {"vmc_3axis.hpp", "vmc_3axis_c.h", "vmc_3axis_c.cpp",
-                        "weilgen_vmc_3axis_hal.c", "weilgen_vmc_3axis_errors.cpp", "Makefile",
-                        "weilgen_vmc_3axis.hal", "vmc_3axis_params.hpp"}) {
+  for (const char* f :
+       {"vmc_3axis.hpp", "vmc_3axis_c.h", "vmc_3axis_c.cpp", "weilgen_vmc_3axis_hal.c",
+        "weilgen_vmc_3axis_errors.cpp", "Makefile", "weilgen_vmc_3axis.hal", "vmc_3axis_params.hpp",
+        "vmc_3axis_params_file.h", "vmc_3axis_params_file.c"}) {
     CAPTURE(f);
     CHECK(fs::exists(dir / f));
   }
@@ -38,16 +39,35 @@ TEST_CASE("weilgen linuxcnc writes the component, its C API, Makefile and config
   CHECK(hal.find("axis_pins[VMC_3AXIS_NUM_AXES] = {\"y\", \"x\", \"z\"}") != std::string::npos);
   CHECK(hal.find("standin") == std::string::npos);
   CHECK(hal.find("vmc_3axis_compensate_at(") != std::string::npos);
+  // kAxes Y, X, Z: X and Y carry the table (sign -1), Z the tool; limits in mm.
+  CHECK(hal.find("axis_sign[VMC_3AXIS_NUM_AXES] = {-1.0, -1.0, 1.0}") != std::string::npos);
+  CHECK(hal.find("travel_max[VMC_3AXIS_NUM_AXES] = {0.0, 5e+02, 0.0}") != std::string::npos);
+  CHECK(hal.find("default_max_correction[VMC_3AXIS_NUM_AXES] = {0.1, 0.1, 0.1}") !=
+        std::string::npos);
+  CHECK(hal.find("#define IDENTIFIED_BUILT_IN 1") != std::string::npos);
+  CHECK(test::read_text((dir / "vmc_3axis_params_file.c").string())
+            .find("int vmc_3axis_params_parse(") != std::string::npos);
   const std::string errors = test::read_text((dir / "weilgen_vmc_3axis_errors.cpp").string());
   CHECK(errors.find("#include \"vmc_3axis_params.hpp\"") != std::string::npos);
   CHECK(errors.find("identified::Errors(q, &e)") != std::string::npos);
   CHECK(test::read_text((dir / "Makefile").string()).find("COMPONENT := weilgen_vmc_3axis") !=
         std::string::npos);
   const std::string lines = test::read_text((dir / "weilgen_vmc_3axis.hal").string());
-  CHECK(lines.find("net x-pos-cmd joint.0.motor-pos-cmd => weilgen_vmc_3axis.x.pos-cmd") !=
-        std::string::npos);
-  CHECK(lines.find("net y-pos-fb weilgen_vmc_3axis.y.pos-fb => joint.1.motor-pos-fb") !=
-        std::string::npos);
+  for (const char* line :
+       {"#   [KINS] KINEMATICS = trivkins coordinates=XYZ\n",
+        "net weilgen-x-pos-cmd joint.0.pos-cmd => weilgen_vmc_3axis.x.pos-cmd\n",
+        "net weilgen-x-motor-cmd joint.0.motor-pos-cmd => weilgen_vmc_3axis.x.motor-pos-cmd\n",
+        "net weilgen-x-pos-comp weilgen_vmc_3axis.x.pos-comp\n",
+        "net weilgen-x-pos-fb-in => weilgen_vmc_3axis.x.pos-fb-in\n",
+        "net weilgen-y-motor-fb weilgen_vmc_3axis.y.pos-fb => joint.1.motor-pos-fb\n",
+        "net machine-is-enabled motion.motion-enabled => weilgen_vmc_3axis.enable\n",
+        "net weilgen-all-homed motion.is-all-homed => weilgen_vmc_3axis.homed\n",
+        "addf weilgen_vmc_3axis.feedback servo-thread -2\n",
+        "setp weilgen_vmc_3axis.z.max-step 0.001  # mm per servo period\n",
+        "net weilgen-fault weilgen_vmc_3axis.fault\n"}) {
+    CAPTURE(line);
+    CHECK(lines.find(line) != std::string::npos);
+  }
 
   // Without identified parameters the errors start at zero (or the JSON's values).
   const fs::path plain = test::fresh_dir("linuxcnc_plain");
@@ -111,4 +131,56 @@ TEST_CASE("weilgen linuxcnc refuses bad parameters, names and outputs, writing n
   CHECK(r.status == 2);
   CHECK(r.out.find("is the input") != std::string::npos);
   CHECK(!fs::exists(same / "Makefile"));
+}
+
+TEST_CASE("weilgen linuxcnc: units, signs, offsets and a params file of the right model") {
+  const fs::path dir = test::fresh_dir("linuxcnc_joints");
+  const std::string data = std::string(WEILGEN_SOURCE_DIR) + "/examples/data/vmc_3axis_points.csv";
+  const std::string json = (dir / "vmc_params.json").string();
+  const test::Run id =
+      test::run(test::cli("identify vmc_3axis -q --data " + data + " --emit-params-json " + json));
+  INFO(id.out);
+  REQUIRE(id.status == 0);
+  const std::string out = (dir / "inch").string();
+  const test::Run r =
+      test::run(test::cli("linuxcnc vmc_3axis --units inch --sign Z=-1 --offset "
+                          "X=250 --params-file " +
+                          json + " --out " + out));
+  INFO(r.out);
+  REQUIRE(r.status == 0);
+  const std::string c = test::read_text(out + "/weilgen_vmc_3axis_hal.c");
+  CHECK(c.find("axis_sign[VMC_3AXIS_NUM_AXES] = {-1.0, -1.0, -1.0}") != std::string::npos);
+  CHECK(c.find("axis_scale[VMC_3AXIS_NUM_AXES] = {25.4, 25.4, 25.4}") != std::string::npos);
+  CHECK(c.find("axis_offset[VMC_3AXIS_NUM_AXES] = {0.0, 2.5e+02, 0.0}") != std::string::npos);
+  // 0.1 mm and 1 um per period in inch.
+  CHECK(c.find("default_max_correction[VMC_3AXIS_NUM_AXES] = {0.003937007874015749, ") !=
+        std::string::npos);
+  CHECK(c.find("#define IDENTIFIED_BUILT_IN 0") != std::string::npos);
+  const std::string hal = test::read_text(out + "/weilgen_vmc_3axis.hal");
+  CHECK(hal.find("loadrt weilgen_vmc_3axis params_file=" + json + "\n") != std::string::npos);
+  CHECK(hal.find("#   [TRAJ] LINEAR_UNITS = inch") != std::string::npos);
+  CHECK(hal.find("model X = 250 - 25.4 * joint (mm)") != std::string::npos);
+  CHECK(hal.find("#   Z  2  Z  -1  25.4  0  inch  --sign") != std::string::npos);
+
+  const auto refused = [&](const std::string& args, int status, const std::string& message) {
+    const std::string never = (dir / "never").string();
+    const test::Run x = test::run(test::cli("linuxcnc " + args + " --out " + never));
+    INFO(args, x.out);
+    CHECK(x.status == status);
+    CHECK(x.out.find(message) != std::string::npos);
+    CHECK(!fs::exists(never));
+  };
+  refused("vmc_3axis --units cm", 2, "--units cm: mm or inch");
+  refused("vmc_3axis --sign X=2", 2, "--sign X=2: a sign is 1 or -1");
+  refused("vmc_3axis --sign A=1", 2, "'A' is not an axis of vmc_3axis");
+  refused("vmc_3axis --offset X=1deg", 2, "X is in mm, not deg");
+  refused("five_axis_ac --params-file " + json, 3,
+          "the parameters of machine 'vmc_3axis', not of five_axis_ac");
+  refused("vmc_3axis --params " + json, 2, "give them as --params-file");
+  std::string other = test::read_text(json);
+  other.replace(other.find("\"model_key\": \"") + 14, 4, "ffff");
+  const std::string stale = (dir / "stale.json").string();
+  write_file_atomically(stale, other);
+  refused("vmc_3axis --params-file " + stale, 3, "stale.json: model_key \"ffff");
+  refused("vmc_3axis --params-file " + (dir / "none.json").string(), 3, "cannot read");
 }

@@ -414,8 +414,10 @@ TEST_CASE("loader: the one unit table: µm and µrad (micro sign or Greek mu) re
            "}, E_AX: {unit: " + angle + "}}\ntool: {body: x}\nworkpiece: {body: bed}\n";
   };
   const Description ascii = load_machine_text(machine("um", "urad"), "a.yaml");
-  for (const auto& [length, angle] : std::vector<std::pair<std::string, std::string>>{
+  for (const auto& units : std::vector<std::pair<std::string, std::string>>{
            {"\u00b5m", "\u00b5rad"}, {"\u03bcm", "\u03bcrad"}}) {
+    const std::string& length = units.first;  // clang < 16 cannot capture a structured binding
+    const std::string& angle = units.second;
     CAPTURE(length);
     const Description d = load_machine_text(machine(length, angle), "b.yaml");
     REQUIRE(d.errors.size() == 2);

@@ -151,3 +151,41 @@ TEST_CASE("a relation ideal gives exactly the order-r model with the ideal's mon
   }
   CHECK(dropped > 10);
 }
+
+TEST_CASE("the exact chain's stepped deviations equal whole deviations (every shipped machine)") {
+  // deviation_steps redoes only the stepped error's body and the products after it; it must give
+  // what deviation() gives with that error stepped (the same operations in the same order: bit
+  // for bit in a plain build; 1e-12 mm leaves room for a compiler's contraction into FMAs), and
+  // deviation(axes, errors, nominal(axes)) what deviation() gives.
+  for (const auto& name : test::shipped_machines()) {
+    CAPTURE(name);
+    const Description d = load_machine_file(test::machine_path(name));
+    const NumericChain chain(d);
+    std::mt19937 rng(7);
+    for (int trial = 0; trial < 3; ++trial) {
+      const auto q = test::random_pose(d, rng);
+      const auto e = test::scaled(test::random_direction(d, rng), 1e-3);
+      std::vector<double> steps(e.size(), 0.0);
+      for (std::size_t k = 0; k < steps.size(); k += 1 + static_cast<std::size_t>(trial))
+        steps[k] = d.errors[k].effect == ErrorEffect::Rotation ? 1e-6 : 1e-3;
+      const Eigen::Matrix4d nominal = chain.nominal(q);
+      std::array<double, 6> at{};
+      std::vector<std::array<double, 6>> stepped(e.size(), {-1, -1, -1, -1, -1, -1});
+      chain.deviation_steps(q, e, steps, nominal, at, stepped);
+      const auto whole = chain.deviation(q, e);
+      CHECK(test::max_abs_diff(at, whole) <= 1e-12);
+      CHECK(test::max_abs_diff(chain.deviation(q, e, nominal), whole) <= 1e-12);
+      for (std::size_t k = 0; k < e.size(); ++k) {
+        CAPTURE(d.errors[k].name);
+        if (steps[k] == 0) {
+          CHECK(stepped[k][0] == -1);  // left as it was
+          continue;
+        }
+        std::vector<double> ek = e;
+        ek[k] += steps[k];
+        const auto ref = chain.deviation(q, ek);
+        CHECK(test::max_abs_diff(stepped[k], ref) <= 1e-12);
+      }
+    }
+  }
+}

@@ -216,6 +216,23 @@ TEST_CASE("normalisation: constants and columns from flags, header keys and defa
         doctest::Approx(101325));
   CHECK(*parse_environment_source("20.5 degC", EnvironmentQuantity::AirTemperature, "x").value ==
         doctest::Approx(20.5));
+  // The same units as the instrument import (base/units): degF, K, mmHg, inHg.
+  CHECK(*parse_environment_source("68 degF", EnvironmentQuantity::AirTemperature, "x").value ==
+        doctest::Approx(20).epsilon(1e-15));
+  CHECK(
+      *parse_environment_source("293.15 K", EnvironmentQuantity::MaterialTemperature, "x").value ==
+      doctest::Approx(20).epsilon(1e-15));
+  CHECK(*parse_environment_source("760 mmHg", EnvironmentQuantity::AirPressure, "x").value ==
+        doctest::Approx(101325).epsilon(2e-7));
+  CHECK(*parse_environment_source("1013 mbar", EnvironmentQuantity::AirPressure, "x").value ==
+        doctest::Approx(101300));
+  CHECK(error_of([] {
+          parse_environment_source("20 degR", EnvironmentQuantity::AirTemperature,
+                                   "--air-temperature");
+        }) == "--air-temperature: unit 'degR' (expected degC, degF or K)");
+  CHECK(error_of([] {
+          parse_environment_source("40 ppm", EnvironmentQuantity::AirHumidity, "--air-humidity");
+        }) == "--air-humidity: unit 'ppm' (expected % or none)");
   CHECK(error_of([] {
           parse_environment_source("1013", EnvironmentQuantity::AirPressure, "--air-pressure");
         }) == "--air-pressure: 1013 Pa is outside [50000, 150000] Pa");

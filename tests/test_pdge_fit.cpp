@@ -1,5 +1,5 @@
 // Parametric fits of position-dependent errors: bases, least squares with standard errors, the
-// 6D-laser seed's Table 4 metrics, order choice by cross-validation, Fourier period search.
+// Zhang & Chen 2021's Table 4 metrics, order choice by cross-validation, Fourier period search.
 #include <doctest/doctest.h>
 
 #include <algorithm>

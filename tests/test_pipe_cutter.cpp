@@ -1,7 +1,7 @@
 // The dual-chuck pipe cutter (machines/pipe_cutter.yaml): parallel jaw chains, linked coordinates,
 // chain directions, derived quantities and the output transform, checked against an independent
-// construction of the seed's equations (3)-(10) as corrected in the machine file's notes (the
-// main chuck's pairs projected on their clamping directions, the pipe's roll, A12 = A04).
+// construction of Jiang et al. 2021's equations (3)-(10) as corrected in the machine file's notes
+// (the main chuck's pairs projected on their clamping directions, the pipe's roll, A12 = A04).
 #include <doctest/doctest.h>
 
 #include <Eigen/Geometry>
@@ -40,7 +40,7 @@ Mat exp_twist(const Vec& w, const Vec& v, double t) {
 Mat trans(double x, double y, double z) { return exp_twist(Vec::Zero(), Vec(x, y, z), 1.0); }
 Mat rot(int axis, double a) { return exp_twist(Vec::Unit(axis), Vec::Zero(), a); }
 
-// The seed's construction with the machine file's geometry and error conventions.
+// Jiang et al. 2021's construction with the machine file's geometry and error conventions.
 struct SeedModel {
   std::map<std::string, double> p;  // parameters, mm
   const Description& d;
@@ -513,7 +513,8 @@ TEST_CASE("pipe cutter: the radial variance does not change when the chucks turn
   // correlates them differently at each angle. The effect is small against the jaws' positioning.
   CHECK(surface_hi / surface_lo < 1.01);
 
-  // The bed-axis concentricity of the seed's eq. (7) (the file before the fix) fails this test.
+  // The bed-axis concentricity of Jiang et al. 2021, eq. (7) (the file before the fix) fails this
+  // test.
   std::string old = replaced(text, "E05y: E05p*U05y.y + E05q*U05z.y", "E05y: (E051.y + E052.y)/2");
   old = replaced(old, "E05z: E05p*U05y.z + E05q*U05z.z", "E05z: (E053.z + E054.z)/2");
   old = replaced(old, "point: [L04 + LW, 0, Z453]", "point: [L04 + LW, 0, 0]");

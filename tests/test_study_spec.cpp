@@ -120,14 +120,15 @@ TEST_CASE("study units: every unit") {
       {"μm", 1e-3, false},  {"nm", 1e-6, false},      {"m", 1e3, false},
       {"rad", 1, true},     {"mrad", 1e-3, true},     {"urad", 1e-6, true},
       {"µrad", 1e-6, true}, {"deg", kPi / 180, true}, {"arcsec", kPi / 648000, true},
-      {"mm/m", 1e-3, true}, {"um/m", 1e-6, true},     {"µm/m", 1e-6, true}};
+      {"mm/m", 1e-3, true}, {"um/m", 1e-6, true},     {"µm/m", 1e-6, true},
+      {"inch", 25.4, false}};
   for (const Case& c : cases) {
     INFO(c.unit);
     const UnitFactor u = parse_unit(c.unit);
     CHECK(u.to_base == c.to_base);
     CHECK(u.angle == c.angle);
   }
-  for (const char* bad : {"", "MM", "inch", "mm/", "um/mm", "µ", "u"}) {
+  for (const char* bad : {"", "MM", "in", "mm/", "um/mm", "µ", "u"}) {
     INFO(bad);
     expect_words(error_of([&] { parse_unit(bad); }),
                  {"unknown unit", "lengths: mm, um, µm, nm, m", "arcsec", "mm/m"});

@@ -1,5 +1,5 @@
 // Writes examples/data/ballbar_xy.csv: a synthetic ballbar test (ISO 230-4) of the vmc_3axis
-// machine in the XY plane at the 6D-laser seed's circle (section 4: centre (343.507, -285.090,
+// machine in the XY plane at Zhang & Chen 2021's circle (section 4: centre (343.507, -285.090,
 // -286.430), R = 100 mm), one counter-clockwise and one clockwise run, 1° steps.
 //
 //   build-ballbar/bench/experiments/weilgen_exp_make_ballbar_data examples/data/ballbar_xy.csv

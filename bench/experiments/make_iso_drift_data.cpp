@@ -1,5 +1,5 @@
 // Writes examples/data/iso230_2_drift.csv: synthetic ISO 230-2 line runs of an X axis under
-// thermal drift, shaped like the drift seed's first measurement (Stejskal et al. 2017: 16 targets
+// thermal drift, shaped like the first measurement of Stejskal et al. 2017 (16 targets
 // over 300 mm, bidirectional cycles, a local anomaly at position 3).
 //
 //   build-iso/bench/experiments/weilgen_exp_make_iso_drift_data examples/data/iso230_2_drift.csv

@@ -1,6 +1,6 @@
 // Writes examples/data/line6d_x.csv: a synthetic 6D-laser line measurement of the X axis of a
-// 500 mm travel, sampled every 10 mm (the seed's Table 1 X line), 5 runs, in the laser's own
-// channels (lin_um, str_h_um, str_v_um, yaw_urad, pitch_urad, roll_urad) so that reading it
+// 500 mm travel, sampled every 10 mm (Zhang & Chen 2021, Table 1 X line), 5 runs, in the laser's
+// own channels (lin_um, str_h_um, str_v_um, yaw_urad, pitch_urad, roll_urad) so that reading it
 // exercises the Table 2 sign conversions and the eq. (1) straightness line removal.
 //
 //   weilgen_exp_make_line6d_data [PATH]     (default: print to stdout)

@@ -49,13 +49,13 @@ using namespace weilgen;
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kEssential = 0.03;  // the seed's threshold for an essential error
+constexpr double kEssential = 0.03;  // Jiang et al. 2021's threshold for an essential error
 constexpr std::size_t kOutputs = 4;  // dx, dy, dz, da: outputs 0 .. 3 of Model::deviation
 const char* const kOutputNames[kOutputs] = {"dx", "dy", "dz", "da"};
 const char* const kOutputUnits[kOutputs] = {"mm", "mm", "mm", "rad"};
 const double kTurnA04[] = {0, 45, 90, 180};  // deg, the chucks' angles of the turning table
 constexpr std::size_t kTurns = 4;
-const double kFeedX[] = {100, 450, 800};  // mm, the seed's feeding positions
+const double kFeedX[] = {100, 450, 800};  // mm, Jiang et al. 2021's feeding positions
 constexpr std::size_t kPoses = 3;
 
 struct Options {
@@ -155,7 +155,7 @@ Options parse_options(int argc, char** argv) {
   return o;
 }
 
-// The seed's poses, each in Description::axes() order, built by coordinate name.
+// Jiang et al. 2021's poses, each in Description::axes() order, built by coordinate name.
 std::vector<std::vector<double>> seed_poses(const Description& desc) {
   std::vector<std::vector<double>> poses;
   for (double x : kFeedX) {
@@ -567,7 +567,7 @@ int run(const Options& opt) {
   so.samples = opt.samples;
   so.sampling = Sampling::Qmc;
   so.seed = 1;
-  so.intervals = SobolIntervals::Bootstrap;  // the seed paper's table: bootstrap intervals
+  so.intervals = SobolIntervals::Bootstrap;  // Jiang et al. 2021's table: bootstrap intervals
   so.bootstrap = opt.bootstrap;
   so.threads = threads;
   auto t0 = std::chrono::steady_clock::now();

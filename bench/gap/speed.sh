@@ -4,14 +4,20 @@
 #
 #   bench/gap/speed.sh WEILGEN [WORKDIR] [--sizes 1000,5000,10000,20000,50000] [--threads 2]
 #                      [--baseline OTHER_WEILGEN] [--instructions 5000,10000] [--repeat 1]
+#                      [--machine vmc_3axis] [--effect reversal]
 #
-# Data: weilgen_gap_synth's grid layout of vmc_3axis (3 outputs per pose) with a reversal of one
-# axis (SNR 5, noise 0.5 µm, seed 7), its cycles repeated until --observations N. Each size is
+# Data: weilgen_gap_synth's grid layout of --machine (3 outputs per pose) with --effect (default a
+# reversal of one axis; SNR 5, noise 0.5 µm, seed 7), its cycles repeated until --observations N
+# (issue 32's thermal set: --machine gantry_grinder --effect thermal_drift --sizes 14886). Each size is
 # run with /usr/bin/time -v (wall, user+sys CPU, peak RSS); `uptime` is recorded beside the
 # numbers because the machine may be shared. --baseline runs another build on the same files
 # (the previous implementation: same verdicts expected). --instructions counts instructions
-# with valgrind --tool=callgrind at the given sizes (one thread; slow, but independent of the
-# load). Results: WORKDIR/speed.md and WORKDIR/speed.tsv (default WORKDIR: build/gap-speed).
+# with valgrind --tool=callgrind at the given sizes (slow, but independent of the load), with
+# --threads and per thread: the main thread's count is the serial part, and total / (main +
+# the busiest worker slot) estimates the CPU/wall ratio a quiet machine gives (valgrind runs the
+# threads one at a time, so it cannot measure it; it assumes each parallel loop's work splits
+# like the slots' totals). Results: WORKDIR/speed.md and WORKDIR/speed.tsv (default WORKDIR:
+# build/gap-speed).
 set -euo pipefail
 
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
@@ -29,6 +35,8 @@ threads=2
 baseline=
 instructions=
 repeat=1
+machine=vmc_3axis
+effect=reversal
 while [[ $# -gt 0 ]]; do
   case $1 in
     --sizes) sizes=$2; shift 2 ;;
@@ -36,6 +44,8 @@ while [[ $# -gt 0 ]]; do
     --baseline) baseline=$(abs "$2"); shift 2 ;;
     --instructions) instructions=$2; shift 2 ;;
     --repeat) repeat=$2; shift 2 ;;
+    --machine) machine=$2; shift 2 ;;
+    --effect) effect=$2; shift 2 ;;
     *) echo "speed.sh: unknown option $1" >&2; exit 2 ;;
   esac
 done
@@ -46,6 +56,7 @@ synth=${WEILGEN_GAP_BIN:-$(dirname "$weilgen")/bench/gap}/weilgen_gap_synth
 [[ -x $synth ]] || synth=$root/build/bench/gap/weilgen_gap_synth
 [[ -x $synth ]] || { echo "speed.sh: build weilgen_gap_synth first" >&2; exit 1; }
 [[ -x /usr/bin/time ]] || { echo "speed.sh: needs /usr/bin/time (Debian package time)" >&2; exit 1; }
+work=$work/$machine-$effect
 mkdir -p "$work"
 tsv=$work/speed.tsv
 echo -e "build\tobservations\trun\twall_s\tcpu_s\tpeak_rss_mb\tverdict\tload_1min" >"$tsv"
@@ -58,14 +69,14 @@ echo "start: $(uptime)" | tee "$work/uptime.txt"
 for n in "${size_list[@]}"; do
   d=$work/n$n
   mkdir -p "$d"
-  [[ -f $d/data.csv ]] || "$synth" --effect reversal --factor 5 --noise-um 0.5 --layout grid \
-    --seed 7 --observations "$n" --out "$d" >/dev/null
+  [[ -f $d/data.csv ]] || "$synth" --machine "$machine" --effect "$effect" --factor 5 \
+    --noise-um 0.5 --layout grid --seed 7 --observations "$n" --out "$d" >/dev/null
   for label in new ${baseline:+baseline}; do
     bin=$weilgen
     [[ $label == baseline ]] && bin=$baseline
     for ((k = 1; k <= repeat; ++k)); do
       load=$(awk '{print $1}' /proc/loadavg)
-      /usr/bin/time -v "$bin" gap vmc_3axis --data "$d/data.csv" --threads "$threads" \
+      /usr/bin/time -v "$bin" gap "$machine" --data "$d/data.csv" --threads "$threads" \
         --json "$d/$label.json" >"$d/$label.log" 2>"$d/$label.time"
       wall=$(seconds "$(field "$d/$label.time" 'Elapsed (wall clock)')")
       cpu=$(awk -v u="$(field "$d/$label.time" 'User time')" \
@@ -80,19 +91,26 @@ echo "end: $(uptime)" | tee -a "$work/uptime.txt"
 
 if [[ -n $instructions ]]; then
   command -v valgrind >/dev/null || { echo "speed.sh: --instructions needs valgrind" >&2; exit 1; }
-  echo -e "build\tobservations\tinstructions" >"$work/instructions.tsv"
+  echo -e "build\tobservations\tinstructions\tmain_thread\tbusiest_worker" >"$work/instructions.tsv"
   IFS=, read -r -a isizes <<<"$instructions"
   for n in "${isizes[@]}"; do
     d=$work/n$n
-    [[ -f $d/data.csv ]] || "$synth" --effect reversal --factor 5 --noise-um 0.5 --layout grid \
-      --seed 7 --observations "$n" --out "$d" >/dev/null
+    [[ -f $d/data.csv ]] || "$synth" --machine "$machine" --effect "$effect" --factor 5 \
+      --noise-um 0.5 --layout grid --seed 7 --observations "$n" --out "$d" >/dev/null
     for label in new ${baseline:+baseline}; do
       bin=$weilgen
       [[ $label == baseline ]] && bin=$baseline
-      valgrind --tool=callgrind --callgrind-out-file="$d/$label.callgrind" "$bin" gap vmc_3axis \
-        --data "$d/data.csv" --threads 1 --json "$d/$label.cg.json" >/dev/null 2>"$d/$label.cg.log"
-      ir=$(grep -E '^(summary|totals):' "$d/$label.callgrind" | head -1 | awk '{print $2}')
-      echo -e "$label\t$n\t$ir" | tee -a "$work/instructions.tsv"
+      rm -f "$d/$label.callgrind"*
+      valgrind --tool=callgrind --separate-threads=yes --callgrind-out-file="$d/$label.callgrind" \
+        "$bin" gap "$machine" --data "$d/data.csv" --threads "$threads" \
+        --json "$d/$label.cg.json" >/dev/null 2>"$d/$label.cg.log"
+      counts=$(for f in "$d/$label.callgrind"-*; do
+        grep -E '^(summary|totals):' "$f" | head -1 | awk '{print $2}'
+      done)
+      ir=$(awk '{ s += $1 } END { printf "%.0f", s }' <<<"$counts")
+      main=$(head -1 <<<"$counts")
+      busiest=$(tail -n +2 <<<"$counts" | sort -n | tail -1)
+      echo -e "$label\t$n\t$ir\t$main\t${busiest:-0}" | tee -a "$work/instructions.tsv"
     done
   done
 fi
@@ -133,10 +151,14 @@ ip = os.path.join(work, "instructions.tsv")
 if os.path.exists(ip):
     ir = list(csv.DictReader(open(ip), delimiter="\t"))
     out.append("")
-    out.append("| build | observations | instructions (callgrind, 1 thread) |")
-    out.append("| --- | ---: | ---: |")
+    out.append("| build | observations | instructions (callgrind) | main thread (serial) | "
+               "busiest worker slot | estimated CPU/wall |")
+    out.append("| --- | ---: | ---: | ---: | ---: | ---: |")
     for r in ir:
-        out.append(f"| {r['build']} | {r['observations']} | {int(r['instructions']):,} |")
+        total, main, busy = (int(r[k]) for k in ("instructions", "main_thread", "busiest_worker"))
+        ratio = total / (main + busy) if main + busy > 0 else float("nan")
+        out.append(f"| {r['build']} | {r['observations']} | {total:,} | {main:,} "
+                   f"({100 * main / total:.1f} %) | {busy:,} | {ratio:.2f} |")
     for l in labels:
         pts = [(int(r["observations"]), float(r["instructions"])) for r in ir if r["build"] == l]
         if len(pts) >= 2:

@@ -187,13 +187,15 @@ def log2s(n):
     return "2^%d" % int(math.log2(n)) if n else "> max"
 
 
-def sobol_section(wg, errors, sigma, coeff, s_exact, repeats, seeds, out):
+def sobol_section(wg, errors, sigma, coeff, s_exact, repeats, seeds, ot_seeds, out):
     """For every seed, the smallest N = 2^j reaching the accuracy, for weilgen (its default
     randomised replicates) and for OpenTURNS (randomised QMC, seeded; plus its deterministic
     default design). Then the run at every N some seed needed is timed `repeats` times,
     alternating tools (OpenTURNS through its own SobolIndicesExperiment, the default design:
     the same work as the shifted one), and each seed is charged the median time of its N: the
-    report gives the median over seeds of those times and their ratio."""
+    report gives the median over seeds of those times and their ratio, and weilgen's median and
+    90th-percentile seed (order statistics of the seeds' N) against OpenTURNS's deterministic
+    design. `ot_seeds`: the randomised OpenTURNS designs tried (each up to 2^19)."""
     cdx = coeff[0]
     out.append("## Sobol' indices: dx at %s, max |S - S_exact| <= %g\n" % (POSE, SOBOL_TOL))
     wg_last, ot_last = 1 << 20, 1 << 19
@@ -209,8 +211,8 @@ def sobol_section(wg, errors, sigma, coeff, s_exact, repeats, seeds, out):
     # One OpenTURNS design per (seed, N) serves the four estimators while N doubles.
     out.append("\nOpenTURNS %s, N reaching the accuracy per design (seed None: the default "
                "deterministic QMC design; seeds 1-%d: randomised QMC, random shift):\n" % (
-                   ot.__version__, seeds))
-    for seed in [None] + list(range(1, seeds + 1)):
+                   ot.__version__, ot_seeds))
+    for seed in [None] + list(range(1, ot_seeds + 1)):
         # All four estimators on the default design; the seeds follow Jansen, the best one.
         names = list(ESTIMATORS) if seed is None else ["Jansen"]
         n, seen = 1 << 14, {name: [] for name in ESTIMATORS}
@@ -240,7 +242,7 @@ def sobol_section(wg, errors, sigma, coeff, s_exact, repeats, seeds, out):
     wg_sizes = sorted({n for n in wg_n.values() if n})
     # A shifted design that never reached the accuracy is charged the time at the largest N
     # tried: its true cost is higher, so the median over seeds is then a lower bound.
-    ot_failed = any(not ot_n["Jansen"][s] for s in range(1, seeds + 1))
+    ot_failed = any(not ot_n["Jansen"][s] for s in range(1, ot_seeds + 1))
     ot_sizes = sorted({n for n in ot_n["Jansen"].values() if n} | ({ot_last} if ot_failed else set()))
     runs = {("weilgen", n): [] for n in wg_sizes}
     runs.update({("Jansen", n): [] for n in ot_sizes})
@@ -271,7 +273,7 @@ def sobol_section(wg, errors, sigma, coeff, s_exact, repeats, seeds, out):
     failed_wg = [s for s, n in wg_n.items() if not n]
     failed_ot = [s for s, n in ot_n["Jansen"].items() if s is not None and not n]
     wg_t = [med[("weilgen", wg_n[s])] for s in wg_n if wg_n[s]]
-    ot_t = [med[("Jansen", ot_n["Jansen"][s] or ot_last)] for s in range(1, seeds + 1)]
+    ot_t = [med[("Jansen", ot_n["Jansen"][s] or ot_last)] for s in range(1, ot_seeds + 1)]
     mw = statistics.median(t[0] for t in wg_t), statistics.median(t[1] for t in wg_t)
     mo = statistics.median(t[0] for t in ot_t), statistics.median(t[1] for t in ot_t)
     out.append("\nMedian over seeds of the time at each seed's N: weilgen %.3f s wall, %.3f s "
@@ -279,7 +281,7 @@ def sobol_section(wg, errors, sigma, coeff, s_exact, repeats, seeds, out):
                % (mw[0], mw[1], log2s(statistics.median_high([n or 1 << 40 for n in
                                                              wg_n.values()])),
                   mo[0], mo[1], log2s(statistics.median_high(
-                      [ot_n["Jansen"][s] or 1 << 40 for s in range(1, seeds + 1)])),
+                      [ot_n["Jansen"][s] or 1 << 40 for s in range(1, ot_seeds + 1)])),
                   "; not reached: weilgen seeds %s, OpenTURNS seeds %s" % (failed_wg, failed_ot)
                   if failed_wg or failed_ot else ""))
     out.append("**Ratio of the median times: %s%.1fx wall, %s%.1fx CPU** (target >= 20x)%s.\n" % (
@@ -291,6 +293,17 @@ def sobol_section(wg, errors, sigma, coeff, s_exact, repeats, seeds, out):
         out.append("Against OpenTURNS's default deterministic design (Jansen, N = %s, %.3f s wall, "
                    "%.3f s CPU): **%.1fx wall, %.1fx CPU** over weilgen's median seed.\n" % (
                        log2s(ot_n["Jansen"][None]), md[0], md[1], md[0] / mw[0], md[1] / mw[1]))
+        # weilgen's seeds by the N they need (a seed beyond the largest N tried sorts last).
+        needed = sorted(n or 1 << 40 for n in wg_n.values())
+        for label, q in (("median", 0.5), ("90th-percentile", 0.9)):
+            n = needed[max(0, math.ceil(q * len(needed)) - 1)]
+            if ("weilgen", n) not in med:
+                out.append("weilgen's %s seed: beyond 2^%d.\n" % (label, int(math.log2(wg_last))))
+                continue
+            t = med[("weilgen", n)]
+            out.append("weilgen's %s seed (N = %s, %.3f s wall, %.3f s CPU) against that design: "
+                       "**%.1fx wall, %.1fx CPU** (target >= 20x).\n" % (
+                           label, log2s(n), t[0], t[1], md[0] / t[0], md[1] / t[1]))
     out.append("weilgen command: `%s --seed S --json FILE`\n" % " ".join(
         wg.command(["sensitivity", MACHINE, "--at", POSE, "--outputs", "dx", "--method", "sobol",
                     "--samples", "N"])))
@@ -510,7 +523,9 @@ def main():
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--threads", type=int, default=0, help="weilgen --threads (0 = all cores)")
     ap.add_argument("--only", choices=["sobol", "reliability"], default=None)
-    ap.add_argument("--seeds", type=int, default=10, help="Sobol' seeds per tool (default 10)")
+    ap.add_argument("--seeds", type=int, default=10, help="weilgen's Sobol' seeds (default 10)")
+    ap.add_argument("--ot-seeds", type=int, default=None,
+                    help="OpenTURNS's randomised designs (default: --seeds)")
     args = ap.parse_args()
     wg = Weilgen(os.path.abspath(args.weilgen), args.threads)
     out = ["# weilgen vs OpenTURNS %s (%s)\n" % (ot.__version__, time.strftime("%Y-%m-%d %H:%M")),
@@ -521,7 +536,8 @@ def main():
     errors, sigma, coeff, s_exact = read_model(wg)
     try:
         if args.only in (None, "sobol"):
-            sobol_section(wg, errors, sigma, coeff, s_exact, args.repeats, args.seeds, out)
+            sobol_section(wg, errors, sigma, coeff, s_exact, args.repeats, args.seeds,
+                          args.seeds if args.ot_seeds is None else args.ot_seeds, out)
         if args.only in (None, "reliability"):
             reliability_section(wg, errors, sigma, coeff, args.repeats, out)
     except BaseException:

@@ -4,6 +4,7 @@
 # (bench/openturns/bench_vs_openturns.py says what is timed and how N is chosen).
 #
 #   bench/openturns/run.sh [path/to/weilgen] [--repeats R] [--threads T] [--only sobol|reliability]
+#                            [--seeds S] [--ot-seeds S2]
 #
 # Installs python3-openturns and python3-scipy through scripts/install_deps.sh --bench when
 # they are missing (needs root, like the set-up script). Prints a Markdown report to stdout.

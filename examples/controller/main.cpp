@@ -1,4 +1,4 @@
-// A controller's compensation cycle on the 6D-laser seed's ballbar circle (section 4): every
+// A controller's compensation cycle on Zhang & Chen 2021's ballbar circle (section 4): every
 // point of the commanded path goes through Compensate with the identified errors, as a real-time
 // controller would call it once per interpolation cycle. The program prints the circularity of
 // the predicted actual path (ISO 230-4: the range of the radial deviation about the least-squares
@@ -35,7 +35,8 @@ using Axes = std::array<double, model::kNumAxes>;
 using Errors = std::array<double, model::kNumErrors>;
 
 constexpr std::size_t kPoints = 360;
-// The seed's ballbar test: centre (343.507, -285.090, -286.430) mm, radius 100 mm, XY plane.
+// Zhang & Chen 2021's ballbar test: centre (343.507, -285.090, -286.430) mm, radius 100 mm, XY
+// plane.
 constexpr double kCentreX = 343.507, kCentreY = -285.090, kCentreZ = -286.430;
 constexpr double kRadiusMm = 100.0;
 constexpr double kPi = 3.14159265358979323846;

@@ -54,8 +54,8 @@ std::vector<double> parse_steps(const Description& d, const std::vector<std::str
   return step;
 }
 
-// The seed's choice: per output that misses a target, the `choose` errors with the largest mean
-// |dR/dsigma| in base units.
+// Wang & Yuan 2021's choice: per output that misses a target, the `choose` errors with the largest
+// mean |dR/dsigma| in base units.
 void choose_raw(const AllocationProblem& prob, const Study& st, std::size_t choose,
                 AllocationOptions& ao) {
   const std::size_t ne = st.inputs.size();

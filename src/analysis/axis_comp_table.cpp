@@ -1,5 +1,6 @@
 #include "weilgen/analysis/axis_comp_table.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -9,11 +10,10 @@
 #include "weilgen/base/format.hpp"
 #include "weilgen/base/output_paths.hpp"
 #include "weilgen/base/text.hpp"
+#include "weilgen/machine/linuxcnc.hpp"
 #include "weilgen/model/numeric_chain.hpp"
 
 namespace weilgen {
-
-namespace {}  // namespace
 
 void AxisCompTableOptions::validate() const {
   if (axis.empty())
@@ -89,24 +89,27 @@ CompTable axis_comp_table(const Model& model, const ErrorParameterisation& param
   const Description& d = model.description();
   const Line line = table_line(d, options);
   const std::size_t axis = line.axis;
-  const Joint& joint = d.bodies[static_cast<std::size_t>(d.axes()[axis])].joint;
   const PoseSet& poses = line.poses;
+  // LinuxCNC's joint of the axis (the machine file's linuxcnc: section and defaults): the table
+  // is in joint coordinates, the tool relative to the workpiece in the configuration's units.
+  LinuxcncOverrides units;
+  units.units = options.table.linear_unit;
+  const LinuxcncJoint x = linuxcnc_mapping(d, units).axes[axis];
   NumericChain chain(d);
   chain.set_parameters(model.parameters());
   ModelData data(model);
-  const bool rotary = joint.type == JointType::Revolute;
-  // Axis unit -> mm (linear) or deg (rotary): to_base gives mm or rad.
-  const double to_mm_or_deg = rotary ? joint.to_base * 180.0 / kPi : joint.to_base;
   CompTable t;
-  t.axis = options.axis;
-  t.unit = machine_unit(rotary, options.table);
+  t.axis = options.axis + " (joint " + std::to_string(x.joint) + ", sign " +
+           (x.sign < 0 ? "-1" : "+1") + ")";
+  t.unit = x.unit;
+  t.joint = x.joint;
   std::vector<double> errors(d.errors.size());
   for (const std::vector<double>& q : poses.poses) {
     param.errors_at(q.data(), theta.data(), errors.data());
     double out[6];
     model.deviation(data, q.data(), errors.data(), out);
     const auto j = chain.nominal_jacobian(q);
-    const int row = rotary ? 3 : 0;  // orientation rows for a rotary axis, position rows else
+    const int row = x.rotary ? 3 : 0;  // orientation rows for a rotary axis, position rows else
     double dot = 0, norm2 = 0;
     for (int k = 0; k < 3; ++k) {
       const double jk = j(row + k, static_cast<Eigen::Index>(axis));
@@ -116,9 +119,14 @@ CompTable axis_comp_table(const Model& model, const ErrorParameterisation& param
     if (!(norm2 > 0))
       throw std::invalid_argument("--axis " + options.axis + ": at " + format_short(q[axis]) +
                                   " the axis moves nothing the table could correct");
-    const double delta = dot / norm2 * to_mm_or_deg;  // axis units -> mm or deg
-    t.nominal.push_back(to_machine_units(q[axis] * to_mm_or_deg, rotary, options.table));
-    t.forward.push_back(to_machine_units(delta, rotary, options.table));
+    // The axis' deviation in its own unit (actual - commanded), then in joint coordinates.
+    const double delta = dot / norm2;
+    t.nominal.push_back(x.to_joint(q[axis]));
+    t.forward.push_back(x.sign * delta / x.scale);
+  }
+  if (x.sign < 0) {  // LinuxCNC reads ascending joint positions
+    std::reverse(t.nominal.begin(), t.nominal.end());
+    std::reverse(t.forward.begin(), t.forward.end());
   }
   t.reverse = t.forward;
   t.validate();

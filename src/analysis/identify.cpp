@@ -7,6 +7,7 @@
 #include <map>
 #include <stdexcept>
 
+#include "weilgen/analysis/per_output_rms.hpp"
 #include "weilgen/analysis/study_spec.hpp"
 #include "weilgen/base/constants.hpp"
 #include "weilgen/base/format.hpp"
@@ -338,6 +339,15 @@ IdentifyResult Identification::run(const Model& model_, const ErrorParameterisat
   R.free_parameters = cols.size();
   R.observations = m;
   R.count = data.count;
+  const std::size_t na = desc.axes().size();
+  R.span_min.assign(na, kInf);
+  R.span_max.assign(na, -kInf);
+  for (const PointObservation& ob : data.observations)
+    for (std::size_t a = 0; a < na; ++a) {
+      const double v = data.poses[ob.row][a] + 0.0;  // + 0.0: a measured -0 is the position 0
+      R.span_min[a] = std::min(R.span_min[a], v);
+      R.span_max[a] = std::max(R.span_max[a], v);
+    }
 
   ModelData md(model_);
   VectorXd y(static_cast<Eigen::Index>(m));
@@ -423,20 +433,17 @@ IdentifyResult Identification::run(const Model& model_, const ErrorParameterisat
   }
   R.unidentifiable = null_combinations(sv, cols);
 
-  std::array<double, kObservationKinds> ss_before{}, ss_after{};
-  R.max_after.fill(0);
+  // Before: the measured values with the set-up references removed, as the fit sees them.
+  PerOutputRms<kObservationKinds> before, after;
   for (std::size_t i = 0; i < m; ++i) {
     const auto o = static_cast<std::size_t>(data.observations[i].output);
-    const double ri = r[static_cast<Eigen::Index>(i)], yi = y[static_cast<Eigen::Index>(i)];
-    ss_before[o] += yi * yi;
-    ss_after[o] += ri * ri;
-    R.max_after[o] = std::max(R.max_after[o], std::abs(ri));
+    before.add(o, y[static_cast<Eigen::Index>(i)]);
+    after.add(o, r[static_cast<Eigen::Index>(i)]);
   }
   for (std::size_t o = 0; o < kObservationKinds; ++o) {
-    const double n = static_cast<double>(R.count[o]);
-    R.rms_before[o] = n > 0 ? std::sqrt(ss_before[o] / n) : kNaN;
-    R.rms_after[o] = n > 0 ? std::sqrt(ss_after[o] / n) : kNaN;
-    if (n == 0) R.max_after[o] = kNaN;
+    R.rms_before[o] = before.rms(o);
+    R.rms_after[o] = after.rms(o);
+    R.max_after[o] = after.max_abs(o);
   }
   return R;
 }

@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "weilgen/analysis/ballbar_model.hpp"
+#include "weilgen/analysis/per_output_rms.hpp"
 #include "weilgen/base/constants.hpp"
 #include "weilgen/base/text.hpp"
 
@@ -24,8 +25,7 @@ Prediction predict_table(const Model& model, const ErrorParameterisation& param,
   }
   ModelData md(model);
   std::vector<double> pose(p.axes.size());
-  std::array<double, 6> ss_meas{}, ss_diff{};
-  p.max_difference.fill(0);
+  PerOutputRms<6> measured, difference;
   for (std::size_t r = 0; r < table.rows(); ++r) {
     bool complete = true;
     for (std::size_t a = 0; a < pose.size(); ++a) {
@@ -39,9 +39,8 @@ Prediction predict_table(const Model& model, const ErrorParameterisation& param,
       m[o] = table.has(kDeviationColumns[o]) ? table.column(kDeviationColumns[o])[r] : kNaN;
       if (!std::isfinite(m[o])) continue;
       ++p.compared[o];
-      ss_meas[o] += m[o] * m[o];
-      ss_diff[o] += (m[o] - f[o]) * (m[o] - f[o]);
-      p.max_difference[o] = std::max(p.max_difference[o], std::abs(m[o] - f[o]));
+      measured.add(o, m[o]);
+      difference.add(o, m[o] - f[o]);
     }
     p.poses.push_back(pose);
     p.lines.push_back(table.lines[r]);
@@ -51,12 +50,9 @@ Prediction predict_table(const Model& model, const ErrorParameterisation& param,
   if (p.poses.empty())
     throw InputError(SourceLoc{table.file, 0, 0},
                      "no row has every coordinate (" + join(p.axes) + "): nothing to predict");
-  for (std::size_t o = 0; o < 6; ++o) {
-    const double n = static_cast<double>(p.compared[o]);
-    p.rms_measured[o] = n > 0 ? std::sqrt(ss_meas[o] / n) : kNaN;
-    p.rms_difference[o] = n > 0 ? std::sqrt(ss_diff[o] / n) : kNaN;
-    if (n == 0) p.max_difference[o] = kNaN;
-  }
+  p.rms_measured = measured.rms_per_output();
+  p.rms_difference = difference.rms_per_output();
+  p.max_difference = difference.max_per_output();
   return p;
 }
 

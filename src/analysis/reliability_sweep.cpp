@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "weilgen/base/memory.hpp"
+#include "weilgen/base/parallel.hpp"
 
 namespace weilgen {
 
@@ -95,6 +96,7 @@ std::vector<SweepCase> ReliabilitySweep::run(
   for (std::size_t k = 0; k < st.tolerances.size(); ++k) {
     const OutputId out = st.tolerances[k].output;
     for (std::size_t p = 0; p < np; ++p) {
+      throw_if_cancelled();
       const double* pose = st.poses.poses[p].data();
       ReliabilityProblem prob;
       prob.inputs = inputs;

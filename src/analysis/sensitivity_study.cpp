@@ -1,5 +1,9 @@
 #include "weilgen/analysis/sensitivity_study.hpp"
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -8,6 +12,33 @@
 #include "weilgen/base/text.hpp"
 
 namespace weilgen {
+
+namespace {
+
+// Σ c_i x_i as four interleaved partial sums (i mod 4) added at the end as (s0 + s2) + (s1 + s3):
+// a fixed order, so the same numbers on any thread and with or without SSE2 (two pairs of SIMD
+// lanes, two independent chains of additions).
+double dot4(const double* c, const double* x, std::size_t n) {
+  std::size_t i = 0;
+  double s[4] = {0, 0, 0, 0};
+#if defined(__SSE2__)
+  __m128d a = _mm_setzero_pd(), b = _mm_setzero_pd();
+  for (; i + 4 <= n; i += 4) {
+    a = _mm_add_pd(a, _mm_mul_pd(_mm_loadu_pd(c + i), _mm_loadu_pd(x + i)));
+    b = _mm_add_pd(b, _mm_mul_pd(_mm_loadu_pd(c + i + 2), _mm_loadu_pd(x + i + 2)));
+  }
+  _mm_storeu_pd(s, a);
+  _mm_storeu_pd(s + 2, b);
+#else
+  for (; i + 4 <= n; i += 4)
+    for (int k = 0; k < 4; ++k)
+      s[k] += c[i + static_cast<std::size_t>(k)] * x[i + static_cast<std::size_t>(k)];
+#endif
+  for (int k = 0; i < n; ++i, ++k) s[k] += c[i] * x[i];
+  return (s[0] + s[2]) + (s[1] + s[3]);
+}
+
+}  // namespace
 
 void SensitivityOptions::validate() const {
   if (!local && !exact && !sobol) throw std::invalid_argument("--method: no method chosen");
@@ -160,9 +191,33 @@ SensitivityResult SensitivityStudy::run(
   std::vector<std::vector<double>> pos(st.threads, std::vector<double>(3 * kSobolMaxBatch)),
       ori(pos);
   for (unsigned t = 0; t < st.threads; ++t) work.emplace_back(model);
+  // Order 1 (a compiled model): every output but dp is exactly linear in the errors, so its
+  // linear form (the deviation at zero error and the coefficients, once per pose) is the model;
+  // evaluating it costs ne multiply-adds per output (as the reliability sweep does, and as a
+  // peer tool given the model as a matrix would).
+  const bool linear = model.order() == 1 && model.engine() != ModelEngine::NumericChain &&
+                      std::find(outputs.begin(), outputs.end(), OutputId::Dp) == outputs.end();
+  std::vector<double> base(6), coeff(6 * ne), rows(no * ne), offset(no);
   for (std::size_t p = 0; p < np; ++p) {
     const double* pose = st.poses.poses[p].data();
-    const BatchFunction fn = [&](unsigned t, std::size_t count, const double* x, double* y) {
+    if (linear) {
+      const std::vector<double> zero(ne, 0.0);
+      model.deviation_and_coefficients(data, pose, zero.data(), base.data(), coeff.data());
+      for (std::size_t o = 0; o < no; ++o) {
+        const auto id = static_cast<std::size_t>(outputs[o]);
+        offset[o] = base[id];
+        std::copy(coeff.begin() + static_cast<std::ptrdiff_t>(id * ne),
+                  coeff.begin() + static_cast<std::ptrdiff_t>((id + 1) * ne),
+                  rows.begin() + static_cast<std::ptrdiff_t>(o * ne));
+      }
+    }
+    const BatchFunction linear_fn = [&](unsigned, std::size_t count, const double* x, double* y) {
+      for (std::size_t j = 0; j < count; ++j)
+        for (std::size_t o = 0; o < no; ++o) {
+          y[j * no + o] = offset[o] + dot4(rows.data() + o * ne, x + j * ne, ne);
+        }
+    };
+    const BatchFunction model_fn = [&](unsigned t, std::size_t count, const double* x, double* y) {
       const double* ps = pos[t].data();
       const double* os = ori[t].data();
       model.deviation_batch(work[t], pose, count, x, need_pos ? pos[t].data() : nullptr,
@@ -177,7 +232,7 @@ SensitivityResult SensitivityStudy::run(
                                    : os[3 * j + id - 3];
         }
     };
-    const SobolResult r = analysis.run(design, no, fn);
+    const SobolResult r = analysis.run(design, no, linear ? linear_fn : model_fn);
     res.evaluations += r.evaluations;
     for (std::size_t o = 0; o < no; ++o) {
       const SobolIndices& s = r.outputs[o];

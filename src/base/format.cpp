@@ -18,9 +18,9 @@ std::string format_number(double v) {
   return buf;
 }
 
-std::string format_short(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
+std::string format_short(double v, int digits) {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%.*g", digits, v);
   return buf;
 }
 

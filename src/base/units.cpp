@@ -25,10 +25,12 @@ const char* const kGreekMu = "\xCE\xBC";
 
 const std::vector<NamedUnit>& units() {
   static const std::vector<NamedUnit> u = {
-      {"mm", {1, false}},     {"um", {1e-3, false}},      {"nm", {1e-6, false}},
-      {"m", {1e3, false}},    {"rad", {1, true}},         {"mrad", {1e-3, true}},
-      {"urad", {1e-6, true}}, {"deg", {kPi / 180, true}}, {"arcsec", {kPi / 648000, true}},
-      {"mm/m", {1e-3, true}}, {"um/m", {1e-6, true}},
+      {"mm", {1, false}},         {"um", {1e-3, false}},
+      {"nm", {1e-6, false}},      {"m", {1e3, false}},
+      {"inch", {25.4, false}},    {"rad", {1, true}},
+      {"mrad", {1e-3, true}},     {"urad", {1e-6, true}},
+      {"deg", {kPi / 180, true}}, {"arcsec", {kPi / 648000, true}},
+      {"mm/m", {1e-3, true}},     {"um/m", {1e-6, true}},
   };
   return u;
 }
@@ -56,7 +58,8 @@ bool unit_char(char c) {
 std::string ascii_unit(const std::string& unit) { return ascii_micro(unit); }
 
 std::string known_units() {
-  return "lengths: mm, um, µm, nm, m; angles: rad, mrad, urad, µrad, deg, arcsec; slopes: mm/m, "
+  return "lengths: mm, um, µm, nm, m, inch; angles: rad, mrad, urad, µrad, deg, arcsec; slopes: "
+         "mm/m, "
          "um/m";
 }
 
@@ -183,6 +186,38 @@ double parse_feedrate_mm_min(const std::string& text, const std::string& what) {
   const double v = q.number * factor;
   if (!(v > 0)) fail(what, "\"" + abbreviated(t) + "\": the feedrate must be > 0");
   return v;
+}
+
+namespace {
+
+// Lower-case ASCII, µ/μ as u, blanks and '_' dropped: "Deg_C" -> "degc", "° F" -> "°f".
+std::string unit_key(const std::string& unit) {
+  std::string key;
+  for (char c : ascii_unit(unit))
+    if (c != ' ' && c != '\t' && c != '_')
+      key += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return key;
+}
+
+}  // namespace
+
+AffineUnit parse_temperature_unit(const std::string& unit) {
+  static const std::string degree = "\xC2\xB0", ordinal = "\xC2\xBA";  // °, º (typed for °)
+  const std::string u = unit_key(unit);
+  if (u == "c" || u == "degc" || u == degree + "c" || u == ordinal + "c") return {1, 0};
+  if (u == "f" || u == "degf" || u == degree + "f") return {5.0 / 9, -160.0 / 9};
+  if (u == "k") return {1, -273.15};
+  throw std::invalid_argument("unit '" + unit + "' (expected degC, degF or K)");
+}
+
+AffineUnit parse_pressure_unit(const std::string& unit) {
+  const std::string u = unit_key(unit);
+  if (u == "pa") return {1, 0};
+  if (u == "hpa" || u == "mbar") return {100, 0};
+  if (u == "kpa") return {1000, 0};
+  if (u == "mmhg") return {133.322387415, 0};
+  if (u == "inhg") return {3386.38864, 0};
+  throw std::invalid_argument("unit '" + unit + "' (expected Pa, hPa, mbar, kPa, mmHg or inHg)");
 }
 
 }  // namespace weilgen

@@ -7,6 +7,7 @@
 #include <boost/program_options.hpp>
 #include <charconv>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -19,11 +20,19 @@
 
 namespace weilgen::cli {
 
+// What a numeric flag admits, for the flag table of `weilgen <verb> --flags-json` (the Python
+// module checks its keywords against the same ranges, docs/python.md).
+class RangedSemantic {
+ public:
+  virtual ~RangedSemantic() = default;
+  virtual const NumberRange& range() const = 0;
+};
+
 // A numeric flag value: the whole token is the number (no "12abc"; "-1" is no unsigned), NaN and
 // infinities are refused, and the number must lie in `range`. A bad value stops the parse with
 // "--bootstrap: '-1' is out of range (allowed: a whole number from 0 to 100000)".
 template <typename T>
-class RangedValue : public boost::program_options::typed_value<T> {
+class RangedValue : public boost::program_options::typed_value<T>, public RangedSemantic {
  public:
   RangedValue(T* store, NumberRange range)
       : boost::program_options::typed_value<T>(store), range_(range) {
@@ -37,6 +46,8 @@ class RangedValue : public boost::program_options::typed_value<T> {
     boost::program_options::typed_value<T>::default_value(v, format_number(static_cast<double>(v)));
     return this;
   }
+
+  const NumberRange& range() const override { return range_; }
 
   void xparse(boost::any& value_store, const std::vector<std::string>& tokens) const override {
     namespace po = boost::program_options;
@@ -79,6 +90,14 @@ template <typename T>
 RangedValue<T>* ranged(T* store, NumberRange range) {
   return new RangedValue<T>(store, range);
 }
+
+// A verb's flags as data (`weilgen <verb> --flags-json`): for every visible option its name, kind
+// (switch, repeatable, number, whole, text), default as --help shows it, allowed range and help
+// text, and the verb's description. The Python module's keywords, signatures, stub and range
+// checks are built from it, and its parity test compares them with it (docs/python.md).
+nlohmann::json flags_json(const std::string& verb,
+                          const boost::program_options::options_description& visible,
+                          const char* positional, int max_positional);
 
 // --threads: 0 (every core) to 1024.
 NumberRange thread_range();

@@ -1,10 +1,8 @@
 #include "iso_flags.hpp"
 
-#include <filesystem>
+#include <optional>
 
 #include "flags.hpp"
-#include "weilgen/base/atomic_file.hpp"
-#include "weilgen/base/text.hpp"
 
 namespace po = boost::program_options;
 
@@ -61,33 +59,29 @@ po::options_description iso_options(IsoFlags& f) {
 
 void apply_iso_flags(const IsoFlags& f, const po::variables_map& vm, Iso230_2StudyOptions& s,
                      ImportOptions& imp) {
-  if (lower(f.format) != "auto") imp.format = parse_instrument_format(f.format);
-  NormalisationOptions& n = s.normalisation;
-  n.mode = parse_normalise_mode(f.normalise);
-  s.iso_only = vm.count("iso-only") > 0;
-  if (vm.count("expansion")) n.expansion_ppm_per_K = f.expansion_ppm_per_K;
-  if (vm.count("wavelength")) n.wavelength_nm = f.wavelength_nm;
-  if (vm.count("air-index-assumed")) n.assumed_index = f.air_index_assumed;
-  if (vm.count("datum")) n.datum_mm = f.datum_mm;
-  if (vm.count("air-compensation"))
-    n.air = parse_air_compensation(vm["air-compensation"].as<std::string>(), "--air-compensation");
-  const std::tuple<const char*, EnvironmentSource*, EnvironmentQuantity> sources[] = {
-      {"material-temperature", &n.material_temperature, EnvironmentQuantity::MaterialTemperature},
-      {"air-temperature", &n.air_temperature, EnvironmentQuantity::AirTemperature},
-      {"air-pressure", &n.air_pressure, EnvironmentQuantity::AirPressure},
-      {"air-humidity", &n.air_humidity, EnvironmentQuantity::AirHumidity}};
-  for (const auto& [flag, source, quantity] : sources)
-    if (vm.count(flag))
-      *source =
-          parse_environment_source(vm[flag].as<std::string>(), quantity, std::string("--") + flag);
-  n.validate();
-  if (!f.tolerance.empty()) s.tolerance = parse_iso_tolerance(f.tolerance);
-  if (vm.count("uncertainty")) s.uncertainty = uncertainty_budget_from_flag(f.uncertainty);
-  if (!f.report.empty()) {
-    const std::string ext = lower(std::filesystem::path(f.report).extension().string());
-    if (ext != ".html" && ext != ".htm")
-      throw std::invalid_argument("--report " + f.report + ": the report is an .html file");
-  }
+  Iso230_2Flags w;
+  w.format = f.format;
+  w.normalise = f.normalise;
+  w.iso_only = vm.count("iso-only") > 0;
+  const auto number = [&](const char* flag, double value) {
+    return vm.count(flag) ? std::optional<double>(value) : std::nullopt;
+  };
+  const auto text = [&](const char* flag) {
+    return vm.count(flag) ? std::optional<std::string>(vm[flag].as<std::string>()) : std::nullopt;
+  };
+  w.expansion_ppm_per_K = number("expansion", f.expansion_ppm_per_K);
+  w.wavelength_nm = number("wavelength", f.wavelength_nm);
+  w.air_index_assumed = number("air-index-assumed", f.air_index_assumed);
+  w.datum_mm = number("datum", f.datum_mm);
+  w.material_temperature = text("material-temperature");
+  w.air_compensation = text("air-compensation");
+  w.air_temperature = text("air-temperature");
+  w.air_pressure = text("air-pressure");
+  w.air_humidity = text("air-humidity");
+  w.uncertainty = text("uncertainty");
+  w.tolerance = f.tolerance;
+  w.report = f.report;
+  w.apply(s, imp);
 }
 
 }  // namespace weilgen::cli

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "weilgen/measure/instrument_import.hpp"
+#include "weilgen/measure/iso230_2_flags.hpp"
 #include "weilgen/measure/iso230_2_study.hpp"
 
 namespace weilgen::cli {
@@ -26,8 +27,8 @@ struct IsoFlags {
 // --report, --iso-only, --uncertainty.
 boost::program_options::options_description iso_options(IsoFlags& flags);
 
-// The flags into the study's options and the import's (std::invalid_argument naming the flag);
-// checks --report is an .html file (the verb checks it with its other outputs before any work).
+// The flags into the study's options and the import's through Iso230_2Flags::apply (the same
+// steps as the Python module's).
 void apply_iso_flags(const IsoFlags& flags, const boost::program_options::variables_map& vm,
                      Iso230_2StudyOptions& study, ImportOptions& import);
 

@@ -1,6 +1,8 @@
 #include <exception>
 #include <iostream>
 #include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "verbs.hpp"
 #include "weilgen/base/version.hpp"
@@ -23,7 +25,7 @@ const std::map<std::string, Verb>& verbs() {
 #ifndef WEILGEN_CODEGEN_ONLY
       {"show",
        {weilgen::cli::verb_show,
-        "show <machine> [--output dx] [--format text|latex|json] [--notation iso|alias]\n"
+        "show <machine> [--output dx] [--format text|latex|json|sympy] [--notation iso|alias]\n"
         "      [--order r]\n"
         "      print the closed-form error expressions"}},
       {"list", {weilgen::cli::verb_list, "list\n      list the shipped machines"}},
@@ -104,6 +106,20 @@ int main(int argc, char** argv) {
   }
   if (std::string(argv[1]) == "--version") {
     std::cout << "weilgen " << weilgen::kVersion << "\n";
+    return 0;
+  }
+  if (std::string(argv[1]) == "--flags-json") {
+    // Every verb's flag table (cli/flags.hpp, flags_json): the Python module's keywords and its
+    // parity test are built from it (docs/python.md).
+    nlohmann::json all = nlohmann::json::object();
+    for (const auto& [name, v] : verbs()) {
+      std::ostringstream table;
+      std::streambuf* const out = std::cout.rdbuf(table.rdbuf());
+      v.run({"--flags-json"});
+      std::cout.rdbuf(out);
+      all[name] = nlohmann::json::parse(table.str());
+    }
+    std::cout << all.dump(1) << "\n";
     return 0;
   }
   const auto it = verbs().find(argv[1]);

@@ -20,16 +20,17 @@ namespace weilgen::cli {
 
 po::options_description model_options(StudyFlags& f) {
   po::options_description model("Model");
-  model.add_options()("order", ranged(&f.order, NumberRange::whole_numbers(1, kMaxAlgebraOrder)),
+  model.add_options()("order",
+                      ranged(&f.request.order, NumberRange::whole_numbers(1, kMaxAlgebraOrder)),
                       "algebra order r >= 1 overriding the machine file's (compiles a model)")(
-      "engine", po::value<std::string>(&f.engine)->default_value("auto"),
+      "engine", po::value<std::string>(&f.request.engine)->default_value("auto"),
       "auto (built-in, cached or compiled; numeric chain without a compiler) | compiled |\n"
       "numeric (the exact Eigen chain)")(
-      "compiler", po::value<std::string>(&f.compiler),
+      "compiler", po::value<std::string>(&f.request.compiler),
       "C++ compiler for machines that are not built in (default $CXX, c++, g++, clang++;\n"
-      "'none' disables compilation)")("param",
-                                      po::value<std::vector<std::string>>(&f.params)->composing(),
-                                      "NAME=VALUE machine parameter (mm or deg), repeatable");
+      "'none' disables compilation)")(
+      "param", po::value<std::vector<std::string>>(&f.request.params)->composing(),
+      "NAME=VALUE machine parameter (mm or deg), repeatable");
   return model;
 }
 
@@ -45,18 +46,19 @@ po::options_description ballbar_circle_options(BallbarFlags& c) {
 void add_study_options(po::options_description& opts, StudyFlags& f, bool with_tolerance) {
   const po::options_description model = model_options(f);
   po::options_description where("Poses and distributions (docs/study-inputs.md)");
-  where.add_options()("at", po::value<std::vector<std::string>>(&f.at)->composing(),
+  where.add_options()("at", po::value<std::vector<std::string>>(&f.request.at)->composing(),
                       "one pose, e.g. X=0,Y=1500,Z=600 (axis units mm/deg); repeatable")(
-      "grid", po::value<std::vector<std::string>>(&f.grid)->composing(),
+      "grid", po::value<std::vector<std::string>>(&f.request.grid)->composing(),
       "a grid of poses: each axis a value or start:stop:count, e.g.\n"
       "X=0:1000:5,Y=0,Z=600:1400:5")(
-      "tolerances", po::value<std::vector<std::string>>(&f.tolerance_files)->composing(),
+      "tolerances", po::value<std::vector<std::string>>(&f.request.tolerance_files)->composing(),
       "tolerance file overriding the machine file's distributions; repeatable")(
-      "set", po::value<std::vector<std::string>>(&f.set)->composing(),
+      "set", po::value<std::vector<std::string>>(&f.request.set)->composing(),
       "NAME=normal:0,0.005mm | sigma:5um | uniform:lo,hi | truncnormal:mu,s,lo,hi | const:v\n"
       "(NAME: error, alias or group:<group>); repeatable, applied last");
   if (with_tolerance)
-    where.add_options()("tolerance", po::value<std::vector<std::string>>(&f.tolerance)->composing(),
+    where.add_options()("tolerance",
+                        po::value<std::vector<std::string>>(&f.request.tolerance)->composing(),
                         "OUTPUT=VALUE, e.g. dx=0.03mm or dy=30um,dz=0.03mm (outputs dx dy dz\n"
                         "da db dc dp; dp = |(dx,dy,dz)|)");
   po::options_description out("Output and run");
@@ -66,7 +68,7 @@ void add_study_options(po::options_description& opts, StudyFlags& f, bool with_t
       "seed",
       ranged(&f.seed, NumberRange::whole_numbers(0, 18446744073709551615.0))->default_value(1),
       "seed of every sampled result (same seed, same numbers, any --threads)")(
-      "threads", ranged(&f.threads, thread_range())->default_value(0),
+      "threads", ranged(&f.request.threads, thread_range())->default_value(0),
       "worker threads (0 = all cores)")("quiet,q", po::bool_switch(&f.quiet),
                                         "no progress or model messages on stderr");
   opts.add(model).add(where).add(out);
@@ -75,11 +77,12 @@ void add_study_options(po::options_description& opts, StudyFlags& f, bool with_t
 std::vector<PathArg> study_inputs(const StudyFlags& f) {
   std::vector<PathArg> in;
   try {
-    if (!f.machine.empty()) in.push_back({"machine file", resolve_machine(f.machine)});
+    if (!f.request.machine.empty())
+      in.push_back({"machine file", resolve_machine(f.request.machine)});
   } catch (const InputError&) {
     // Reported when the study opens it.
   }
-  for (const std::string& t : f.tolerance_files) in.push_back({"--tolerances", t});
+  for (const std::string& t : f.request.tolerance_files) in.push_back({"--tolerances", t});
   return in;
 }
 
@@ -88,18 +91,7 @@ std::vector<PathArg> study_outputs(const StudyFlags& f) {
 }
 
 StudyRequest study_request(const StudyFlags& f) {
-  StudyRequest r;
-  r.machine = f.machine;
-  r.order = f.order;
-  r.engine = f.engine;
-  r.compiler = f.compiler;
-  r.params = f.params;
-  r.at = f.at;
-  r.grid = f.grid;
-  r.tolerance = f.tolerance;
-  r.set = f.set;
-  r.tolerance_files = f.tolerance_files;
-  r.threads = f.threads;
+  StudyRequest r = f.request;
   if (!f.quiet) r.log = [](const std::string& m) { std::cerr << "weilgen: " << m << "\n"; };
   return r;
 }
@@ -114,7 +106,7 @@ Study open_study(const StudyFlags& f, bool need_tolerances) {
 
 void fill_measurement_request(const po::variables_map& vm, StudyFlags& flags,
                               MeasurementRequest& request) {
-  if (vm.count("machine")) flags.machine = vm["machine"].as<std::string>();
+  if (vm.count("machine")) flags.request.machine = vm["machine"].as<std::string>();
   request.model = study_request(flags);
   request.allow_unknown = vm.count("allow-unknown") > 0;
   request.warn = [](const std::string& w) { std::cerr << w << "\n"; };

@@ -20,15 +20,13 @@
 
 namespace weilgen::cli {
 
+// The study flags: the model, pose and distribution flags bind straight into `request` (as
+// verb_gap binds GapRequest); the rest say where to write and how to run.
 struct StudyFlags {
-  std::string machine;
-  int order = 0;
-  std::string engine = "auto";
-  std::string compiler;
-  std::vector<std::string> params, at, grid, tolerance, set, tolerance_files;
+  StudyRequest request;  // --order --engine --compiler --param --at --grid --tolerance(s) --set
+                         // --threads, and the machine (positional)
   std::string json, csv, plot;
   std::uint64_t seed = 1;
-  unsigned threads = 0;
   bool quiet = false;
 };
 

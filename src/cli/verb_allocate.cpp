@@ -1,4 +1,4 @@
-// weilgen allocate: tolerance allocation by the grinder seed's step procedure (tighten the most
+// weilgen allocate: tolerance allocation by Wang & Yuan 2021's step procedure (tighten the most
 // reliability-sensitive errors step by step until the targets hold) and a cost-aware optimum
 // (min sum w_i / sigma_i subject to the same targets). The study is analysis/allocation_study,
 // the documents report/allocation_document; docs/reliability.md.
@@ -63,7 +63,7 @@ int verb_allocate(const Args& args) {
   add_study_options(opts, f, true);
   po::variables_map vm;
   if (auto stop = parse_args<std::string>("allocate", args, opts, "machine", 1, vm)) return *stop;
-  if (vm.count("machine")) f.machine = vm["machine"].as<std::string>();
+  if (vm.count("machine")) f.request.machine = vm["machine"].as<std::string>();
   AllocationStudyOptions ao;
   ao.min_target = min_target;
   ao.mean_target = mean_target;

@@ -29,7 +29,7 @@ int verb_ballbar(const Args& args) {
       "each geometric cause are named. docs/ballbar.md, docs/data-format.md.\n\nOptions");
   std::string json_path, plot_path, report_path;
   opts.add_options()("help,h", "show this help")(
-      "machine", po::value<std::string>(&flags.machine),
+      "machine", po::value<std::string>(&flags.request.machine),
       "a shipped machine or machine file: evaluate through its model (optional)")(
       "feedrate", po::value<std::string>(&rq.feedrate),
       "the programmed feed (e.g. '1000 mm/min'; mm/s, m/min, in/min): servo mismatch as a time "
@@ -55,7 +55,7 @@ int verb_ballbar(const Args& args) {
   if (auto stop = parse_args<std::string>("ballbar", args, opts, "trace", 1, vm)) return *stop;
   if (!vm.count("trace")) return usage_error("ballbar", "no trace file given");
   rq.trace = vm["trace"].as<std::string>();
-  if (vm.count("pdge") && flags.machine.empty())
+  if (vm.count("pdge") && flags.request.machine.empty())
     return usage_error("ballbar", "--pdge: the model's terms need --machine");
   fill_measurement_request(vm, flags, rq);
   try {

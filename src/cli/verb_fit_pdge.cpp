@@ -1,5 +1,5 @@
 // weilgen fit-pdge: parametric fits of position-dependent errors (polynomial, Fourier, Legendre,
-// Chebyshev), compared by the 6D-laser seed's Table 4 metrics, the order chosen by
+// Chebyshev), compared by Zhang & Chen 2021's Table 4 metrics, the order chosen by
 // cross-validation. Bases, CV rule, period search, metrics and the JSON schema: docs/fit-pdge.md;
 // the 6D line variant of the CSV: docs/data-format.md.
 #include <iostream>

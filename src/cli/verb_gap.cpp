@@ -7,6 +7,7 @@
 #include "verbs.hpp"
 #include "weilgen/analysis/gap_request.hpp"
 #include "weilgen/base/atomic_file.hpp"
+#include "weilgen/base/text.hpp"
 #include "weilgen/report/gap_document.hpp"
 
 namespace po = boost::program_options;
@@ -24,16 +25,16 @@ int verb_gap(const Args& args) {
       "candidate unmodelled effects by held-out improvement with a test corrected for the extra\n"
       "parameters, and says how far the gap shrinks. docs/gap.md.\n\nOptions");
   std::string json_path, csv_path, report_path, plot_dir;
+  const std::string effects_help =
+      "candidate effects, comma-separated (default: the library: " + join(gap_effect_names()) + ")";
   opts.add_options()("help,h", "show this help")("data", po::value<std::string>(&rq.data),
                                                  "measurement CSV (docs/data-format.md)")(
       "holdout", po::value<std::string>(&rq.holdout)->default_value(rq.holdout),
       "cycle[:K] | time[:K] | space[:AXIS][:K] | forward[:FRACTION] | auto (cycle with >= 3 "
       "cycles, else time, else space)")(
       "effects", po::value<std::vector<std::string>>(&rq.effects)->composing(),
-      "candidate effects, comma-separated (default: the library: thermal_drift, reversal, "
-      "periodic, pdge_shape, higher_order, missing_error, tool_offset, setup)")(
-      "at", po::value<std::vector<std::string>>(&rq.at)->composing(),
-      "coordinates the data do not list, e.g. X=0,Y=0,Z=0 (mm, deg)")(
+      effects_help.c_str())("at", po::value<std::vector<std::string>>(&rq.at)->composing(),
+                            "coordinates the data do not list, e.g. X=0,Y=0,Z=0 (mm, deg)")(
       "pdge", po::value<std::vector<std::string>>(&rq.pdge)->composing(),
       "PDGE basis as for identify (poly:3, E_YY=fourier:3)")(
       "alpha", ranged(&rq.alpha, NumberRange::open(0, 0.5))->default_value(rq.alpha),

@@ -21,6 +21,11 @@ template <typename Positional>
 std::optional<int> parse_args(const std::string& verb, const Args& args,
                               const po::options_description& visible, const char* positional,
                               int max_positional, po::variables_map& vm) {
+  // The flag table for the Python module and its parity test (docs/python.md).
+  if (args.size() == 1 && args[0] == "--flags-json") {
+    std::cout << flags_json(verb, visible, positional, max_positional).dump(1) << "\n";
+    return 0;
+  }
   po::options_description hidden;
   hidden.add_options()(positional, po::value<Positional>(), "")(
       "unexpected-argument", po::value<std::vector<std::string>>(), "");

@@ -31,7 +31,7 @@ int verb_identify(const Args& args) {
       "parameter combinations the data cannot identify); Gauss-Newton for order >= 2. Predicts\n"
       "other measurements (points, ballbar circles) and writes the parameters as a standalone\n"
       "controller header. docs/identify.md.\n\nOptions");
-  std::string json_path, csv_path, plot_path, emit;
+  std::string json_path, csv_path, plot_path, emit, emit_json;
   opts.add_options()("help,h", "show this help")(
       "data", po::value<std::vector<std::string>>(&rq.data)->composing(),
       "measurement CSV (poses + deviations); repeatable")(
@@ -57,6 +57,9 @@ int verb_identify(const Args& args) {
       "intervals, to FILE (.png or .svg, gnuplot)")(
       "emit-params", po::value<std::string>(&emit),
       "write the identified parameters as a standalone C++ header to FILE")(
+      "emit-params-json", po::value<std::string>(&emit_json),
+      "write the identified parameters as JSON to FILE (loaded at run time by a controller: the\n"
+      "LinuxCNC component's params_file, docs/controllers.md)")(
       "allow-unknown", "warn about unknown columns instead of failing")(
       "quiet,q", po::bool_switch(&flags.quiet), "no model messages on stderr");
   opts.add(ballbar_circle_options(rq.circle));
@@ -78,6 +81,7 @@ int verb_identify(const Args& args) {
                               {"--csv", csv_path},
                               {"--plot", plot_path},
                               {"--emit-params", emit},
+                              {"--emit-params-json", emit_json},
                               {"--predict-out", rq.predict_out},
                               {"--comp-table", comp.path}});
   if (!plot_path.empty()) check_plot_target(plot_path);
@@ -93,9 +97,13 @@ int verb_identify(const Args& args) {
     write_file_atomically(rq.predict_out,
                           prediction_csv(*run.predictions.back().points, run.model->description()));
   if (!emit.empty()) {
-    write_file_atomically(emit, params_header(*run.model, *run.param, run.result.theta,
-                                              identify_provenance(run.result)));
+    write_file_atomically(
+        emit, params_header(*run.model, *run.param, run.result, identify_provenance(run.result)));
     std::cout << "\nwrote " << emit << "\n";
+  }
+  if (!emit_json.empty()) {
+    write_file_atomically(emit_json, params_json(*run.model, *run.param, run.result));
+    std::cout << "\nwrote " << emit_json << "\n";
   }
   if (!json_path.empty()) write_file_atomically(json_path, identify_json(run).dump(2) + "\n");
   if (!csv_path.empty())

@@ -1,6 +1,7 @@
 // weilgen iso230-2: the ISO 230-2 positioning figures of one axis from a measurement CSV, with the
-// drift seed's thermal-drift-eliminated evaluation side by side. Definitions, the drift method,
-// the anomaly criterion and the JSON schema: docs/iso230-2.md; the CSV: docs/data-format.md.
+// Stejskal et al. 2017's thermal-drift-eliminated evaluation side by side. Definitions, the drift
+// method, the anomaly criterion and the JSON schema: docs/iso230-2.md; the CSV:
+// docs/data-format.md.
 #include <iostream>
 
 #include "comp_table.hpp"

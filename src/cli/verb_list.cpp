@@ -1,6 +1,5 @@
-#include <filesystem>
 #include <iostream>
-#include <set>
+#include <nlohmann/json.hpp>
 #include <vector>
 
 #include "verbs.hpp"
@@ -14,11 +13,18 @@ int verb_list(const Args& args) {
               << "): name, axes, errors, title.\n";
     return 0;
   }
+  if (args.size() == 1 && args[0] == "--flags-json") {  // no flags (cli/flags.hpp, flags_json)
+    std::cout << nlohmann::json{{"verb", "list"},
+                                {"positional", nullptr},
+                                {"positional_count", 0},
+                                {"about", "Lists the shipped machines."},
+                                {"flags", nlohmann::json::array()}}
+                     .dump(1)
+              << "\n";
+    return 0;
+  }
   if (!args.empty()) return usage_error("list", "takes no arguments");
-  std::set<std::string> files;
-  for (const auto& e : std::filesystem::directory_iterator(shipped_machines_dir()))
-    if (e.path().extension() == ".yaml") files.insert(e.path().string());
-  for (const auto& f : files) {
+  for (const auto& f : shipped_machine_files()) {
     const Description d = load_machine_file(f);
     // "XZY" for one-letter coordinates, "X, A12, Y231" otherwise.
     std::vector<std::string> names;

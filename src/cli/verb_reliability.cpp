@@ -32,7 +32,7 @@ int verb_reliability(const Args& args) {
   po::variables_map vm;
   if (auto stop = parse_args<std::string>("reliability", args, opts, "machine", 1, vm))
     return *stop;
-  if (vm.count("machine")) f.machine = vm["machine"].as<std::string>();
+  if (vm.count("machine")) f.request.machine = vm["machine"].as<std::string>();
   const ReliabilitySettings settings = parse_reliability_flags(rf, f.seed);
   check_output_paths(study_inputs(f), study_outputs(f));
   if (!f.plot.empty()) check_plot_target(f.plot);  // before a long run, not after

@@ -56,7 +56,7 @@ int verb_sensitivity(const Args& args) {
   po::variables_map vm;
   if (auto stop = parse_args<std::string>("sensitivity", args, opts, "machine", 1, vm))
     return *stop;
-  if (vm.count("machine")) f.machine = vm["machine"].as<std::string>();
+  if (vm.count("machine")) f.request.machine = vm["machine"].as<std::string>();
 
   SensitivityOptions so;
   try {

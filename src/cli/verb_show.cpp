@@ -21,7 +21,8 @@ int verb_show(const Args& args) {
   int order = 0;
   opts.add_options()("help,h", "show this help")("output", po::value<std::string>(&output),
                                                  "only this output: dx dy dz da db dc")(
-      "format", po::value<std::string>(&format)->default_value("text"), "text | latex | json")(
+      "format", po::value<std::string>(&format)->default_value("text"),
+      "text | latex | json | sympy (Python syntax, * and **, that sympy.sympify reads)")(
       "notation", po::value<std::string>(&notation)->default_value("iso"),
       "iso (ISO 230-1 names) | alias (each error's first alias, e.g. the paper's symbols)")(
       "order", ranged(&order, NumberRange::whole_numbers(1, kMaxAlgebraOrder)),
@@ -29,8 +30,8 @@ int verb_show(const Args& args) {
   po::variables_map vm;
   if (auto stop = parse_args<std::string>("show", args, opts, "machine", 1, vm)) return *stop;
   if (!vm.count("machine")) return usage_error("show", "no machine given");
-  if (format != "text" && format != "latex" && format != "json")
-    return usage_error("show", "--format must be text, latex or json, not '" + format + "'");
+  if (format != "text" && format != "latex" && format != "json" && format != "sympy")
+    return usage_error("show", "--format must be text, latex, json or sympy, not '" + format + "'");
   if (notation != "iso" && notation != "alias")
     return usage_error("show", "--notation must be iso or alias, not '" + notation + "'");
   int only = -1;
@@ -52,7 +53,9 @@ int verb_show(const Args& args) {
     std::cout << j.dump(2) << "\n";
     return 0;
   }
-  const auto style = format == "latex" ? gen::FormStyle::Latex : gen::FormStyle::Text;
+  const auto style = format == "latex"   ? gen::FormStyle::Latex
+                     : format == "sympy" ? gen::FormStyle::Sympy
+                                         : gen::FormStyle::Text;
   for (int o = 0; o < kNumDeviationOutputs; ++o)
     if (only < 0 || only == o) std::cout << gen::closed_form(m, o, style, n) << "\n";
   return 0;

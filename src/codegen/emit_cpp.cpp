@@ -221,6 +221,38 @@ struct FunctionCode {
 };
 
 // Body of a generated function: used inputs, one CSE pass over all groups, guarded outputs.
+// The "// Inputs" block declaring the inputs that the symbols `used` name (and the inputs the
+// computed ones need); their cost (sin/cos calls, reciprocals) is added to `cost`.
+std::string inputs_block(const InputTable& inputs, const std::set<std::string>& used,
+                         OpCount& cost) {
+  std::set<std::string> used_code;
+  for (const auto& s : used)
+    if (auto it = inputs.code_name.find(s); it != inputs.code_name.end())
+      used_code.insert(it->second);
+  // cos/sin of a coordinate need the coordinate itself; each costs a call and a multiply.
+  const auto is_trig = [](const std::string& code) {
+    return code.rfind("cos_", 0) == 0 || code.rfind("sin_", 0) == 0;
+  };
+  // Computed inputs (reverse declaration order: they may use earlier ones) pull in what they use.
+  for (auto it = inputs.order.rbegin(); it != inputs.order.rend(); ++it) {
+    if (!used_code.count(*it) || !inputs.depends.count(*it)) continue;
+    used_code.insert(inputs.depends.at(*it).begin(), inputs.depends.at(*it).end());
+    cost += inputs.cost.at(*it);
+  }
+  for (const auto& code : inputs.order)
+    if (used_code.count(code) && is_trig(code)) {
+      used_code.insert(code.substr(4));
+      ++cost.functions;
+      ++cost.muls;
+    }
+  std::ostringstream os;
+  os << "  // Inputs\n";
+  for (const auto& code : inputs.order)
+    if (used_code.count(code))
+      os << "  const Scalar " << code << " = " << inputs.definition.at(code) << ";\n";
+  return os.str();
+}
+
 FunctionCode function_body(const InputTable& inputs, const std::vector<OutputGroup>& groups,
                            const Coefficients* coefficients = nullptr) {
   std::vector<ex> all;
@@ -235,31 +267,8 @@ FunctionCode function_body(const InputTable& inputs, const std::vector<OutputGro
 
   ExprPrinter printer(ExprPrinter::Style::Cpp, inputs.code_name);
   std::ostringstream os;
-  std::set<std::string> used_code;
-  for (const auto& s : used)
-    if (auto it = inputs.code_name.find(s); it != inputs.code_name.end())
-      used_code.insert(it->second);
-  // cos/sin of a coordinate need the coordinate itself; each costs a call and a multiply.
-  const auto is_trig = [](const std::string& code) {
-    return code.rfind("cos_", 0) == 0 || code.rfind("sin_", 0) == 0;
-  };
   OpCount trig;
-  // Computed inputs (reverse declaration order: they may use earlier ones) pull in what they use.
-  for (auto it = inputs.order.rbegin(); it != inputs.order.rend(); ++it) {
-    if (!used_code.count(*it) || !inputs.depends.count(*it)) continue;
-    used_code.insert(inputs.depends.at(*it).begin(), inputs.depends.at(*it).end());
-    trig += inputs.cost.at(*it);
-  }
-  for (const auto& code : inputs.order)
-    if (used_code.count(code) && is_trig(code)) {
-      used_code.insert(code.substr(4));
-      ++trig.functions;
-      ++trig.muls;
-    }
-  os << "  // Inputs\n";
-  for (const auto& code : inputs.order)
-    if (used_code.count(code))
-      os << "  const Scalar " << code << " = " << inputs.definition.at(code) << ";\n";
+  os << inputs_block(inputs, used, trig);
   os << "\n  // Intermediate terms (" << cse.temps.size() << ")\n";
   for (const auto& t : cse.temps)
     os << "  const Scalar " << t.symbol.get_name() << " = " << printer.print(t.value) << ";\n";
@@ -283,6 +292,126 @@ FunctionCode function_body(const InputTable& inputs, const std::vector<OutputGro
   FunctionCode fc{os.str(), printer.ops(), cse.temps.size()};
   fc.ops += trig;
   return fc;
+}
+
+// A long function in parts (split_function, emit_cpp.hpp's kSplitStatements): a compiler's time
+// and memory grow faster than the length of a function (g++ -O2 took 228 s and 2.2 GiB for the
+// pipe cutter's order-3 MonomialCoefficients of 16 208 statements), so it becomes functions of
+// at most `part_statements` statements each, called in order. A temporary used by a later part
+// is the element `_s[slot]` of a shared array in every part; every part declares the inputs it
+// uses.
+
+struct SplitCode {
+  std::string parts;  // the part functions' definitions
+  std::string calls;  // the body of the function that calls them
+  OpCount ops;
+  std::size_t temps = 0, parts_count = 0, shared = 0;
+};
+
+// `values` into `alias`[i] (an std::array<Scalar, size_name>&) by the functions
+// `name`Part0, `name`Part1, ... with the arguments of `signature` ("const std::array<Scalar,
+// kNumAxes>& axes, ...") and `arguments` ("axes, params"); `calls` guards on `pointer`.
+SplitCode split_function(const InputTable& inputs, const std::vector<ex>& values,
+                         const std::string& name, const std::string& signature,
+                         const std::string& arguments, const std::string& pointer,
+                         const std::string& alias, const std::string& size_name,
+                         const SplitLimits& limits) {
+  const CseResult cse = eliminate_common_subexpressions(values);
+  const std::size_t nt = cse.temps.size(), total = nt + cse.outputs.size();
+  SplitCode out;
+  if (total <= limits.split_statements || total == 0) return out;  // parts_count 0: one function
+  const std::size_t per = std::max<std::size_t>(1, limits.part_statements);
+  const std::size_t parts = (total + per - 1) / per;
+  // Statements: temporaries 0 .. nt-1, outputs nt ... In the order written, each temporary comes
+  // just before its first use (outputs in order, a temporary's own temporaries first), so that
+  // most are used inside their own part.
+  std::map<std::string, std::size_t> temp_index;
+  for (std::size_t i = 0; i < nt; ++i) temp_index[cse.temps[i].symbol.get_name()] = i;
+  std::vector<std::set<std::size_t>> uses(total);  // the temporaries each statement uses
+  std::vector<std::set<std::string>> symbols(total);
+  for (std::size_t i = 0; i < total; ++i) {
+    collect_symbols(i < nt ? cse.temps[i].value : cse.outputs[i - nt], symbols[i]);
+    for (const auto& sym : symbols[i])
+      if (auto it = temp_index.find(sym); it != temp_index.end()) uses[i].insert(it->second);
+  }
+  std::vector<std::size_t> order;
+  std::vector<char> placed(nt, 0);
+  for (std::size_t o = nt; o < total; ++o) {
+    // Depth-first over the temporaries the output needs (an explicit stack: chains can be long).
+    std::vector<std::pair<std::size_t, bool>> stack{{o, false}};
+    while (!stack.empty()) {
+      auto [i, expanded] = stack.back();
+      stack.pop_back();
+      if (expanded) {
+        if (i >= nt || !placed[i]) order.push_back(i);
+        if (i < nt) placed[i] = 1;
+        continue;
+      }
+      if (i < nt && placed[i]) continue;
+      stack.push_back({i, true});
+      for (auto it = uses[i].rbegin(); it != uses[i].rend(); ++it)
+        if (!placed[*it]) stack.push_back({*it, false});
+    }
+  }
+  for (std::size_t t = 0; t < nt; ++t)
+    if (!placed[t]) order.push_back(t);  // unused by any output (not expected)
+  std::vector<std::size_t> position(total);
+  for (std::size_t k = 0; k < total; ++k) position[order[k]] = k;
+  auto part_of = [&](std::size_t k) { return k * parts / total; };  // by position, even parts
+  // A temporary used in a later part than its own is shared.
+  std::vector<std::size_t> slot(nt, SIZE_MAX);
+  for (std::size_t k = 0; k < total; ++k)
+    for (std::size_t t : uses[order[k]])
+      if (part_of(position[t]) != part_of(k) && slot[t] == SIZE_MAX) slot[t] = out.shared++;
+  // A shared temporary is `_s[slot]` wherever it appears (as long a name as `_tmpN`).
+  std::map<std::string, std::string> names = inputs.code_name;
+  for (std::size_t t = 0; t < nt; ++t)
+    if (slot[t] != SIZE_MAX)
+      names[cse.temps[t].symbol.get_name()] = "_s[" + std::to_string(slot[t]) + "]";
+  ExprPrinter printer(ExprPrinter::Style::Cpp, names);
+  std::ostringstream defs;
+  std::size_t begin = 0;
+  for (std::size_t part = 0; part < parts; ++part) {
+    std::size_t end = begin;
+    while (end < total && part_of(end) == part) ++end;
+    std::set<std::string> used;
+    for (std::size_t k = begin; k < end; ++k)
+      used.insert(symbols[order[k]].begin(), symbols[order[k]].end());
+    std::ostringstream body;
+    body << inputs_block(inputs, used, out.ops) << "\n";
+    for (std::size_t k = begin; k < end; ++k) {
+      const std::size_t i = order[k];
+      if (i < nt) {
+        const std::string value = printer.print(cse.temps[i].value);
+        if (slot[i] == SIZE_MAX)
+          body << "  const Scalar " << cse.temps[i].symbol.get_name() << " = " << value << ";\n";
+        else
+          body << "  _s[" << slot[i] << "] = " << value << ";\n";
+      } else {
+        body << "  " << alias << "[" << i - nt << "] = " << printer.print(cse.outputs[i - nt])
+             << ";\n";
+      }
+    }
+    defs << "template <typename Scalar>\nWEILGEN_MODELS_NOINLINE void " << name << "Part" << part
+         << "(" << signature << ", Scalar* const _s,\n    std::array<Scalar, " << size_name << ">& "
+         << alias << ") {\n  using std::cos;\n  using std::sin;\n  using std::sqrt;\n"
+         << body.str() << "}\n\n";
+    begin = end;
+  }
+  std::ostringstream calls;
+  calls << "  if (" << pointer << " == nullptr) return;\n"
+        << "  // Temporaries that later parts use (" << out.shared
+        << "), each written before it is read.\n"
+        << "  std::array<Scalar, " << std::max<std::size_t>(out.shared, 1) << "> _s;\n";
+  for (std::size_t part = 0; part < parts; ++part)
+    calls << "  " << name << "Part" << part << "<Scalar>(" << arguments << ", _s.data(), *"
+          << pointer << ");\n";
+  out.ops += printer.ops();
+  out.temps = nt;
+  out.parts_count = parts;
+  out.parts = defs.str();
+  out.calls = calls.str();
+  return out;
 }
 
 // Items of a long initializer list, several to a line of at most 98 characters.
@@ -311,12 +440,15 @@ std::string packed_lines(const std::vector<std::string>& items) {
 // (coefficient, numeric factor) instead of one assignment per term.
 struct HigherTable {
   FunctionCode monomial, deviation, deviation_and_coefficients, higher_order;
-  std::size_t count = 0;  // kNumMonomialCoefficients
-  std::string tables;     // kHigherFactors and kHigherTable
+  std::size_t count = 0;       // kNumMonomialCoefficients
+  std::string tables;          // kHigherFactors and kHigherTable
+  std::string monomial_parts;  // MonomialCoefficients' parts when split (split_function)
+  std::size_t parts = 0;
 };
 
 HigherTable higher_table(const SymbolicModel& m, const std::vector<Monomial>& higher,
-                         const InputTable& inputs, std::size_t max_nested) {
+                         const InputTable& inputs, std::size_t max_nested,
+                         const SplitLimits& limits) {
   Coefficients shared;
   shared.everything = true;
   shared.prefix = "_c[";
@@ -361,7 +493,18 @@ HigherTable higher_table(const SymbolicModel& m, const std::vector<Monomial>& hi
   std::vector<ex> values;
   for (const auto& def : shared.defs) values.push_back(def.second);
   // A short name for the ~10 000 assignments (`_k[N] = ...`).
-  t.monomial = function_body(inputs, {{"coefficients", values, false, "_k"}});
+  const SplitCode split = split_function(
+      inputs, values, "MonomialCoefficients",
+      "[[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,\n    [[maybe_unused]] const "
+      "std::array<Scalar, kNumParams>& params",
+      "axes, params", "coefficients", "_k", "kNumMonomialCoefficients", limits);
+  if (split.parts_count == 0) {
+    t.monomial = function_body(inputs, {{"coefficients", values, false, "_k"}});
+  } else {
+    t.monomial = {split.calls, split.ops, split.temps};
+    t.monomial_parts = split.parts;
+    t.parts = split.parts_count;
+  }
   const std::string call =
       "  std::array<Scalar, kNumMonomialCoefficients> _c{};\n"
       "  MonomialCoefficients(axes, params, &_c);\n";
@@ -463,7 +606,7 @@ std::string doc_list(const std::vector<std::string>& names) {
 }  // namespace
 
 std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_label,
-                            std::size_t max_nested_higher_terms) {
+                            std::size_t max_nested_higher_terms, const SplitLimits& split) {
   const Description& d = m.desc;
   const InputTable inputs = inputs_of(m);
   const std::size_t ne = m.errors.size();
@@ -500,7 +643,7 @@ std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_la
                               {"orientation_coeff", srot}},
                              &shared);
   } else {
-    table = higher_table(m, higher, inputs, max_nested_higher_terms);
+    table = higher_table(m, higher, inputs, max_nested_higher_terms, split);
     dev = table.deviation;
     dev_coef = table.deviation_and_coefficients;
     high = table.higher_order;
@@ -718,6 +861,18 @@ std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_la
     os << dev_text.str() << coef_text.str() << dev_coef_text.str();
   } else {
     // Deviation calls DeviationAndCoefficients, which comes first.
+    if (table.parts > 0)
+      os << "// MonomialCoefficients in " << table.parts
+         << " parts, each a function of its own (a compiler's time and\n"
+            "// memory grow faster than the length of one function), called in order.\n"
+            "#ifndef WEILGEN_MODELS_NOINLINE\n"
+            "#if defined(__GNUC__) || defined(__clang__)\n"
+            "#define WEILGEN_MODELS_NOINLINE __attribute__((noinline))\n"
+            "#else\n"
+            "#define WEILGEN_MODELS_NOINLINE\n"
+            "#endif\n"
+            "#endif\n\n"
+         << table.monomial_parts;
     os << "// The coefficient polynomials of the error monomials, each once (every coefficient of "
           "an\n"
           "// output's monomial is a numeric factor times one of them or a number).\n"

@@ -71,11 +71,15 @@ CoefficientText coefficient_text(ex coeff, ExprPrinter& pr, FormStyle style) {
   return out;
 }
 
+const char* product_sign(FormStyle style) {
+  return style == FormStyle::Latex ? "\\," : style == FormStyle::Sympy ? "*" : "·";
+}
+
 // Appends " + c·name" (or the first term) to acc in place: a closed form at order 3 has tens of
 // thousands of terms, and building a new string per term would copy it each time.
 void append_term(std::string& acc, const CoefficientText& c, const std::string& name,
                  FormStyle style) {
-  const char* times = style == FormStyle::Latex ? "\\," : "·";
+  const char* times = product_sign(style);
   acc += acc.empty() ? (c.negative ? "-" : "") : (c.negative ? " - " : " + ");
   if (c.text != "1") acc.append(c.text).append(times);
   acc += name;
@@ -103,7 +107,9 @@ class TermPrinter {
   TermPrinter(const SymbolicModel& m, FormStyle style)
       : m_(m),
         style_(style),
-        pr_(style == FormStyle::Latex ? ExprPrinter::Style::Latex : ExprPrinter::Style::Text,
+        pr_(style == FormStyle::Latex   ? ExprPrinter::Style::Latex
+            : style == FormStyle::Sympy ? ExprPrinter::Style::Sympy
+                                        : ExprPrinter::Style::Text,
             symbol_names(m, style)) {}
   FormStyle style() const { return style_; }
   const CoefficientText& operator()(const ex& coefficient, int sign) {
@@ -147,7 +153,7 @@ std::string closed_form(const SymbolicModel& m, int o, Notation notation, int ma
     int sign = 1;
     for (auto i : mono) {
       const auto [n, sg] = display(m, i, notation, style);
-      name += (name.empty() ? "" : (style == FormStyle::Latex ? "\\," : "·")) + n;
+      name += (name.empty() ? "" : product_sign(style)) + n;
       sign *= sg;
     }
     append_term(s, tp(c, sign), name, style);

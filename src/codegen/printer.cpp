@@ -202,7 +202,10 @@ std::string ExprPrinter::term(const ex& e, bool& negative) {
     negative = true;
     coeff = -coeff;
   }
-  const std::string times = style_ == Style::Cpp ? " * " : (style_ == Style::Text ? "·" : " ");
+  const std::string times = style_ == Style::Cpp     ? " * "
+                            : style_ == Style::Text  ? "·"
+                            : style_ == Style::Sympy ? "*"
+                                                     : " ";
   std::string s;
   if (!coeff.is_equal(1) || num.empty()) {
     s = number(coeff);
@@ -229,6 +232,7 @@ std::string ExprPrinter::term(const ex& e, bool& negative) {
 std::string ExprPrinter::power(const ex& base, long n) {
   const std::string b = factor(base);
   if (n == 1) return b;
+  if (style_ == Style::Sympy) return b + "**" + std::to_string(n);
   if (style_ != Style::Cpp)
     return b + (style_ == Style::Latex ? "^{" : "^") + std::to_string(n) +
            (style_ == Style::Latex ? "}" : "");
@@ -282,8 +286,8 @@ std::string ExprPrinter::factor(const ex& e) {
     }
     if (expo.is_equal(GiNaC::numeric(1, 2))) {
       ++ops_.functions;
-      return (style_ == Style::Cpp ? "sqrt(" : "\\sqrt{") + print(base) +
-             (style_ == Style::Cpp ? ")" : "}");
+      const bool call = style_ == Style::Cpp || style_ == Style::Sympy;
+      return (call ? "sqrt(" : "\\sqrt{") + print(base) + (call ? ")" : "}");
     }
     ++ops_.functions;
     return "pow(" + print(base) + ", " + print(expo) + ")";

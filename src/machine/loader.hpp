@@ -6,6 +6,7 @@
 //   loader_defaults.cpp  error_defaults (per group, per kind) and pdge_basis (per joint type)
 //   loader_chains.cpp    chain points and directions, derived quantities, the output
 //                        transform, tool, workpiece and algebra
+//   loader_linuxcnc.cpp  the linuxcnc section (signs, offsets, letters, joints, units)
 //   yaml_loader.cpp      the public API (weilgen/machine/yaml_loader.hpp) and Loader::load
 #pragma once
 
@@ -45,10 +46,10 @@ inline Unit table_unit(const std::string& name) {
   return {name, f.to_base, f.angle};
 }
 
-const std::vector<std::string> kTopKeys = {"weilgen", "name",       "title",      "notes",
-                                           "algebra", "parameters", "groups",     "error_defaults",
-                                           "bodies",  "tool",       "workpiece",  "points",
-                                           "derived", "output",     "pdge_basis", "directions"};
+const std::vector<std::string> kTopKeys = {
+    "weilgen", "name",           "title",      "notes",      "algebra",   "parameters",
+    "groups",  "error_defaults", "bodies",     "tool",       "workpiece", "points",
+    "derived", "output",         "pdge_basis", "directions", "linuxcnc"};
 const std::vector<std::string> kBodyKeys = {"parent", "offset", "joint", "errors"};
 const std::vector<std::string> kOffsetKeys = {"translation", "rotation"};
 const std::vector<std::string> kRotationKeys = {"axis", "angle"};
@@ -70,6 +71,8 @@ const std::vector<std::string> kPointKeys = {"body", "point"};
 const std::vector<std::string> kDirectionKeys = {"body", "direction"};
 const std::vector<std::string> kAlgebraKeys = {"order", "relations"};
 const std::vector<std::string> kAliasKeys = {"name", "sign"};
+const std::vector<std::string> kLinuxcncKeys = {"units", "axes"};
+const std::vector<std::string> kLinuxcncAxisKeys = {"sign", "offset", "letter", "joint"};
 
 inline bool is_identifier(const std::string& s) {
   if (s.empty() || std::isdigit(static_cast<unsigned char>(s[0]))) return false;
@@ -251,7 +254,8 @@ class Loader {
   // The six fields of a twist [ωx, ωy, ωz, vx, vy, vz] and its ω: numbers, a unit vector or zero.
   std::vector<Field> twist_fields(const Field& f, Vec3& w) const;
 
-  // ξ = [ωx, ωy, ωz, vx, vy, vz] (the seed's twists): ω numbers, v expressions over parameters.
+  // ξ = [ωx, ωy, ωz, vx, vy, vz] (Jiang et al. 2021's twists): ω numbers, v expressions over
+  // parameters.
   void read_twist(const Field& f, std::optional<JointType> declared, Joint& j) const;
 
   // ---- Points, derived quantities, output transform ---------------------------------------
@@ -320,6 +324,11 @@ class Loader {
   // The distribution (and, unless given, the unit) from error_defaults[group].
   void apply_group_default(ErrorDef& err, bool unit_given, const Field& at,
                            const std::string& context) const;
+
+  // ---- LinuxCNC (loader_linuxcnc.cpp) --------------------------------------------------------
+
+  // The `linuxcnc:` section, after the bodies: units and per-axis sign, offset, letter, joint.
+  void read_linuxcnc(const Field& f);
 
   // ---- Tool, workpiece, algebra ---------------------------------------------------------------
 

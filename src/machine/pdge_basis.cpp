@@ -7,18 +7,13 @@
 #include <stdexcept>
 
 #include "weilgen/base/constants.hpp"
+#include "weilgen/base/format.hpp"
 #include "weilgen/base/text.hpp"
 
 namespace weilgen {
 namespace {
 
 constexpr int kMaxOrder = 200;
-
-std::string num(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.10g", v);
-  return buf;
-}
 
 // Power-series coefficients (in u) of the first n + 1 Legendre or Chebyshev polynomials:
 // m[k][j] = coefficient of u^j in P_k (or T_k).
@@ -85,9 +80,11 @@ Basis Basis::make(BasisKind kind, int order, double a, double b, double period_m
 
 void Basis::validate() const {
   if (!std::isfinite(a) || !std::isfinite(b))
-    throw std::invalid_argument("travel [" + num(a) + ", " + num(b) + "] mm is not finite");
+    throw std::invalid_argument("travel [" + format_short(a, 10) + ", " + format_short(b, 10) +
+                                "] mm is not finite");
   if (!(b > a)) {
-    throw std::invalid_argument("travel [" + num(a) + ", " + num(b) + "] mm has " +
+    throw std::invalid_argument("travel [" + format_short(a, 10) + ", " + format_short(b, 10) +
+                                "] mm has " +
                                 (a == b ? std::string("zero length") : "its end before its start") +
                                 ": a basis needs a travel a < b");
   }
@@ -98,7 +95,7 @@ void Basis::validate() const {
   }
   if (kind == BasisKind::Fourier && !std::isnan(period_mm) &&
       !(std::isfinite(period_mm) && period_mm > 0)) {
-    throw std::invalid_argument("basis fourier: period " + num(period_mm) +
+    throw std::invalid_argument("basis fourier: period " + format_short(period_mm, 10) +
                                 " mm must be a finite length > 0");
   }
 }
@@ -109,7 +106,7 @@ double Basis::period() const { return std::isnan(period_mm) ? b - a : period_mm;
 
 std::string Basis::name() const {
   std::string s = std::string(basis_kind_name(kind)) + ":" + std::to_string(order);
-  if (kind == BasisKind::Fourier && !std::isnan(period_mm)) s += ":" + num(period_mm);
+  if (kind == BasisKind::Fourier && !std::isnan(period_mm)) s += ":" + format_short(period_mm, 10);
   return s;
 }
 
@@ -222,7 +219,7 @@ std::string BasisSpec::str() const {
     if (period_search)
       s += ":auto";
     else if (!std::isnan(period_mm))
-      s += ":" + num(period_mm);
+      s += ":" + format_short(period_mm, 10);
   }
   return s;
 }

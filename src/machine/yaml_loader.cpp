@@ -23,6 +23,7 @@
 #include "weilgen/base/units.hpp"
 #include "weilgen/machine/derived.hpp"
 #include "weilgen/machine/iso_names.hpp"
+#include "weilgen/machine/linuxcnc.hpp"
 #include "weilgen/machine/model_key.hpp"
 #include "weilgen/machine/pdge_basis.hpp"
 
@@ -66,8 +67,10 @@ Description Loader::load(const YAML::Node& root) {
   }
   if (const Entry* e = top.find("algebra")) read_algebra(e->value);
   if (const Entry* e = top.find("pdge_basis")) read_pdge_basis(e->value);
+  if (const Entry* e = top.find("linuxcnc")) read_linuxcnc(e->value);
   d_.source_file = file_;
   check_derived(d_);
+  if (top.find("linuxcnc")) linuxcnc_mapping(d_);  // letters and joints used twice, gaps
   return std::move(d_);
 }
 
@@ -121,30 +124,48 @@ Distribution read_distribution_keys(const YAML::Node& mapping, const std::string
   return Loader(file).distribution_keys(mapping, path);
 }
 
+namespace {
+std::string& machines_dir_choice() {
+  static std::string dir;
+  return dir;
+}
+}  // namespace
+
+void use_shipped_machines_dir(const std::string& dir) { machines_dir_choice() = dir; }
+
 std::string shipped_machines_dir() {
   namespace fs = std::filesystem;
   std::error_code ec;
   if (const char* env = std::getenv("WEILGEN_MACHINES_DIR"); env && *env) return env;
-  if (fs::is_directory(WEILGEN_MACHINES_DIR, ec)) return WEILGEN_MACHINES_DIR;
-  // An installed weilgen: <prefix>/bin/weilgen and <prefix>/share/weilgen/machines.
-  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec) {
-    const fs::path installed = exe.parent_path().parent_path() / "share" / "weilgen" / "machines";
-    if (fs::is_directory(installed, ec)) return installed.string();
-  }
-  // An installed module loaded by another program (the Python module in
-  // <prefix>/lib/python3.X/dist-packages): the prefix is a few levels above the module.
-  static const int anchor = 0;  // an address inside this module
+  if (!machines_dir_choice().empty()) return machines_dir_choice();
+  // An installed weilgen reads its installed copy even while the source tree it was built from
+  // still exists: <prefix>/share/weilgen/machines a few levels above the binary holding this code
+  // (<prefix>/bin/weilgen, or the Python module in <prefix>/lib/python3.X/dist-packages/weilgen).
+  static const int anchor = 0;  // an address inside this binary
   Dl_info info{};
-  if (dladdr(&anchor, &info) != 0 && info.dli_fname) {
-    fs::path dir = fs::absolute(info.dli_fname, ec).parent_path();
-    for (int up = 0; up < 4 && dir.has_parent_path() && dir != dir.root_path(); ++up) {
+  const bool module = dladdr(&anchor, &info) != 0 && info.dli_fname &&
+                      fs::path(info.dli_fname).extension() == ".so";
+  fs::path binary =
+      module ? fs::absolute(info.dli_fname, ec) : fs::read_symlink("/proc/self/exe", ec);
+  if (!ec && !binary.empty()) {
+    fs::path dir = binary.parent_path();
+    for (int up = 0; up < 5 && dir.has_parent_path() && dir != dir.root_path(); ++up) {
       dir = dir.parent_path();
       const fs::path installed = dir / "share" / "weilgen" / "machines";
       if (fs::is_directory(installed, ec)) return installed.string();
     }
   }
-  return WEILGEN_MACHINES_DIR;
+  return WEILGEN_MACHINES_DIR;  // the source tree's
+}
+
+std::vector<std::string> shipped_machine_files() {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  std::vector<std::string> files;
+  for (const auto& e : fs::directory_iterator(shipped_machines_dir(), ec))
+    if (e.path().extension() == ".yaml") files.push_back(e.path().string());
+  std::sort(files.begin(), files.end());
+  return files;
 }
 
 std::string resolve_machine(const std::string& name_or_path) {

@@ -275,26 +275,25 @@ bool converted_number(const std::string& text, bool decimal_comma, const Convers
   return true;
 }
 
+// A base-units conversion (base/units) with the file's place in its message.
+template <typename Parse>
+Conversion affine_unit(Parse parse, const std::string& unit, const std::string& where,
+                       const char* tidy_unit) {
+  try {
+    const AffineUnit a = parse(unit);
+    return {a.factor, a.offset, tidy_unit};
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(where + e.what());
+  }
+}
+
 Conversion temperature_unit(const std::string& unit, const std::string& where) {
-  const std::string u = normalise(unit);
-  if (u.empty() || u == "c" || u == "degc" || u == std::string(kDegree) + "c" ||
-      u == std::string(kOrdinal) + "c")
-    return {1, 0, "degC"};
-  if (u == "f" || u == "degf" || u == std::string(kDegree) + "f")
-    return {5.0 / 9, -160.0 / 9, "degC"};
-  if (u == "k") return {1, -273.15, "degC"};
-  throw std::invalid_argument(where + "unit '" + unit + "' (expected degC, degF or K)");
+  if (normalise(unit).empty()) return {1, 0, "degC"};
+  return affine_unit(parse_temperature_unit, unit, where, "degC");
 }
 
 Conversion pressure_unit(const std::string& unit, const std::string& where) {
-  const std::string u = normalise(unit);
-  if (u == "pa") return {1, 0, "Pa"};
-  if (u == "hpa" || u == "mbar") return {100, 0, "Pa"};
-  if (u == "kpa") return {1000, 0, "Pa"};
-  if (u == "mmhg") return {133.322387415, 0, "Pa"};
-  if (u == "inhg") return {3386.38864, 0, "Pa"};
-  throw std::invalid_argument(where + "unit '" + unit +
-                              "' (expected Pa, hPa, mbar, kPa, mmHg or inHg)");
+  return affine_unit(parse_pressure_unit, unit, where, "Pa");
 }
 
 Conversion time_unit(const std::string& unit, const std::string& where) {

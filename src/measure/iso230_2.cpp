@@ -1,4 +1,4 @@
-// ISO 230-2 data grouping, column selection and the standard's figures. The drift seed's
+// ISO 230-2 data grouping, column selection and the standard's figures. Stejskal et al. 2017's
 // evaluation is in iso230_2_drift.cpp. Formulas: docs/iso230-2.md.
 #include "weilgen/measure/iso230_2.hpp"
 

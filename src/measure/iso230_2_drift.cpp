@@ -1,4 +1,4 @@
-// The drift seed's evaluation (Stejskal et al. 2017, eqs. (4)-(10)): adjacent-position
+// The thermal-drift elimination of Stejskal et al. 2017 (eqs. (4)-(10)): adjacent-position
 // differences, the deviation chart rebuilt from a reference position and cycle, the anomaly test
 // on the differences' spreads, and the drift per cycle. docs/iso230-2.md, "Drift elimination".
 #include <algorithm>
@@ -179,7 +179,7 @@ DriftResult DriftElimination::run(const IsoRuns& R) const {
 
   // The rebuilt chart: the reference cycle's value at the reference target, accumulated with the
   // mean adjacent differences outward; s* of the difference linking each target toward the
-  // reference, divided by sqrt(2) (the seed's eq. (9)).
+  // reference, divided by sqrt(2) (Stejskal et al. 2017, eq. (9)).
   std::array<std::vector<double>, 2> s_star;
   for (int d = 0; d < 2; ++d) {
     const std::size_t n = R.cycles[d].size();

@@ -143,7 +143,9 @@ std::map<std::string, double> uncertainty_defaults(const std::string& instrument
 void UncertaintyBudget::validate() const {
   if (instrument_class != "auto") class_index(instrument_class);
   for (const auto& [name, v] : values) {
-    if (std::none_of(keys().begin(), keys().end(), [&](const Key& k) { return name == k.name; }))
+    // clang < 16 cannot capture a structured binding; the lambda takes a plain reference.
+    const std::string& key = name;
+    if (std::none_of(keys().begin(), keys().end(), [&](const Key& k) { return key == k.name; }))
       throw std::invalid_argument("uncertainty budget: unknown key '" + name +
                                   "' (keys: " + key_list() + ")");
     if (!(std::isfinite(v) && v >= 0))

@@ -10,6 +10,7 @@
 #include "weilgen/base/error.hpp"
 #include "weilgen/base/format.hpp"
 #include "weilgen/base/text.hpp"
+#include "weilgen/base/units.hpp"
 
 namespace weilgen {
 
@@ -374,24 +375,19 @@ EnvironmentSource parse_environment_source(const std::string& text, EnvironmentQ
   std::string unit;
   if (split_number_unit(t, v, unit)) {
     const Limits l = limits_of(q);
-    double factor = 1;
-    const std::string u = lower(unit);
-    if (q == EnvironmentQuantity::AirPressure) {
-      if (u == "hpa" || u == "mbar")
-        factor = 100;
-      else if (u == "kpa")
-        factor = 1000;
-      else if (!(u.empty() || u == "pa"))
-        throw std::invalid_argument(origin + ": unit '" + unit + "' (expected Pa, hPa, mbar, kPa)");
-    } else if (q == EnvironmentQuantity::AirHumidity) {
-      if (!(u.empty() || u == "%"))
-        throw std::invalid_argument(origin + ": unit '" + unit + "' (expected % or none)");
-    } else if (!(u.empty() || u == "c" || u == "degc" ||
-                 unit == "\xC2\xB0"
-                         "C")) {
-      throw std::invalid_argument(origin + ": unit '" + unit + "' (expected degC or none)");
+    AffineUnit to_base;  // the unit to Pa or degC; no unit: already Pa, %, degC
+    try {
+      if (q == EnvironmentQuantity::AirPressure && !unit.empty())
+        to_base = parse_pressure_unit(unit);
+      else if (q == EnvironmentQuantity::AirHumidity && !(unit.empty() || unit == "%"))
+        throw std::invalid_argument("unit '" + unit + "' (expected % or none)");
+      else if (q != EnvironmentQuantity::AirPressure && q != EnvironmentQuantity::AirHumidity &&
+               !unit.empty())
+        to_base = parse_temperature_unit(unit);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(origin + ": " + e.what());
     }
-    s.value = v * factor;
+    s.value = to_base.to_base(v);
     check_value(*s.value, l.lo, l.hi, l.unit, origin);
     return s;
   }

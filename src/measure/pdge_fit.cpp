@@ -11,17 +11,12 @@
 #include <stdexcept>
 
 #include "weilgen/base/constants.hpp"
+#include "weilgen/base/format.hpp"
 
 namespace weilgen {
 namespace {
 
 using Rows = std::vector<std::size_t>;
-
-std::string num(double v, int digits = 6) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.*g", digits, v);
-  return buf;
-}
 
 Rows all_rows(std::size_t n) {
   Rows r(n);
@@ -77,11 +72,11 @@ Solved solve_rows(const Basis& basis, const std::vector<double>& x, const std::v
   if (s.rank < p) {
     s.error = basis.name() + " has " + std::to_string(p) +
               " coefficients but its design matrix has numerical rank " + std::to_string(s.rank) +
-              " (relative tolerance " + num(tolerance, 3) +
+              " (relative tolerance " + format_short(tolerance, 3) +
               "): the data cannot support this order" +
-              (basis.kind == BasisKind::Fourier
-                   ? " (positions too few or aliased at period " + num(basis.period()) + " mm)"
-                   : "");
+              (basis.kind == BasisKind::Fourier ? " (positions too few or aliased at period " +
+                                                      format_short(basis.period(), 6) + " mm)"
+                                                : "");
     return s;
   }
   s.coef = qr.solve(Y);
@@ -307,10 +302,12 @@ PeriodSearchResult PeriodSearch::run(const std::vector<double>& x, const std::ve
   const double lmin = std::isnan(options_.min_mm) ? 2 * order * dx : options_.min_mm;
   const double lmax = std::isnan(options_.max_mm) ? 2 * T : options_.max_mm;
   if (!(lmin > 0) || !(lmin < lmax)) {
-    throw std::invalid_argument(
-        "period search: fourier:" + std::to_string(order) +
-        " needs a period range min < max, got [" + num(lmin) + ", " + num(lmax) + "] mm" +
-        (std::isnan(options_.min_mm) ? " (min = 2 * order * spacing " + num(dx) + " mm)" : ""));
+    throw std::invalid_argument("period search: fourier:" + std::to_string(order) +
+                                " needs a period range min < max, got [" + format_short(lmin, 6) +
+                                ", " + format_short(lmax, 6) + "] mm" +
+                                (std::isnan(options_.min_mm)
+                                     ? " (min = 2 * order * spacing " + format_short(dx, 6) + " mm)"
+                                     : ""));
   }
   const double flo = 1 / lmax, fhi = 1 / lmin;
   const double df = 1 / (options_.oversampling * order * T);
@@ -351,9 +348,9 @@ PeriodSearchResult PeriodSearch::run(const std::vector<double>& x, const std::ve
     if (v < best_value) best_value = v, best = i;
   }
   if (best == count) {
-    throw std::invalid_argument("period search: no period in [" + num(lmin) + ", " + num(lmax) +
-                                "] mm gives a full-rank fourier:" + std::to_string(order) +
-                                " fit of these positions");
+    throw std::invalid_argument(
+        "period search: no period in [" + format_short(lmin, 6) + ", " + format_short(lmax, 6) +
+        "] mm gives a full-rank fourier:" + std::to_string(order) + " fit of these positions");
   }
   const double lo = fgrid[best == 0 ? 0 : best - 1];
   const double hi = fgrid[std::min(best + 1, count - 1)];

@@ -36,22 +36,56 @@ NumericChain::NumericChain(Description desc)
     : desc_(std::move(desc)),
       axis_bodies_(desc_.axes()),
       linked_bodies_(desc_.linked_axes()),
-      params_(desc_.parameter_defaults()) {}
+      params_(desc_.parameter_defaults()) {
+  const std::size_t nb = desc_.bodies.size();
+  paths_.resize(nb);
+  placed_.resize(nb);
+  for (std::size_t b = 0; b < nb; ++b) {
+    paths_[b] = desc_.chain_to(static_cast<int>(b));
+    for (int ei : desc_.bodies[b].errors)
+      placed_[b][static_cast<std::size_t>(desc_.errors[static_cast<std::size_t>(ei)].placement)]
+          .push_back(ei);
+  }
+  cache_parameters();
+}
 
 void NumericChain::set_parameters(const std::vector<double>& values) {
   if (values.size() != desc_.parameters.size())
     throw std::invalid_argument("expected " + std::to_string(desc_.parameters.size()) +
                                 " parameter values");
   for (std::size_t i = 0; i < values.size(); ++i) params_[desc_.parameters[i].name] = values[i];
+  cache_parameters();
+}
+
+void NumericChain::cache_parameters() {
+  offsets_.resize(desc_.bodies.size());
+  through_.resize(desc_.bodies.size());
+  for (std::size_t k = 0; k < desc_.bodies.size(); ++k) {
+    const Body& b = desc_.bodies[k];
+    Eigen::Vector3d t;
+    for (int i = 0; i < 3; ++i) t[i] = b.offset.translation[i].eval(params_);
+    Eigen::Matrix4d m = translation(t);
+    for (const auto& r : b.offset.rotations)
+      m = m * rotation(vec(r.axis), r.angle_deg.eval(params_) * kPi / 180.0);
+    offsets_[k] = m;
+    for (int i = 0; i < 3; ++i) through_[k][i] = b.joint.through[i].eval(params_);
+  }
+  tool_point_ = point_of(desc_.tool);
+  workpiece_point_ = point_of(desc_.workpiece);
+}
+
+Eigen::Vector3d NumericChain::point_of(const PointSpec& end) const {
+  Eigen::Vector3d p;
+  for (int i = 0; i < 3; ++i) p[i] = end.point[i].eval(params_);
+  return p;
 }
 
 Eigen::Matrix4d NumericChain::error_transform(int body, ErrorPlacement placement,
                                               const std::vector<double>& errors) const {
   Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
-  for (int ei : desc_.bodies[body].errors) {
-    const ErrorDef& e = desc_.errors[ei];
-    if (e.placement != placement) continue;
-    const double v = errors.at(ei);
+  for (int ei : placed_[static_cast<std::size_t>(body)][static_cast<std::size_t>(placement)]) {
+    const ErrorDef& e = desc_.errors[static_cast<std::size_t>(ei)];
+    const double v = errors[static_cast<std::size_t>(ei)];
     m = m * (e.effect == ErrorEffect::Translation ? translation(v * vec(e.direction))
                                                   : rotation(vec(e.direction), v));
   }
@@ -60,21 +94,15 @@ Eigen::Matrix4d NumericChain::error_transform(int body, ErrorPlacement placement
 
 Eigen::Matrix4d NumericChain::body_transform(int body, const std::vector<double>& q_body,
                                              const std::vector<double>& errors) const {
-  const Body& b = desc_.bodies[body];
-  Eigen::Vector3d t;
-  for (int i = 0; i < 3; ++i) t[i] = b.offset.translation[i].eval(params_);
-  Eigen::Matrix4d m = translation(t);
-  for (const auto& r : b.offset.rotations)
-    m = m * rotation(vec(r.axis), r.angle_deg.eval(params_) * kPi / 180.0);
-
+  const Body& b = desc_.bodies[static_cast<std::size_t>(body)];
+  const Eigen::Matrix4d& m = offsets_[static_cast<std::size_t>(body)];
   Eigen::Matrix4d joint = Eigen::Matrix4d::Identity();
   if (b.joint.type != JointType::Fixed) {
     const double q = q_body[static_cast<std::size_t>(body)] * b.joint.to_base;
     if (b.joint.type == JointType::Prismatic) {
       joint = translation(q * vec(b.joint.axis));
     } else {
-      Eigen::Vector3d through;
-      for (int i = 0; i < 3; ++i) through[i] = b.joint.through[i].eval(params_);
+      const Eigen::Vector3d& through = through_[static_cast<std::size_t>(body)];
       joint = translation(through) * rotation(vec(b.joint.axis), q) * translation(-through);
     }
   }
@@ -83,13 +111,13 @@ Eigen::Matrix4d NumericChain::body_transform(int body, const std::vector<double>
          rigid_inverse(axis) * error_transform(body, ErrorPlacement::After, errors);
 }
 
-Eigen::Matrix4d NumericChain::branch(const PointSpec& end, const std::vector<double>& q_body,
+Eigen::Matrix4d NumericChain::branch(int body, const Eigen::Vector3d& point,
+                                     const std::vector<double>& q_body,
                                      const std::vector<double>& errors) const {
   Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
-  for (int b : desc_.chain_to(end.body)) m = m * body_transform(b, q_body, errors);
-  Eigen::Vector3d p;
-  for (int i = 0; i < 3; ++i) p[i] = end.point[i].eval(params_);
-  return m * translation(p);
+  if (body >= 0 && static_cast<std::size_t>(body) < paths_.size())
+    for (int b : paths_[static_cast<std::size_t>(body)]) m = m * body_transform(b, q_body, errors);
+  return m * translation(point);
 }
 
 std::map<std::string, double> NumericChain::coordinate_values(
@@ -106,14 +134,15 @@ Eigen::Matrix4d NumericChain::output_transform(std::map<std::string, double> val
                                                const std::vector<double>& errors) const {
   const std::vector<double> none(errors.size(), 0.0);
   for (const ChainPoint& p : desc_.points) {
+    const Eigen::Vector3d at = point_of(p.at);
     const Eigen::Vector3d d =
-        (branch(p.at, q_body, errors) - branch(p.at, q_body, none)).block<3, 1>(0, 3);
+        (branch(p.at.body, at, q_body, errors) - branch(p.at.body, at, q_body, none))
+            .block<3, 1>(0, 3);
     for (int i = 0; i < 3; ++i) values[p.name + "." + static_cast<char>('x' + i)] = d[i];
   }
   for (const ChainDirection& u : desc_.directions) {
-    PointSpec frame;
-    frame.body = u.body;
-    const Eigen::Vector3d r = branch(frame, q_body, none).block<3, 3>(0, 0) * vec(u.direction);
+    const Eigen::Vector3d r =
+        branch(u.body, Eigen::Vector3d::Zero(), q_body, none).block<3, 3>(0, 0) * vec(u.direction);
     for (int i = 0; i < 3; ++i) values[u.name + "." + static_cast<char>('x' + i)] = r[i];
   }
   for (const Derived& q : desc_.derived) values[q.name] = q.value.eval(values);
@@ -153,15 +182,15 @@ Eigen::Matrix4d NumericChain::tool_in_workpiece(const std::vector<double>& axes,
   // Names are needed only for linked coordinates and the output transform: serial machines
   // evaluate without building them (this chain is the numeric engine's hot path).
   if (linked_bodies_.empty() && !desc_.output)
-    return rigid_inverse(branch(desc_.workpiece, q_body, errors)) *
-           branch(desc_.tool, q_body, errors);
+    return rigid_inverse(branch(desc_.workpiece.body, workpiece_point_, q_body, errors)) *
+           branch(desc_.tool.body, tool_point_, q_body, errors);
   const std::map<std::string, double> values = coordinate_values(axes);
   for (int b : linked_bodies_)
     q_body[static_cast<std::size_t>(b)] =
         values.at(desc_.bodies[static_cast<std::size_t>(b)].joint.coordinate);
   if (desc_.output) return output_transform(values, q_body, errors);
-  return rigid_inverse(branch(desc_.workpiece, q_body, errors)) *
-         branch(desc_.tool, q_body, errors);
+  return rigid_inverse(branch(desc_.workpiece.body, workpiece_point_, q_body, errors)) *
+         branch(desc_.tool.body, tool_point_, q_body, errors);
 }
 
 Eigen::Matrix4d NumericChain::workpiece_in_base(const std::vector<double>& axes) const {
@@ -177,19 +206,106 @@ Eigen::Matrix4d NumericChain::workpiece_in_base(const std::vector<double>& axes)
       q_body[static_cast<std::size_t>(b)] =
           values.at(desc_.bodies[static_cast<std::size_t>(b)].joint.coordinate);
   }
-  return branch(desc_.workpiece, q_body, std::vector<double>(desc_.errors.size(), 0.0));
+  return branch(desc_.workpiece.body, workpiece_point_, q_body,
+                std::vector<double>(desc_.errors.size(), 0.0));
 }
 
-std::array<double, 6> NumericChain::deviation(const std::vector<double>& axes,
-                                              const std::vector<double>& errors) const {
-  const Eigen::Matrix4d actual = tool_in_workpiece(axes, errors);
-  const Eigen::Matrix4d nominal =
-      tool_in_workpiece(axes, std::vector<double>(desc_.errors.size(), 0.0));
+namespace {
+// Position difference and rotation vector of `actual` against `nominal` (the outputs).
+std::array<double, 6> relative(const Eigen::Matrix4d& actual, const Eigen::Matrix4d& nominal) {
   const Eigen::Vector3d dp = actual.block<3, 1>(0, 3) - nominal.block<3, 1>(0, 3);
   const Eigen::Matrix3d dr = actual.block<3, 3>(0, 0) * nominal.block<3, 3>(0, 0).transpose();
   const Eigen::AngleAxisd aa(dr);
   const Eigen::Vector3d w = aa.angle() * aa.axis();
   return {dp[0], dp[1], dp[2], w[0], w[1], w[2]};
+}
+}  // namespace
+
+std::array<double, 6> NumericChain::deviation(const std::vector<double>& axes,
+                                              const std::vector<double>& errors) const {
+  const Eigen::Matrix4d actual = tool_in_workpiece(axes, errors);
+  return relative(actual, nominal(axes));
+}
+
+Eigen::Matrix4d NumericChain::nominal(const std::vector<double>& axes) const {
+  return tool_in_workpiece(axes, std::vector<double>(desc_.errors.size(), 0.0));
+}
+
+std::array<double, 6> NumericChain::deviation(const std::vector<double>& axes,
+                                              const std::vector<double>& errors,
+                                              const Eigen::Matrix4d& nominal) const {
+  return relative(tool_in_workpiece(axes, errors), nominal);
+}
+
+void NumericChain::deviation_steps(const std::vector<double>& axes,
+                                   const std::vector<double>& errors,
+                                   const std::vector<double>& steps, const Eigen::Matrix4d& nominal,
+                                   std::array<double, 6>& at,
+                                   std::vector<std::array<double, 6>>& stepped) const {
+  const std::size_t ne = desc_.errors.size();
+  if (steps.size() != ne) throw std::invalid_argument("expected " + std::to_string(ne) + " steps");
+  stepped.resize(ne);
+  at = deviation(axes, errors, nominal);  // checks the sizes
+  std::vector<double> e = errors;
+  if (!linked_bodies_.empty() || desc_.output) {
+    for (std::size_t k = 0; k < ne; ++k) {
+      if (steps[k] == 0) continue;
+      e[k] = errors[k] + steps[k];
+      stepped[k] = deviation(axes, e, nominal);
+      e[k] = errors[k];
+    }
+    return;
+  }
+  // A serial chain: each branch's products from the base, as branch() multiplies them, with
+  // the partial product before every body kept; a step in an error of body b redoes b's
+  // transform and the products from b on in every branch through b.
+  std::vector<double> q_body(desc_.bodies.size(), 0.0);
+  for (std::size_t k = 0; k < axis_bodies_.size(); ++k)
+    q_body[static_cast<std::size_t>(axis_bodies_[k])] = axes[k];
+  struct Branch {
+    const std::vector<int>* path = nullptr;
+    const Eigen::Vector3d* point = nullptr;
+    std::vector<Eigen::Matrix4d> before;  // before[j]: the product of the first j transforms
+    std::vector<Eigen::Matrix4d> body;    // the transforms at `errors`
+    Eigen::Matrix4d frame;                // branch(): the whole product times Trans(point)
+  };
+  static const std::vector<int> kNoPath;
+  auto make = [&](int end, const Eigen::Vector3d& point) {
+    Branch br;
+    br.path = end >= 0 && static_cast<std::size_t>(end) < paths_.size()
+                  ? &paths_[static_cast<std::size_t>(end)]
+                  : &kNoPath;
+    br.point = &point;
+    Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+    for (int b : *br.path) {
+      br.before.push_back(m);
+      br.body.push_back(body_transform(b, q_body, errors));
+      m = m * br.body.back();
+    }
+    br.frame = m * translation(point);
+    return br;
+  };
+  const Branch work = make(desc_.workpiece.body, workpiece_point_);
+  const Branch tool = make(desc_.tool.body, tool_point_);
+  // The branch's frame with body b's transform replaced by `bt` (the branch's own if b is not
+  // on it).
+  auto restep = [](const Branch& br, int b, const Eigen::Matrix4d& bt) {
+    const auto it = std::find(br.path->begin(), br.path->end(), b);
+    if (it == br.path->end()) return br.frame;
+    const auto j = static_cast<std::size_t>(it - br.path->begin());
+    Eigen::Matrix4d m = br.before[j] * bt;
+    for (std::size_t i = j + 1; i < br.body.size(); ++i) m = m * br.body[i];
+    return Eigen::Matrix4d(m * translation(*br.point));
+  };
+  for (std::size_t k = 0; k < ne; ++k) {
+    if (steps[k] == 0) continue;
+    const int b = desc_.errors[k].body;
+    e[k] = errors[k] + steps[k];
+    const Eigen::Matrix4d bt = b >= 0 ? body_transform(b, q_body, e) : Eigen::Matrix4d::Identity();
+    e[k] = errors[k];
+    const Eigen::Matrix4d actual = rigid_inverse(restep(work, b, bt)) * restep(tool, b, bt);
+    stepped[k] = relative(actual, nominal);
+  }
 }
 
 Eigen::Matrix<double, 6, Eigen::Dynamic> NumericChain::nominal_jacobian(

@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <nlohmann/json.hpp>
@@ -20,6 +21,7 @@
 #include <vector>
 
 #include "weilgen/analysis/study.hpp"
+#include "weilgen/base/range.hpp"
 
 namespace weilgen::python {
 
@@ -27,14 +29,34 @@ namespace py = pybind11;
 
 // ---- keywords.cpp: keyword arguments as flags --------------------------------------------
 
+// One flag of a verb as `weilgen <verb> --flags-json` describes it (cli/flags.hpp, flags_json):
+// the package loads the table at import (weilgen/_flags.json, written by the build from the CLI)
+// and the keywords are checked against it as the CLI checks the flags.
+struct FlagSpec {
+  std::string kind;                  // switch, repeatable, number, whole, text
+  std::optional<std::string> def;    // the default as --help shows it
+  std::optional<NumberRange> range;  // numbers: what the flag admits
+};
+void use_flag_tables(const std::string& json_text);
+// The flag `keyword` of the verb of `function` (iso230_2: iso230-2; Model: the model flags), or
+// null when the table has none.
+const FlagSpec* flag_spec(const std::string& function, const std::string& keyword);
+// What each function implements: function -> its keywords (the parity test compares them with
+// the CLI's flags, tests/python/test_parity.py).
+std::map<std::string, std::vector<std::string>>& implemented_keywords();
+
 // The keyword arguments of one call, checked against the function's keywords. A keyword's
 // flag is its name with '_' as '-' (rank_tol: --rank-tol); messages name the flag, as the
-// CLI's do. Values that are None count as not given.
+// CLI's do. Values are checked as the CLI checks them (kind and range of the flag table) before
+// anything runs. Values that are None count as not given.
 class Keywords {
  public:
-  // ArgumentError for a keyword the function does not take.
+  // ArgumentError for a keyword the function does not take, or a value its flag refuses.
   Keywords(const char* function, const py::kwargs& kwargs, const std::vector<const char*>& names);
 
+  // Given, and not the flag's default (the wrapper passes every default: left out is the CLI's
+  // default, and a flag at its default counts as not given, as for the CLI's checks of flags
+  // that need another).
   bool given(const char* name) const;
   // A flag that takes text: a str or os.PathLike (a number is written as Python writes it).
   std::optional<std::string> text(const char* name) const;
@@ -82,8 +104,10 @@ void register_model(py::module_& m);
 
 // null -> None, numbers -> int/float, objects -> dict, arrays of numbers (null as NaN) ->
 // numpy arrays (int64 when every element is an integer; a rectangular nest of such arrays
-// becomes one n-dimensional array), other arrays -> list.
-py::object to_python(const nlohmann::json& document);
+// becomes one n-dimensional array), other arrays -> list. An object keyed by error names
+// (dR_dmu, a step's spreads) lists them in the model's order (`errors`), not the JSON's
+// alphabetical one.
+py::object to_python(const nlohmann::json& document, const std::vector<std::string>& errors = {});
 void register_documents(py::module_& m);  // weilgen.plain
 
 // ---- errors.cpp: exceptions, messages, the GIL --------------------------------------------
@@ -105,17 +129,25 @@ class Messages {
   std::vector<std::string> warnings_;
 };
 
-// Runs `f` with the GIL released (an analysis that may take minutes, or compile a model).
+// Runs `f` with the GIL released (a model evaluation, or opening a model).
 template <typename F>
 auto without_gil(F&& f) {
   py::gil_scoped_release release;
   return f();
 }
 
+// Runs an analysis without the GIL and interruptibly: called from the main thread, `f` runs on a
+// worker thread while the caller polls Python's signal handlers every 20 ms; a handler's
+// exception (KeyboardInterrupt for Ctrl-C) cancels the run (base/parallel.hpp, CancelScope) and
+// is raised once the worker has stopped. From another thread (where Python runs no signal
+// handlers) it is without_gil(f).
+nlohmann::json run_analysis(const std::function<nlohmann::json()>& f);
+
 // ---- the analyses ---------------------------------------------------------------------------
 
-void register_study_functions(py::module_& m);  // sensitivity, reliability, allocate
-void register_data_functions(py::module_& m);   // iso230_2, fit_pdge, identify, gap
+void register_study_functions(py::module_& m);    // sensitivity, reliability, allocate
+void register_data_functions(py::module_& m);     // iso230_2, fit_pdge, identify, gap
+void register_generate_function(py::module_& m);  // generate
 
 template <typename T>
 void Keywords::set(const char* name, T& field) const {

@@ -7,7 +7,9 @@
 #include "weilgen/analysis/gap_request.hpp"
 #include "weilgen/analysis/identify_request.hpp"
 #include "weilgen/base/atomic_file.hpp"
+#include "weilgen/base/output_paths.hpp"
 #include "weilgen/measure/instrument_import.hpp"
+#include "weilgen/measure/iso230_2_flags.hpp"
 #include "weilgen/measure/iso230_2_study.hpp"
 #include "weilgen/measure/pdge_fit_study.hpp"
 #include "weilgen/report/ballbar_document.hpp"
@@ -15,6 +17,7 @@
 #include "weilgen/report/gap_document.hpp"
 #include "weilgen/report/identify_document.hpp"
 #include "weilgen/report/iso230_2_document.hpp"
+#include "weilgen/report/iso230_2_html.hpp"
 #include "weilgen/report/params_header.hpp"
 #include "weilgen/report/pdge_fit_document.hpp"
 #include "weilgen/report/plot.hpp"
@@ -29,6 +32,64 @@ std::vector<const char*> with_model(std::initializer_list<const char*> own) {
   for (const char* k : {"plane", "centre", "radius", "feed", "allow_unknown"}) v.push_back(k);
   for (const char* k : model_keywords()) v.push_back(k);
   return v;
+}
+
+// The keywords of each function: the flags of its verb (tests/python/test_parity.py compares
+// them with `weilgen <verb> --flags-json`).
+const std::vector<const char*>& iso230_2_keywords() {
+  // One line per group of flags (clang-format would put one name per line).
+  // clang-format off
+  static const std::vector<const char*> v = {
+      "axis", "column", "reference_position", "reference_cycle", "alpha", "target_tolerance",
+      "allow_unknown", "csv", "plot",
+      "comp_table", "comp_type", "comp_units", "comp_source",
+      "format", "normalise", "expansion", "material_temperature", "air_compensation",
+      "air_temperature", "air_pressure", "air_humidity", "wavelength", "air_index_assumed",
+      "datum", "tolerance", "report", "iso_only", "uncertainty"};
+  // clang-format on
+  return v;
+}
+const std::vector<const char*>& fit_pdge_keywords() {
+  static const std::vector<const char*> v = {"basis",
+                                             "order",
+                                             "min_order",
+                                             "max_order",
+                                             "period",
+                                             "cv",
+                                             "folds",
+                                             "rule",
+                                             "column",
+                                             "axis",
+                                             "travel",
+                                             "keep_line",
+                                             "angular_reference",
+                                             "csv",
+                                             "plot"};
+  return v;
+}
+const std::vector<const char*>& identify_keywords() {
+  static const std::vector<const char*> v =
+      with_model({"data", "pdge", "fix", "rank_tol", "predict", "predict_out", "emit_params",
+                  "emit_params_json", "csv", "plot", "comp_table", "comp_type", "comp_units",
+                  "axis", "comp_points", "comp_at"});
+  return v;
+}
+const std::vector<const char*>& ballbar_keywords() {
+  static const std::vector<const char*> v =
+      with_model({"machine", "feedrate", "alpha", "min_contribution", "pdge", "plot", "report"});
+  return v;
+}
+const std::vector<const char*>& gap_keywords() {
+  static const std::vector<const char*> v = with_model(
+      {"data", "holdout", "effects", "at", "pdge", "alpha", "threads", "csv", "report", "plot"});
+  return v;
+}
+
+// An output path keyword: "" when not given.
+std::string output(const Keywords& kw, const char* name) {
+  std::string path;
+  kw.set(name, path);
+  return path;
 }
 
 // The ballbar circle --plane --centre --radius --feed (centre also as a dict: {"X": 250,
@@ -87,10 +148,7 @@ std::string data_path(py::handle data, const char* what) {
 }
 
 py::object iso230_2(py::handle data, const py::kwargs& kwargs) {
-  const Keywords kw("iso230_2", kwargs,
-                    {"axis", "column", "reference_position", "reference_cycle", "alpha",
-                     "target_tolerance", "allow_unknown", "plot", "comp_table", "comp_type",
-                     "comp_units", "comp_source", "normalise", "iso_only", "uncertainty"});
+  const Keywords kw("iso230_2", kwargs, iso230_2_keywords());
   const std::string path = data_path(data, "data file");
   Iso230_2StudyOptions so;
   kw.set("axis", so.axis);
@@ -99,43 +157,55 @@ py::object iso230_2(py::handle data, const py::kwargs& kwargs) {
   kw.set("target_tolerance", so.target_tolerance_mm);
   if (auto p = kw.number("reference_position")) so.drift.reference_position_mm = *p;
   if (auto c = kw.integer("reference_cycle")) so.drift.reference_cycle = *c;
-  // --normalise, --iso-only, --uncertainty (issue 29's flags).
-  std::string normalise, uncertainty;
-  kw.set("normalise", normalise);
-  if (!normalise.empty()) so.normalisation.mode = parse_normalise_mode(normalise);
-  so.iso_only = kw.flag("iso_only");
-  kw.set("uncertainty", uncertainty);
-  if (!uncertainty.empty()) so.uncertainty = uncertainty_budget_from_flag(uncertainty);
-  const Iso230_2Study study(so);  // validates
-  // Laser exports too (format auto, as the CLI's default): their compensation state counts.
+  Iso230_2Flags flags;
+  kw.set("format", flags.format);
+  kw.set("normalise", flags.normalise);
+  flags.iso_only = kw.flag("iso_only");
+  flags.uncertainty = kw.text("uncertainty");
+  flags.expansion_ppm_per_K = kw.number("expansion");
+  flags.material_temperature = kw.text("material_temperature");
+  flags.air_compensation = kw.text("air_compensation");
+  flags.air_temperature = kw.text("air_temperature");
+  flags.air_pressure = kw.text("air_pressure");
+  flags.air_humidity = kw.text("air_humidity");
+  flags.wavelength_nm = kw.number("wavelength");
+  flags.air_index_assumed = kw.number("air_index_assumed");
+  flags.datum_mm = kw.number("datum");
+  kw.set("tolerance", flags.tolerance);
+  kw.set("report", flags.report);
   ImportOptions io;
   io.read.allow_unknown = kw.flag("allow_unknown");
   io.axis = so.axis;
-  std::string plot;
-  kw.set("plot", plot);
-  if (!plot.empty()) check_plot_target(plot);
+  flags.apply(so, io);
+  const Iso230_2Study study(so);  // validates
+  const std::string plot = output(kw, "plot"), csv = output(kw, "csv");
   const CompTableCall comp(kw, false, {{"data file", path}});
+  check_output_paths(
+      {{"data file", path}},
+      {{"--plot", plot}, {"--csv", csv}, {"--report", flags.report}, {"--comp-table", comp.path}});
+  if (!plot.empty()) check_plot_target(plot);
   Messages messages(true);
-  const nlohmann::json doc = without_gil([&] {
+  const nlohmann::json doc = run_analysis([&] {
     const ImportResult imported = read_instrument_file(path, io);
     for (const auto& w : imported.table.warnings) messages.warn()(w);
     const Iso230_2StudyResult r = study.run(imported.table);
     for (const auto& w : r.normalisation.warnings) messages.warn()(w);
+    const std::string format = to_string(imported.format);
     const CompTable comp_table =
         comp.path.empty() ? CompTable{} : comp_table_from_iso(r, comp.options.table);
     if (!plot.empty())
       write_plot(plot, iso230_2_panels(r), "ISO 230-2, " + r.columns.axis + ": " + path);
+    if (!csv.empty()) write_file_atomically(csv, iso230_2_csv(r));
+    if (!flags.report.empty()) write_file_atomically(flags.report, iso230_2_html(path, r, format));
     comp.write(comp_table);
-    return iso230_2_json(path, r, to_string(imported.format));
+    return iso230_2_json(path, r, format);
   });
   messages.issue();
   return to_python(doc);
 }
 
 py::object fit_pdge(py::handle data, const py::kwargs& kwargs) {
-  const Keywords kw("fit_pdge", kwargs,
-                    {"basis", "order", "min_order", "max_order", "period", "cv", "folds", "rule",
-                     "column", "axis", "travel", "keep_line", "angular_reference", "plot"});
+  const Keywords kw("fit_pdge", kwargs, fit_pdge_keywords());
   const std::string path = data_path(data, "data file");
   PdgeFitStudyOptions so;
   so.bases = kw.items("basis", false);
@@ -152,22 +222,23 @@ py::object fit_pdge(py::handle data, const py::kwargs& kwargs) {
   kw.set("keep_line", so.keep_line);
   kw.set("angular_reference", so.angular);
   const PdgeFitStudy study(so);  // validates
-  std::string plot;
-  kw.set("plot", plot);
-  const nlohmann::json doc = without_gil([&] {
-    if (!plot.empty()) check_plot_target(plot);
+  const std::string plot = output(kw, "plot"), csv = output(kw, "csv");
+  check_output_paths({{"data file", path}}, {{"--csv", csv}, {"--plot", plot}});
+  if (!plot.empty()) check_plot_target(plot);
+  Messages messages(true);
+  const nlohmann::json doc = run_analysis([&] {
     const PdgeFitStudyResult r = study.run(path);
+    for (const std::string& w : r.warnings) messages.warn()(w);
+    if (!csv.empty()) write_file_atomically(csv, pdge_fit_csv(r));
     if (!plot.empty()) write_plot(plot, pdge_fit_panels(r), "weilgen fit-pdge: " + path);
     return pdge_fit_json(so, r);
   });
+  messages.issue();
   return to_python(doc);
 }
 
 py::object identify(py::handle machine, const py::kwargs& kwargs) {
-  const Keywords kw(
-      "identify", kwargs,
-      with_model({"data", "pdge", "fix", "rank_tol", "predict", "predict_out", "emit_params",
-                  "comp_table", "comp_type", "comp_units", "axis", "comp_points", "comp_at"}));
+  const Keywords kw("identify", kwargs, identify_keywords());
   IdentifyRequest rq;
   Messages messages(kw.flag("quiet"));
   measurement_keywords(machine, kw, rq, messages);
@@ -177,14 +248,22 @@ py::object identify(py::handle machine, const py::kwargs& kwargs) {
   rq.predict = kw.items("predict", false);
   kw.set("predict_out", rq.predict_out);
   kw.set("rank_tol", rq.rank_tolerance);
-  std::string emit;
-  kw.set("emit_params", emit);
+  const std::string emit = output(kw, "emit_params"), csv = output(kw, "csv"),
+                    plot = output(kw, "plot"), emit_json = output(kw, "emit_params_json");
   rq.validate();
   std::vector<PathArg> inputs;
   for (const std::string& d : rq.data) inputs.push_back({"--data", d});
   for (const std::string& p : rq.predict) inputs.push_back({"--predict", p});
   const CompTableCall comp(kw, true, inputs);
-  const nlohmann::json doc = without_gil([&] {
+  check_output_paths(inputs, {{"--csv", csv},
+                              {"--plot", plot},
+                              {"--emit-params", emit},
+                              {"--emit-params-json", emit_json},
+                              {"--predict-out", rq.predict_out},
+                              {"--comp-table", comp.path}});
+  if (!plot.empty()) check_plot_target(plot);
+  std::vector<std::string> errors;
+  const nlohmann::json doc = run_analysis([&] {
     if (!comp.path.empty()) check_axis_comp_table(rq.description(), comp.options);
     const IdentifyRun run = run_identify(rq);
     const CompTable comp_table =
@@ -194,19 +273,24 @@ py::object identify(py::handle machine, const py::kwargs& kwargs) {
       write_file_atomically(
           rq.predict_out, prediction_csv(*run.predictions.back().points, run.model->description()));
     if (!emit.empty())
-      write_file_atomically(emit, params_header(*run.model, *run.param, run.result.theta,
-                                                identify_provenance(run.result)));
+      write_file_atomically(
+          emit, params_header(*run.model, *run.param, run.result, identify_provenance(run.result)));
+    if (!emit_json.empty())
+      write_file_atomically(emit_json, params_json(*run.model, *run.param, run.result));
+    if (!csv.empty()) write_file_atomically(csv, identify_csv(*run.model, *run.param, run.result));
+    if (!plot.empty())
+      write_plot(plot, identify_panels(*run.param, run.result),
+                 "weilgen identify: " + run.model->name());
     comp.write(comp_table);
+    errors = error_names(run.model->description());
     return identify_json(run);
   });
   messages.issue();
-  return to_python(doc);
+  return to_python(doc, errors);
 }
 
 py::object gap(py::handle machine, const py::kwargs& kwargs) {
-  const Keywords kw("gap", kwargs,
-                    with_model({"data", "holdout", "effects", "at", "pdge", "alpha", "threads",
-                                "report", "plot"}));
+  const Keywords kw("gap", kwargs, gap_keywords());
   GapRequest rq;
   Messages messages(kw.flag("quiet"));
   measurement_keywords(machine, kw, rq, messages);
@@ -217,33 +301,32 @@ py::object gap(py::handle machine, const py::kwargs& kwargs) {
   rq.pdge = kw.items("pdge", false);
   kw.set("alpha", rq.alpha);
   kw.set("threads", rq.threads);
-  std::string report, plot_dir;
-  kw.set("report", report);
-  kw.set("plot", plot_dir);
+  const std::string report = output(kw, "report"), plot_dir = output(kw, "plot"),
+                    csv = output(kw, "csv");
   rq.validate();
-  const nlohmann::json doc = without_gil([&] {
-    if (!plot_dir.empty()) check_plot_target(plot_dir + "/x.png");
+  const std::vector<PathArg> inputs = {{"--data", rq.data}};
+  check_output_paths(inputs, {{"--csv", csv}, {"--report", report}});
+  check_output_dir(inputs, {"--plot", plot_dir});
+  if (!plot_dir.empty()) check_plot_target(plot_dir + "/x.png");
+  std::vector<std::string> errors;
+  const nlohmann::json doc = run_analysis([&] {
     const GapRun run = run_gap(rq);
     const std::vector<std::string> pngs = plot_dir.empty()
                                               ? std::vector<std::string>{}
                                               : write_gap_plots(plot_dir, run.data, run.result);
     if (!report.empty())
       write_file_atomically(report, gap_markdown(run.result, *run.model, rq.data, pngs, report));
+    if (!csv.empty()) write_file_atomically(csv, gap_csv(run.result, rq.data));
+    errors = error_names(run.model->description());
     return gap_json(run.result, *run.model, rq.data);
   });
   messages.issue();
-  return to_python(doc);
+  return to_python(doc, errors);
 }
-
-}  // namespace
 
 // weilgen ballbar (issue 29): a trace on its own, or through a machine's model (machine=).
 py::object ballbar(py::handle trace, const py::kwargs& kwargs) {
-  std::vector<const char*> names = {"machine", "feedrate", "alpha",  "min_contribution",
-                                    "pdge",    "plot",     "report", "plane",
-                                    "centre",  "radius",   "feed",   "allow_unknown"};
-  for (const char* k : model_keywords()) names.push_back(k);
-  const Keywords kw("ballbar", kwargs, names);
+  const Keywords kw("ballbar", kwargs, ballbar_keywords());
   BallbarRequest rq;
   Messages messages(kw.flag("quiet"));
   rq.trace = data_path(trace, "trace file");
@@ -260,12 +343,10 @@ py::object ballbar(py::handle trace, const py::kwargs& kwargs) {
   kw.set("alpha", rq.alpha);
   kw.set("min_contribution", rq.min_contribution_um);
   if (kw.given("pdge")) rq.pdge = kw.items("pdge", false);
-  std::string plot, report;
-  kw.set("plot", plot);
-  kw.set("report", report);
+  const std::string plot = output(kw, "plot"), report = output(kw, "report");
   rq.validate();
   rq.check_outputs("", plot, report);
-  const nlohmann::json doc = without_gil([&] {
+  const nlohmann::json doc = run_analysis([&] {
     const BallbarStudy st = run_ballbar(rq);
     if (!plot.empty()) write_file_atomically(plot, ballbar_polar_svg(st));
     if (!report.empty()) write_file_atomically(report, ballbar_html(st));
@@ -275,42 +356,21 @@ py::object ballbar(py::handle trace, const py::kwargs& kwargs) {
   return to_python(doc);
 }
 
+}  // namespace
+
 void register_data_functions(py::module_& m) {
-  m.def("iso230_2", &iso230_2, py::arg("data"),
-        R"doc(weilgen iso230-2: ISO 230-2 positioning figures of one axis, with the
-thermal-drift-eliminated evaluation.
-
-iso230_2(data, *, axis, column, reference_position, reference_cycle, alpha, target_tolerance,
-         allow_unknown, plot, comp_table, comp_type, comp_units, comp_source, normalise,
-         iso_only, uncertainty) -> dict: the document `weilgen iso230-2 --json` writes
-(docs/iso230-2.md). None: the CLI's default.)doc");
-  m.def("ballbar", &ballbar, py::arg("trace"),
-        R"doc(weilgen ballbar: a ballbar trace on its own — ISO 230-4 G (least-squares and minimum
-zone), F, H per run, and the usual causes fitted on the trace and ranked.
-
-ballbar(trace, *, radius, plane, centre, feed, feedrate, alpha, min_contribution, plot, report,
-        allow_unknown, machine, pdge, order, engine, compiler, param, quiet) -> dict: the
-document `weilgen ballbar --json` writes (docs/ballbar.md). plot= an .svg, report= an .html.)doc");
-  m.def("fit_pdge", &fit_pdge, py::arg("data"),
-        R"doc(weilgen fit-pdge: fits of position-dependent errors, order by cross-validation.
-
-fit_pdge(data, *, basis, order, min_order, max_order, period, cv, folds, rule, column, axis,
-         travel, keep_line, angular_reference, plot) -> dict: the document
-`weilgen fit-pdge --json` writes (docs/fit-pdge.md); its failures are in the document.)doc");
-  m.def("identify", &identify, py::arg("machine"),
-        R"doc(weilgen identify: fit the error parameters to point measurements, and predict.
-
-identify(machine, *, data, pdge, fix, rank_tol, predict, predict_out, emit_params, comp_table,
-         comp_type, comp_units, axis, comp_points, comp_at, plane, centre, radius, feed,
-         allow_unknown, order, engine, compiler, param, quiet) -> dict:
-the document `weilgen identify --json` writes (docs/identify.md).)doc");
-  m.def("gap", &gap, py::arg("machine"),
-        R"doc(weilgen gap: where model and machine disagree, which unmodelled effect, how far
-the gap shrinks.
-
-gap(machine, *, data, holdout, effects, at, pdge, alpha, threads, report, plot, plane, centre,
-    radius, feed, allow_unknown, order, engine, compiler, param, quiet) -> dict: the document
-`weilgen gap --json` writes (docs/gap.md).)doc");
+  // The documented functions are the package's (weilgen/_verbs.py, generated from the CLI's
+  // flags, with signatures and docstrings); these take the keywords.
+  const auto add = [&](const char* name, py::object (*f)(py::handle, const py::kwargs&),
+                       const char* positional, const std::vector<const char*>& keywords) {
+    m.def(name, f, py::arg(positional));
+    implemented_keywords()[name].assign(keywords.begin(), keywords.end());
+  };
+  add("iso230_2", &iso230_2, "data", iso230_2_keywords());
+  add("fit_pdge", &fit_pdge, "data", fit_pdge_keywords());
+  add("identify", &identify, "machine", identify_keywords());
+  add("gap", &gap, "machine", gap_keywords());
+  add("ballbar", &ballbar, "trace", ballbar_keywords());
 }
 
 }  // namespace weilgen::python

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -85,9 +86,32 @@ py::object plain_value(py::handle v) {
   return py::reinterpret_borrow<py::object>(v);
 }
 
-}  // namespace
+using ErrorIndex = std::map<std::string, std::size_t>;
 
-py::object to_python(const json& j) {
+py::object convert(const json& j, const ErrorIndex& errors);
+
+// An object's items, in the model's error order when every key is an error name.
+py::dict object_dict(const json& j, const ErrorIndex& errors) {
+  py::dict d;
+  std::vector<std::pair<std::size_t, const std::string*>> order;
+  for (const auto& item : j.items()) {
+    const auto it = errors.find(item.key());
+    if (it == errors.end()) {
+      order.clear();
+      break;
+    }
+    order.emplace_back(it->second, &item.key());
+  }
+  if (order.size() > 1) {
+    std::sort(order.begin(), order.end());
+    for (const auto& [index, key] : order) d[py::str(*key)] = convert(j.at(*key), errors);
+    return d;
+  }
+  for (const auto& [key, value] : j.items()) d[py::str(key)] = convert(value, errors);
+  return d;
+}
+
+py::object convert(const json& j, const ErrorIndex& errors) {
   switch (j.type()) {
     case json::value_t::null:
       return py::none();
@@ -101,22 +125,27 @@ py::object to_python(const json& j) {
       return py::float_(j.get<double>());
     case json::value_t::string:
       return py::str(j.get<std::string>());
-    case json::value_t::object: {
-      py::dict d;
-      for (const auto& [key, value] : j.items()) d[py::str(key)] = to_python(value);
-      return std::move(d);
-    }
+    case json::value_t::object:
+      return object_dict(j, errors);
     case json::value_t::array: {
       NumericArray a;
       if (collect(j, 0, a))
         return a.integer ? make_array(a.shape, a.integers) : make_array(a.shape, a.values);
       py::list l;
-      for (const json& x : j) l.append(to_python(x));
+      for (const json& x : j) l.append(convert(x, errors));
       return std::move(l);
     }
     default:
       return py::none();  // binary and discarded values: no document holds them
   }
+}
+
+}  // namespace
+
+py::object to_python(const json& j, const std::vector<std::string>& errors) {
+  ErrorIndex index;
+  for (std::size_t i = 0; i < errors.size(); ++i) index.emplace(errors[i], i);
+  return convert(j, index);
 }
 
 void register_documents(py::module_& m) {

@@ -1,7 +1,13 @@
 #include <Python.h>
 
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <thread>
+
 #include "binding.hpp"
 #include "weilgen/base/error.hpp"
+#include "weilgen/base/parallel.hpp"
 
 namespace weilgen::python {
 
@@ -99,6 +105,59 @@ void Messages::issue() {
   for (const std::string& w : warnings_)
     if (PyErr_WarnEx(g_warning, w.c_str(), 1) != 0) throw py::error_already_set();
   warnings_.clear();
+}
+
+}  // namespace weilgen::python
+
+namespace weilgen::python {
+
+nlohmann::json run_analysis(const std::function<nlohmann::json()>& f) {
+  // Python runs signal handlers on the main thread only: elsewhere nothing can interrupt.
+  const py::module_ threading = py::module_::import("threading");
+  if (!threading.attr("main_thread")().is(threading.attr("current_thread")()))
+    return without_gil(f);
+  std::atomic<bool> cancel{false};
+  nlohmann::json result;
+  std::exception_ptr error;
+  std::mutex mutex;
+  std::condition_variable finished;
+  bool done = false;
+  PyObject *type = nullptr, *value = nullptr, *traceback = nullptr;  // the handler's exception
+  {
+    py::gil_scoped_release release;
+    std::thread worker([&] {
+      const CancelScope scope(&cancel);
+      try {
+        result = f();
+      } catch (...) {
+        error = std::current_exception();
+      }
+      const std::lock_guard<std::mutex> lock(mutex);
+      done = true;
+      finished.notify_one();
+    });
+    std::unique_lock<std::mutex> lock(mutex);
+    while (!finished.wait_for(lock, std::chrono::milliseconds(20), [&] { return done; })) {
+      if (type) continue;  // interrupted: waiting for the worker to stop
+      lock.unlock();
+      {
+        py::gil_scoped_acquire gil;
+        if (PyErr_CheckSignals() != 0) {
+          PyErr_Fetch(&type, &value, &traceback);
+          cancel = true;
+        }
+      }
+      lock.lock();
+    }
+    lock.unlock();
+    worker.join();
+  }
+  if (type) {
+    PyErr_Restore(type, value, traceback);
+    throw py::error_already_set();
+  }
+  if (error) std::rethrow_exception(error);
+  return result;
 }
 
 }  // namespace weilgen::python

@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "binding.hpp"
+#include "weilgen/base/range.hpp"
 #include "weilgen/base/text.hpp"
 
 namespace weilgen::python {
@@ -30,7 +31,65 @@ std::string joined(const std::vector<std::string>& parts, const char* sep) {
   return out;
 }
 
+// verb -> keyword -> its flag (the flag's name with '-' as '_').
+std::map<std::string, std::map<std::string, FlagSpec>>& flag_tables() {
+  static std::map<std::string, std::map<std::string, FlagSpec>> tables;
+  return tables;
+}
+
+std::string keyword_of(std::string flag) {
+  std::replace(flag.begin(), flag.end(), '-', '_');
+  return flag;
+}
+
+double end_value(const nlohmann::json& j, double infinite) {
+  return j.is_null() ? infinite : j.get<double>();
+}
+
 }  // namespace
+
+void use_flag_tables(const std::string& json_text) {
+  const nlohmann::json all = nlohmann::json::parse(json_text);
+  auto& tables = flag_tables();
+  tables.clear();
+  const double inf = std::numeric_limits<double>::infinity();
+  for (const auto& [verb, table] : all.items()) {
+    auto& specs = tables[verb];
+    for (const nlohmann::json& f : table.at("flags")) {
+      FlagSpec spec;
+      spec.kind = f.at("kind").get<std::string>();
+      if (!f.at("default").is_null()) spec.def = f.at("default").get<std::string>();
+      if (const nlohmann::json& r = f.at("range"); !r.is_null()) {
+        NumberRange range;
+        range.lo = end_value(r.at("lo"), -inf);
+        range.hi = end_value(r.at("hi"), inf);
+        range.lo_open = r.at("lo_open").get<bool>();
+        range.hi_open = r.at("hi_open").get<bool>();
+        range.whole = r.at("whole").get<bool>();
+        spec.range = range;
+      }
+      specs[keyword_of(f.at("name").get<std::string>())] = spec;
+    }
+  }
+}
+
+const FlagSpec* flag_spec(const std::string& function, const std::string& keyword) {
+  // Model takes the model flags, which every model verb shares.
+  const std::string verb = function == "Model" ? "sensitivity" : [&] {
+    std::string v = function;
+    std::replace(v.begin(), v.end(), '_', '-');
+    return v;
+  }();
+  const auto table = flag_tables().find(verb);
+  if (table == flag_tables().end()) return nullptr;
+  const auto spec = table->second.find(keyword);
+  return spec == table->second.end() ? nullptr : &spec->second;
+}
+
+std::map<std::string, std::vector<std::string>>& implemented_keywords() {
+  static std::map<std::string, std::vector<std::string>> functions;
+  return functions;
+}
 
 std::string value_text(py::handle v, const std::string& flag) {
   if (py::isinstance<py::str>(v)) return v.cast<std::string>();
@@ -66,6 +125,19 @@ Keywords::Keywords(const char* function, const py::kwargs& kwargs,
                                   "' (keywords: " + join(known) + ")");
     }
   }
+  // Every value checked as the CLI parses its command line, before anything runs.
+  for (const char* name : names) {
+    const py::handle v = value(name);
+    const FlagSpec* spec = flag_spec(function_, name);
+    if (v.is_none() || !spec) continue;
+    if (spec->kind == "switch") {
+      flag(name);
+    } else if (spec->range) {
+      parse_number_in(value_text(v, flag_name(name)), *spec->range, flag_name(name));
+    } else if (spec->kind == "whole") {
+      integer(name);
+    }
+  }
 }
 
 std::string Keywords::flag_name(const char* name) const {
@@ -79,7 +151,19 @@ py::handle Keywords::value(const char* name) const {
   return kwargs_[name];
 }
 
-bool Keywords::given(const char* name) const { return !value(name).is_none(); }
+bool Keywords::given(const char* name) const {
+  const py::handle v = value(name);
+  if (v.is_none()) return false;
+  const FlagSpec* spec = flag_spec(function_, name);
+  if (!spec) return true;
+  if (spec->kind == "switch") return flag(name);
+  if (!spec->def) return true;
+  if (spec->kind == "number" || spec->kind == "whole") {
+    if (!is_number(v)) return true;
+    return py::float_(object(v)).cast<double>() != std::stod(*spec->def);
+  }
+  return !(is_text(v) || is_number(v)) || value_text(v, flag_name(name)) != *spec->def;
+}
 
 std::optional<std::string> Keywords::text(const char* name) const {
   const py::handle v = value(name);

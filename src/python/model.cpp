@@ -7,6 +7,8 @@
 #include "binding.hpp"
 #include "weilgen/base/parallel.hpp"
 #include "weilgen/base/text.hpp"
+#include "weilgen/codegen/emit_report.hpp"
+#include "weilgen/codegen/model_builder.hpp"
 #include "weilgen/machine/model_key.hpp"
 #include "weilgen/machine/outputs.hpp"
 #include "weilgen/machine/yaml_loader.hpp"
@@ -24,6 +26,7 @@ struct PyModel {
   // The model at other parameter values (deviation(..., params=...)): the last one asked for.
   std::vector<double> other_values;
   std::shared_ptr<const Model> other;
+  std::shared_ptr<const gen::SymbolicModel> symbolic;  // closed_form's, built on first use
 };
 
 const char* base_unit(const ErrorDef& e) {
@@ -181,6 +184,64 @@ py::array_t<double> coefficients(PyModel& pm, py::handle axes, py::handle params
   return out;
 }
 
+// `weilgen show`'s text for the model's machine and order: every output or `output` alone, in
+// `format` text, latex, sympy (Python syntax) or json (the document, as a dict).
+py::object closed_form(PyModel& pm, const std::string& output, const std::string& notation,
+                       const std::string& format) {
+  if (format != "text" && format != "latex" && format != "json" && format != "sympy")
+    throw std::invalid_argument(
+        "closed_form: format must be 'text', 'latex', 'sympy-string' or "
+        "'json', not '" +
+        format + "'");
+  if (notation != "iso" && notation != "alias")
+    throw std::invalid_argument("closed_form: notation must be 'iso' or 'alias', not '" + notation +
+                                "'");
+  int only = -1;
+  for (std::size_t o = 0; o < kNumDeviationOutputs; ++o)
+    if (output == output_name(o)) only = static_cast<int>(o);
+  if (!output.empty() && only < 0)
+    throw std::invalid_argument("closed_form: unknown output '" + output + "' (dx dy dz da db dc)");
+  if (!pm.symbolic) {
+    const Description& d = pm.model->description();
+    const int order = pm.model->order();
+    pm.symbolic = without_gil(
+        [&] { return std::make_shared<const gen::SymbolicModel>(gen::build_model(d, order)); });
+  }
+  const gen::SymbolicModel& m = *pm.symbolic;
+  const gen::Notation n = notation == "iso" ? gen::Notation::Iso : gen::Notation::Alias;
+  if (format == "json") {
+    nlohmann::json j = json_document("show", gen::closed_forms_json(m, n));
+    if (only >= 0) j["outputs"] = {{output, j["outputs"][output]}};
+    return to_python(j);
+  }
+  const auto style = format == "latex"   ? gen::FormStyle::Latex
+                     : format == "sympy" ? gen::FormStyle::Sympy
+                                         : gen::FormStyle::Text;
+  std::string text;
+  for (int o = 0; o < kNumDeviationOutputs; ++o)
+    if (only < 0 || only == o) text += gen::closed_form(m, o, style, n) + "\n";
+  return py::str(text);
+}
+
+// The shipped machines (`weilgen list`): name, title, file, axes, axis units, errors, order.
+py::list machines() {
+  py::list out;
+  for (const std::string& file : shipped_machine_files()) {
+    const Description d = load_machine_file(file);
+    py::dict m;
+    m["name"] = d.name;
+    m["title"] = d.title;
+    m["file"] = file;
+    m["axes"] = axis_names(d);
+    m["axis_units"] = axis_units(d);
+    m["errors"] = d.errors.size();
+    m["order"] = d.algebra.order;
+    m["params"] = param_names(d);
+    out.append(std::move(m));
+  }
+  return out;
+}
+
 }  // namespace
 
 const std::vector<const char*>& model_keywords() {
@@ -215,6 +276,8 @@ void model_request(py::handle machine, const Keywords& kw, StudyRequest& r,
 }
 
 void register_model(py::module_& m) {
+  m.def("_machines", &machines);
+  m.def("_use_machines_dir", &use_shipped_machines_dir, py::arg("dir"));
   py::class_<PyModel>(m, "Model", R"doc(A machine's error model (docs/python.md).
 
 Model(machine, order=None, *, engine=None, compiler=None, param=None, quiet=False)
@@ -328,6 +391,31 @@ Returns (N, 6), or (6,) when both are one row.)doc")
            R"doc(d(output)/d(error) at zero error: (N, 6, n), or (6, n) for one row of axes.
 
 Rows dx dy dz in mm per error unit, da db dc in rad per error unit (errors in .error_units).)doc")
+      .def_property_readonly(
+          "axis_ranges",
+          [](const PyModel& p) {
+            py::list out;
+            const Description& d = p.model->description();
+            for (int b : d.axes()) {
+              const Joint& j = d.bodies[static_cast<std::size_t>(b)].joint;
+              out.append(j.min < j.max ? py::object(py::make_tuple(j.min, j.max)) : py::none());
+            }
+            return out;
+          },
+          "each axis's travel (min, max) in its unit (mm, deg), or None when the file gives none")
+      .def_property_readonly(
+          "_state",
+          [](const PyModel& p) {
+            py::dict s;
+            s["machine"] = p.request.machine;
+            s["order"] = p.request.order;
+            s["engine"] = p.request.engine;
+            s["compiler"] = p.request.compiler;
+            s["param"] = p.request.params;
+            return s;
+          },
+          "how the model was opened (pickling opens it again)")
+      .def("_closed_form", &closed_form, py::arg("output"), py::arg("notation"), py::arg("format"))
       .def("__repr__", [](const PyModel& p) {
         std::ostringstream os;
         os << "<weilgen.Model " << p.model->name() << " order " << p.model->order() << " ("

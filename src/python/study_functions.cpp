@@ -7,6 +7,8 @@
 #include "weilgen/analysis/sensitivity_study.hpp"
 #include "weilgen/analysis/tolerance_file.hpp"
 #include "weilgen/base/atomic_file.hpp"
+#include "weilgen/base/output_paths.hpp"
+#include "weilgen/base/parallel.hpp"
 #include "weilgen/base/text.hpp"
 #include "weilgen/report/allocation_document.hpp"
 #include "weilgen/report/plot.hpp"
@@ -17,16 +19,39 @@ namespace weilgen::python {
 
 namespace {
 
-std::vector<const char*> keywords(std::initializer_list<const char*> own) {
+std::vector<const char*> keywords(std::initializer_list<const char*> own,
+                                  bool with_reliability = false) {
   std::vector<const char*> v(own);
   for (const char* k : {"at", "grid", "tolerances", "set", "seed", "threads", "csv", "plot"})
     v.push_back(k);
   for (const char* k : model_keywords()) v.push_back(k);
+  if (with_reliability)
+    for (const char* k : {"limit", "method", "samples", "confidence", "sensitivities"})
+      v.push_back(k);
   return v;
 }
 
-const char* const kReliabilityKeywords[] = {"limit", "method", "samples", "confidence",
-                                            "sensitivities"};
+// The keywords of each function: the flags of its verb (tests/python/test_parity.py compares
+// them with `weilgen <verb> --flags-json`).
+const std::vector<const char*>& sensitivity_keywords() {
+  static const std::vector<const char*> v = keywords(
+      {"method", "outputs", "samples", "sampling", "replicates", "bootstrap", "confidence"});
+  return v;
+}
+const std::vector<const char*>& reliability_keywords() {
+  static const std::vector<const char*> v = keywords({"tolerance"}, true);
+  return v;
+}
+const std::vector<const char*>& allocate_keywords() {
+  static const std::vector<const char*> v =
+      keywords({"tolerance", "min", "mean", "step", "choose", "rank", "errors", "max_steps",
+                "per_output", "cost_aware", "weight", "max_loosen", "save_tolerances"},
+               true);
+  return v;
+}
+
+// Progress of a run: the poll point of a cancelled run between parallel loops.
+void progress(std::size_t, std::size_t) { throw_if_cancelled(); }
 
 // The study part of a request: --at --grid --tolerances --set --threads (and --tolerance).
 void study_keywords(const Keywords& kw, StudyRequest& r, bool with_tolerance) {
@@ -50,15 +75,22 @@ struct StudyCall {
     kw.set("csv", csv);
     kw.set("plot", plot);
   }
-  // Before a long run, as the verbs do: the plot target is checked.
-  Study open(bool need_tolerances) const {
+  // Before a long run, as the verbs do: the outputs and the plot target are checked.
+  void check_outputs(std::vector<PathArg> more = {}) const {
+    std::vector<PathArg> inputs;
+    for (const std::string& t : request.tolerance_files) inputs.push_back({"--tolerances", t});
+    more.push_back({"--csv", csv});
+    more.push_back({"--plot", plot});
+    check_output_paths(inputs, more);
     if (!plot.empty()) check_plot_target(plot);
+  }
+  Study open(bool need_tolerances) const {
     if (opened) return open_study(request, opened, need_tolerances);
     return open_study(request, need_tolerances);
   }
 };
 
-ReliabilityFlags reliability_keywords(const Keywords& kw, ReliabilityFlags f) {
+ReliabilityFlags reliability_flags(const Keywords& kw, ReliabilityFlags f) {
   kw.set("limit", f.limit);
   kw.set("method", f.method);
   kw.set("samples", f.samples);
@@ -68,9 +100,7 @@ ReliabilityFlags reliability_keywords(const Keywords& kw, ReliabilityFlags f) {
 }
 
 py::object sensitivity(py::handle machine, const py::kwargs& kwargs) {
-  const Keywords kw("sensitivity", kwargs,
-                    keywords({"method", "outputs", "samples", "sampling", "replicates", "bootstrap",
-                              "confidence"}));
+  const Keywords kw("sensitivity", kwargs, sensitivity_keywords());
   const StudyCall call(machine, kw, false);
   SensitivityOptions so;
   if (auto m = kw.text("method")) parse_sensitivity_method(*m, so);
@@ -86,30 +116,35 @@ py::object sensitivity(py::handle machine, const py::kwargs& kwargs) {
     set_sobol_intervals(so.sobol_options, replicates ? &reps : nullptr,
                         boot ? &resamples : nullptr);
   so.validate();
-  const nlohmann::json doc = without_gil([&] {
+  call.check_outputs();
+  std::vector<std::string> errors;
+  const nlohmann::json doc = run_analysis([&] {
     const Study st = call.open(false);
-    const SensitivityResult r = SensitivityStudy(so).run(st);
+    errors = error_names(st.model->description());
+    const SensitivityResult r = SensitivityStudy(so).run(st, progress);
     if (!call.csv.empty()) write_file_atomically(call.csv, sensitivity_csv(st, r));
     if (!call.plot.empty())
       write_plot(call.plot, sensitivity_panels(st, so, r),
                  "weilgen sensitivity: " + st.model->name());
     return sensitivity_json(st, so, r);
   });
-  return to_python(doc);
+  return to_python(doc, errors);
 }
 
 py::object reliability(py::handle machine, const py::kwargs& kwargs) {
-  std::vector<const char*> names = keywords({"tolerance"});
-  names.insert(names.end(), std::begin(kReliabilityKeywords), std::end(kReliabilityKeywords));
-  const Keywords kw("reliability", kwargs, names);
+  const Keywords kw("reliability", kwargs, reliability_keywords());
   const StudyCall call(machine, kw, true);
-  const ReliabilityFlags rf = reliability_keywords(kw, ReliabilityFlags{});
+  const ReliabilityFlags rf = reliability_flags(kw, ReliabilityFlags{});
   std::uint64_t seed = ReliabilityOptions{}.seed;
   kw.set("seed", seed);
   const ReliabilitySettings settings = parse_reliability_flags(rf, seed);
-  const nlohmann::json doc = without_gil([&] {
+  call.check_outputs();
+  std::vector<std::string> errors;
+  const nlohmann::json doc = run_analysis([&] {
     const Study st = call.open(true);
-    const auto cases = ReliabilitySweep(settings).run(st, st.inputs);
+    if (!call.plot.empty()) check_reliability_plot(st);
+    errors = error_names(st.model->description());
+    const auto cases = ReliabilitySweep(settings).run(st, st.inputs, progress);
     if (!call.csv.empty()) write_file_atomically(call.csv, reliability_csv(st, settings, cases));
     if (!call.plot.empty())
       write_plot(call.plot, reliability_panels(st, cases),
@@ -117,15 +152,11 @@ py::object reliability(py::handle machine, const py::kwargs& kwargs) {
     const ReliabilitySettingsText text{rf.method, rf.limit, rf.samples, seed, rf.confidence};
     return reliability_json(st, settings, text, cases);
   });
-  return to_python(doc);
+  return to_python(doc, errors);
 }
 
 py::object allocate(py::handle machine, const py::kwargs& kwargs) {
-  std::vector<const char*> names =
-      keywords({"tolerance", "min", "mean", "step", "choose", "rank", "errors", "max_steps",
-                "per_output", "cost_aware", "weight", "max_loosen", "save_tolerances"});
-  names.insert(names.end(), std::begin(kReliabilityKeywords), std::end(kReliabilityKeywords));
-  const Keywords kw("allocate", kwargs, names);
+  const Keywords kw("allocate", kwargs, allocate_keywords());
   const StudyCall call(machine, kw, true);
   if (!call.plot.empty())
     throw std::invalid_argument("--plot: allocate draws no plot (see the JSON's steps)");
@@ -135,7 +166,7 @@ py::object allocate(py::handle machine, const py::kwargs& kwargs) {
   kw.set("max_loosen", ao.max_loosen);
   kw.set("rank", ao.rank);
   ao.validate();
-  const ReliabilityFlags rf = reliability_keywords(kw, ReliabilityFlags::for_allocation());
+  const ReliabilityFlags rf = reliability_flags(kw, ReliabilityFlags::for_allocation());
   std::uint64_t seed = ReliabilityOptions{}.seed;
   kw.set("seed", seed);
   ao.reliability = parse_reliability_flags(rf, seed);
@@ -148,8 +179,11 @@ py::object allocate(py::handle machine, const py::kwargs& kwargs) {
   if (auto e = kw.list("errors")) ao.errors = split(*e, ',');
   std::string save;
   kw.set("save_tolerances", save);
-  const nlohmann::json doc = without_gil([&] {
+  call.check_outputs({{"--save-tolerances", save}});
+  std::vector<std::string> errors;
+  const nlohmann::json doc = run_analysis([&] {
     const Study st = call.open(true);
+    errors = error_names(st.model->description());
     const AllocationStudyResult out = AllocationStudy(ao).run(st);
     if (!save.empty())
       write_tolerance_file(save, st.model->description(), out.final_inputs,
@@ -158,41 +192,22 @@ py::object allocate(py::handle machine, const py::kwargs& kwargs) {
     const AllocationSettingsText text{rf.limit, rf.method, seed};
     return allocation_json(st, ao, text, out);
   });
-  return to_python(doc);
+  return to_python(doc, errors);
 }
 
 }  // namespace
 
 void register_study_functions(py::module_& m) {
-  m.def("sensitivity", &sensitivity, py::arg("machine"),
-        R"doc(weilgen sensitivity: local coefficients, exact and Sobol' indices per pose and output.
-
-sensitivity(machine, *, at, grid, method, outputs, samples, sampling, replicates, bootstrap, confidence,
-            tolerances, set, seed, threads, csv, plot, order, engine, compiler, param, quiet)
-
-machine: a name, a machine file or a weilgen.Model. The keywords are the flags of
-`weilgen sensitivity` (left out or None: the CLI's default). Returns the document
-`weilgen sensitivity --json` writes (docs/sensitivity.md, docs/python.md).)doc");
-  m.def("reliability", &reliability, py::arg("machine"),
-        R"doc(weilgen reliability: R = P(deviation within tolerance) per pose and output.
-
-reliability(machine, *, tolerance, at, grid, limit, method, samples, confidence, sensitivities,
-            tolerances, set, seed, threads, csv, plot, order, engine, compiler, param, quiet)
-
-The keywords are the flags of `weilgen reliability` (left out or None: the CLI's default).
-Returns the document `weilgen reliability --json` writes (docs/reliability.md).)doc");
-  m.def(
-      "allocate", &allocate, py::arg("machine"),
-      R"doc(weilgen allocate: tighten the most sensitive errors until the reliability targets hold.
-
-allocate(machine, *, tolerance, at, grid, min, mean, step, choose, rank, errors, max_steps,
-         per_output, cost_aware, weight, max_loosen, save_tolerances, limit, method, samples,
-         confidence, sensitivities, tolerances, set, seed, threads, csv, order, engine,
-         compiler, param, quiet)
-
-The keywords are the flags of `weilgen allocate` (left out or None: the CLI's default).
-Returns the document `weilgen allocate --json` writes (docs/reliability.md); its "met" says
-whether the targets hold (where the CLI exits with status 1).)doc");
+  // The documented functions are the package's (weilgen/_verbs.py, generated from the CLI's
+  // flags, with signatures and docstrings); these take the keywords.
+  const auto add = [&](const char* name, py::object (*f)(py::handle, const py::kwargs&),
+                       const std::vector<const char*>& keywords) {
+    m.def(name, f, py::arg("machine"));
+    implemented_keywords()[name].assign(keywords.begin(), keywords.end());
+  };
+  add("sensitivity", &sensitivity, sensitivity_keywords());
+  add("reliability", &reliability, reliability_keywords());
+  add("allocate", &allocate, allocate_keywords());
 }
 
 }  // namespace weilgen::python

@@ -34,8 +34,10 @@ std::string comp_table_text(const CompTable& table, int type, const std::string&
      << format_number(table.nominal.front()) << " .. " << format_number(table.nominal.back()) << " "
      << table.unit << "; deviation (actual - commanded) forward " << range(table.forward)
      << ", reverse " << range(table.reverse) << (angle ? " urad" : " um") << "\n"
-     << "  in the INI file's [JOINT_n] section of the axis: COMP_FILE = " << path
-     << " and COMP_FILE_TYPE = " << type << " (docs/controllers.md)\n";
+     << "  in the INI file's "
+     << (table.joint >= 0 ? "[JOINT_" + std::to_string(table.joint) + "]" : "[JOINT_n]")
+     << " section of the axis: COMP_FILE = " << path << " and COMP_FILE_TYPE = " << type
+     << " (docs/controllers.md)\n";
   return os.str();
 }
 

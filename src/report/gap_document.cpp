@@ -139,12 +139,12 @@ nlohmann::json gap_json(const GapResult& r, const Model& model, const std::strin
                           {"observations", r.observations},
                           {"parameters", r.parameters},
                           {"rank", r.rank},
-                          {"heldout_rms_um", per_output_json(r.baseline_rms, r.count)},
-                          {"heldout_max_um", per_output_json(r.baseline_max, r.count)},
-                          {"heldout_rms_all_um", json_number(r.baseline_rms_um)},
-                          {"heldout_rms_ideal_um", per_output_json(r.baseline_ideal, r.count)},
-                          {"excess_um", json_number(r.baseline_excess_um)},
-                          {"p_value", json_number(r.baseline_p_value)},
+                          {"heldout_rms_um", per_output_json(r.baseline.rms, r.count)},
+                          {"heldout_max_um", per_output_json(r.baseline.max, r.count)},
+                          {"heldout_rms_all_um", json_number(r.baseline.rms_um)},
+                          {"heldout_rms_ideal_um", per_output_json(r.baseline.ideal, r.count)},
+                          {"excess_um", json_number(r.baseline.excess_um)},
+                          {"p_value", json_number(r.baseline.p_value)},
                           {"lack_of_fit_p_value", json_number(r.baseline_lack_of_fit_p)},
                           {"lack_of_fit_along", r.baseline_lack_of_fit_along}}},
                         {"noise_floor_um", json_number(r.noise.sigma_um)},
@@ -154,16 +154,16 @@ nlohmann::json gap_json(const GapResult& r, const Model& model, const std::strin
                         {"where", where},
                         {"effects", effects},
                         {"verdict",
-                         {{"effect", r.verdict},
-                          {"reason", r.verdict_reason},
+                         {{"effect", r.verdict.str()},
+                          {"reason", r.verdict.reason},
                           {"explanation", names},
                           {"steps", expl},
-                          {"heldout_rms_after_um", per_output_json(r.final_rms, r.count)},
-                          {"heldout_rms_after_all_um", json_number(r.final_rms_um)},
-                          {"heldout_rms_ideal_um", per_output_json(r.final_ideal, r.count)},
-                          {"heldout_rms_ideal_all_um", json_number(r.final_ideal_um)},
-                          {"remaining_excess_um", json_number(r.final_excess_um)},
-                          {"remaining_p_value", json_number(r.final_p_value)}}}});
+                          {"heldout_rms_after_um", per_output_json(r.final.rms, r.count)},
+                          {"heldout_rms_after_all_um", json_number(r.final.rms_um)},
+                          {"heldout_rms_ideal_um", per_output_json(r.final.ideal, r.count)},
+                          {"heldout_rms_ideal_all_um", json_number(r.final.ideal_um)},
+                          {"remaining_excess_um", json_number(r.final.excess_um)},
+                          {"remaining_p_value", json_number(r.final.p_value)}}}});
 }
 
 std::string gap_text(const GapResult& r, const Model& model, const std::string& data,
@@ -172,7 +172,7 @@ std::string gap_text(const GapResult& r, const Model& model, const std::string& 
   const char* h2 = markdown ? "## " : "";
   os << (markdown ? "# " : "") << "Gap diagnosis: " << model.name() << " against " << data
      << "\n\n";
-  os << "Verdict: " << (markdown ? "**" : "") << r.verdict << (markdown ? "**" : "");
+  os << "Verdict: " << (markdown ? "**" : "") << r.verdict.str() << (markdown ? "**" : "");
   if (!r.explanation.empty()) {
     os << " (";
     for (std::size_t i = 0; i < r.explanation.size(); ++i)
@@ -180,7 +180,7 @@ std::string gap_text(const GapResult& r, const Model& model, const std::string& 
     os << ")";
   }
   os << "\n"
-     << (markdown ? "\n" : "") << "Why: " << r.verdict_reason << ".\n\n"
+     << (markdown ? "\n" : "") << "Why: " << r.verdict.reason << ".\n\n"
      << h2 << "Baseline\n\n";
   if (!r.outliers.empty()) {
     os << r.outliers.size() << " gross reading" << (r.outliers.size() > 1 ? "s" : "")
@@ -197,8 +197,8 @@ std::string gap_text(const GapResult& r, const Model& model, const std::string& 
      << " parameters (rank " << r.rank << ").\n";
   os << "noise floor " << f3(r.noise.sigma_um) << " µm (" << r.noise.source << ": "
      << r.noise.detail << ")\n";
-  os << "held-out gap: RMS " << f3(r.baseline_rms_um) << " µm, excess over the floor "
-     << f3(r.baseline_excess_um) << " µm, p = " << f3(r.baseline_p_value)
+  os << "held-out gap: RMS " << f3(r.baseline.rms_um) << " µm, excess over the floor "
+     << f3(r.baseline.excess_um) << " µm, p = " << f3(r.baseline.p_value)
      << "; lack of fit on all data p = " << f3(r.baseline_lack_of_fit_p)
      << (r.baseline_lack_of_fit_along.empty() ? ""
                                               : " (along " + r.baseline_lack_of_fit_along + ")")
@@ -210,12 +210,12 @@ std::string gap_text(const GapResult& r, const Model& model, const std::string& 
   for (std::size_t o = 0; o < kObservationKinds; ++o) {
     if (!r.count[o]) continue;
     if (markdown)
-      os << "| " << observation_name(o) << " | " << f3(r.baseline_rms[o]) << " | "
-         << f3(r.baseline_max[o]) << " | " << f3(r.final_rms[o]) << " |\n";
+      os << "| " << observation_name(o) << " | " << f3(r.baseline.rms[o]) << " | "
+         << f3(r.baseline.max[o]) << " | " << f3(r.final.rms[o]) << " |\n";
     else
       os << std::left << std::setw(8) << observation_name(o) << std::right << std::setw(12)
-         << f3(r.baseline_rms[o]) << std::setw(9) << f3(r.baseline_max[o]) << std::setw(11)
-         << f3(r.final_rms[o]) << "  " << observation_unit(o) << "\n";
+         << f3(r.baseline.rms[o]) << std::setw(9) << f3(r.baseline.max[o]) << std::setw(11)
+         << f3(r.final.rms[o]) << "  " << observation_unit(o) << "\n";
   }
   os << "\n" << h2 << "Where\n\n";
   std::size_t shown = 0;
@@ -252,10 +252,10 @@ std::string gap_text(const GapResult& r, const Model& model, const std::string& 
          << candidate_text(e) << "\n";
   }
   os << "\n" << h2 << "How far it shrinks\n\n";
-  os << "held-out RMS " << f3(r.baseline_rms_um) << " → " << f3(r.final_rms_um) << " µm ("
-     << f3(100 * (1 - r.final_rms_um / r.baseline_rms_um)) << " %); remaining excess over the "
-     << "floor " << f3(r.final_excess_um) << " µm (p " << f3(r.final_p_value) << "); a right "
-     << "model would leave " << f3(r.final_ideal_um)
+  os << "held-out RMS " << f3(r.baseline.rms_um) << " → " << f3(r.final.rms_um) << " µm ("
+     << f3(100 * (1 - r.final.rms_um / r.baseline.rms_um)) << " %); remaining excess over the "
+     << "floor " << f3(r.final.excess_um) << " µm (p " << f3(r.final.p_value) << "); a right "
+     << "model would leave " << f3(r.final.ideal_um)
      << " µm (the floor with the folds' prediction error)\n";
   return os.str();
 }
@@ -351,7 +351,7 @@ std::vector<GapPlot> gap_plots(const GapData& gd, const GapResult& r) {
   for (const EffectFit& e : r.effects)
     bc.categories.push_back(e.name), s.value.push_back(e.heldout_rms_after_um);
   bc.categories.push_back("baseline");
-  s.value.push_back(r.baseline_rms_um);
+  s.value.push_back(r.baseline.rms_um);
   bc.series = {s};
   out.push_back({"effects", "effect ranking", {bc}});
   return out;

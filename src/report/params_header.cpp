@@ -7,11 +7,11 @@
 #include "weilgen/base/constants.hpp"
 #include "weilgen/base/format.hpp"
 #include "weilgen/machine/model_key.hpp"
+#include "weilgen/report/json_common.hpp"
 
 namespace weilgen {
 
 namespace {
-
 
 // The basis evaluators, written once per header (templated on the scalar).
 const char* kEvaluators =
@@ -60,7 +60,29 @@ Scalar FourierSum(const std::array<double, N>& c, Scalar w) {
 }
 )";
 
+// The position an error's basis is evaluated at: the axis' position held within its span.
+const char* kHeld =
+    R"(// Axis a's position held within its identified span (a NaN stays NaN: Compensate refuses it).
+template <typename Scalar>
+Scalar Held(const std::array<Scalar, kNumAxes>& axes, std::size_t a) {
+  const Scalar lo = Scalar(kSpanMin[a]), hi = Scalar(kSpanMax[a]);
+  return axes[a] < lo ? lo : axes[a] > hi ? hi : axes[a];
+}
+)";
+
 }  // namespace
+
+IdentifiedSpan identified_span(const Description& d, const IdentifyResult& result) {
+  IdentifiedSpan s;
+  const std::vector<int> axes = d.axes();
+  for (std::size_t a = 0; a < axes.size(); ++a) {
+    const Joint& j = d.bodies[static_cast<std::size_t>(axes[a])].joint;
+    const bool measured = a < result.span_min.size() && result.span_min[a] <= result.span_max[a];
+    s.min.push_back(measured ? result.span_min[a] : j.min);
+    s.max.push_back(measured ? result.span_max[a] : j.max);
+  }
+  return s;
+}
 
 std::vector<std::string> identify_provenance(const IdentifyResult& r) {
   char sigma[32];
@@ -74,10 +96,12 @@ std::vector<std::string> identify_provenance(const IdentifyResult& r) {
 }
 
 std::string params_header(const Model& model, const ErrorParameterisation& param,
-                          const std::vector<double>& theta,
+                          const IdentifyResult& result,
                           const std::vector<std::string>& provenance) {
   const Description& d = model.description();
   const std::vector<int> axes = d.axes();
+  const std::vector<double>& theta = result.theta;
+  const IdentifiedSpan span = identified_span(d, result);
   std::ostringstream h;
   h << "// Identified error parameters of machine '" << d.name << "' for the model header "
     << d.name << ".hpp\n// (namespace weilgen_models::" << d.name
@@ -101,7 +125,21 @@ std::string params_header(const Model& model, const ErrorParameterisation& param
   h << ").\ninline constexpr std::array<double, kNumParams> kParams = {{";
   for (std::size_t p = 0; p < model.parameters().size(); ++p)
     h << (p ? ", " : "") << format_literal17(model.parameters()[p]);
-  h << "}};\n\n" << kEvaluators << "\n";
+  h << "}};\n";
+  const auto list = [&](const std::vector<double>& v) {
+    std::string t;
+    for (std::size_t a = 0; a < v.size(); ++a) t += (a ? ", " : "") + format_literal17(v[a]);
+    return t;
+  };
+  h << "// Where the errors were identified: the span of the measured poses along every axis (";
+  for (std::size_t a = 0; a < axes.size(); ++a) {
+    const Joint& j = d.bodies[static_cast<std::size_t>(axes[a])].joint;
+    h << (a ? ", " : "") << j.coordinate << " " << j.unit;
+  }
+  h << ").\n// Errors() holds every PDGE at its axis' span ends: a basis is never extrapolated.\n"
+    << "inline constexpr std::array<double, kNumAxes> kSpanMin = {{" << list(span.min) << "}};\n"
+    << "inline constexpr std::array<double, kNumAxes> kSpanMax = {{" << list(span.max) << "}};\n\n"
+    << kEvaluators << kHeld << "\n";
 
   // Coefficient tables in base units.
   std::vector<std::size_t> first(d.errors.size(), 0);
@@ -113,8 +151,8 @@ std::string params_header(const Model& model, const ErrorParameterisation& param
     const auto& basis = param.basis_of(k);
     const std::string unit = e.base_unit();
     if (!basis) {
-      h << "inline constexpr double k" << e.name << " = " << format_literal17(theta[first[k]] * e.to_base)
-        << ";  // " << unit << "\n";
+      h << "inline constexpr double k" << e.name << " = "
+        << format_literal17(theta[first[k]] * e.to_base) << ";  // " << unit << "\n";
       body << "  e[" << k << "] = Scalar(k" << e.name << ");\n";
       continue;
     }
@@ -127,15 +165,16 @@ std::string params_header(const Model& model, const ErrorParameterisation& param
       throw std::invalid_argument("--emit-params: " + e.name +
                                   " runs along the linked coordinate " + coord +
                                   ", which the params header cannot evaluate");
-    h << "// " << e.name << "(" << coord << "): " << basis->name() << " on [" << format_literal17(basis->a)
-      << ", " << format_literal17(basis->b) << "], " << unit << "\n";
+    h << "// " << e.name << "(" << coord << "): " << basis->name() << " on ["
+      << format_literal17(basis->a) << ", " << format_literal17(basis->b) << "], " << unit << "\n";
     h << "inline constexpr std::array<double, " << basis->size() << "> k" << e.name << " = {{";
     for (std::size_t t = 0; t < basis->size(); ++t)
       h << (t ? ", " : "") << format_literal17(theta[first[k] + t] * e.to_base);
     h << "}};\n";
-    const std::string x = "axes[" + std::to_string(a) + "]";
-    const std::string u = "(Scalar(2) * " + x + " - Scalar(" + format_literal17(basis->a + basis->b) +
-                          ")) / Scalar(" + format_literal17(basis->b - basis->a) + ")";
+    const std::string x = "Held(axes, " + std::to_string(a) + ")";
+    const std::string u = "(Scalar(2) * " + x + " - Scalar(" +
+                          format_literal17(basis->a + basis->b) + ")) / Scalar(" +
+                          format_literal17(basis->b - basis->a) + ")";
     switch (basis->kind) {
       case BasisKind::Polynomial:
         body << "  e[" << k << "] = PolySum(k" << e.name << ", " << u << ");\n";
@@ -160,6 +199,65 @@ std::string params_header(const Model& model, const ErrorParameterisation& param
     << body.str() << "}\n\n}  // namespace " << d.name
     << "_params\n}  // namespace weilgen_models\n";
   return h.str();
+}
+
+std::string params_json(const Model& model, const ErrorParameterisation& param,
+                        const IdentifyResult& result) {
+  using nlohmann::json;
+  const Description& d = model.description();
+  const std::vector<int> axes = d.axes();
+  const IdentifiedSpan span = identified_span(d, result);
+  json params = json::array(), axis_list = json::array(), errors = json::array();
+  for (std::size_t p = 0; p < d.parameters.size(); ++p)
+    params.push_back({{"name", d.parameters[p].name},
+                      {"unit", d.parameters[p].unit},
+                      {"value", model.parameters()[p]}});
+  for (std::size_t a = 0; a < axes.size(); ++a) {
+    const Joint& j = d.bodies[static_cast<std::size_t>(axes[a])].joint;
+    axis_list.push_back(
+        {{"name", j.coordinate}, {"unit", j.unit}, {"span", {span.min[a], span.max[a]}}});
+  }
+  std::vector<std::size_t> first(d.errors.size(), 0);
+  for (std::size_t p = param.parameters().size(); p-- > 0;)
+    first[static_cast<std::size_t>(param.parameters()[p].error)] = p;
+  for (std::size_t k = 0; k < d.errors.size(); ++k) {
+    const ErrorDef& e = d.errors[k];
+    const auto& basis = param.basis_of(k);
+    json entry = {{"name", e.name}, {"unit", e.base_unit()}};
+    if (!basis) {
+      entry["basis"] = "constant";
+      entry["value"] = result.theta[first[k]] * e.to_base;
+      errors.push_back(entry);
+      continue;
+    }
+    std::size_t a = axes.size();
+    for (std::size_t i = 0; i < axes.size(); ++i)
+      if (d.bodies[static_cast<std::size_t>(axes[i])].joint.coordinate == param.coordinate_of(k))
+        a = i;
+    if (a == axes.size())
+      throw std::invalid_argument("--emit-params-json: " + e.name +
+                                  " runs along the linked coordinate " + param.coordinate_of(k) +
+                                  ", which a controller cannot evaluate");
+    const char* kind = basis_kind_name(basis->kind);
+    json c = json::array();
+    for (std::size_t t = 0; t < basis->size(); ++t)
+      c.push_back(result.theta[first[k] + t] * e.to_base);
+    entry["basis"] = kind;
+    entry["axis"] = a;
+    entry["coordinate"] = param.coordinate_of(k);
+    entry["from"] = basis->a;
+    entry["to"] = basis->b;
+    if (basis->kind == BasisKind::Fourier) entry["period"] = basis->period();
+    entry["coefficients"] = c;
+    errors.push_back(entry);
+  }
+  json doc = json_document("identify", {{"weilgen_params", 1},
+                                        {"machine", d.name},
+                                        {"model_key", model_key(d.source_hash, model.order())},
+                                        {"params", params},
+                                        {"axes", axis_list},
+                                        {"errors", errors}});
+  return doc.dump(1) + "\n";
 }
 
 }  // namespace weilgen

@@ -31,7 +31,7 @@ std::string reliability_text(const Study& st, const ReliabilitySettings& setting
        << ", tolerance " << tol.text << ", method " << to_string(first.method) << " (R in %)\n";
     const auto& g = st.poses;
     if (g.grid_axes.size() == 2 && g.grid_size() == np) {
-      // A table like the seed's Tables 2-4: rows = first grid axis, columns = second.
+      // A table like Wang & Yuan 2021, Tables 2-4: rows = first grid axis, columns = second.
       const auto& rows = g.grid_values[0];
       const auto& cols = g.grid_values[1];
       std::ostringstream h;

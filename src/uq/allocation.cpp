@@ -5,6 +5,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "allocation_detail.hpp"
+
 namespace weilgen::allocation_detail {
 
 namespace {

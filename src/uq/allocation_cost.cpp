@@ -8,6 +8,7 @@
 #include <nlopt.hpp>
 #include <stdexcept>
 
+#include "allocation_detail.hpp"
 #include "weilgen/uq/allocation.hpp"
 
 namespace weilgen {

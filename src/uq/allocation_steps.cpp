@@ -1,9 +1,10 @@
-// The seed's step procedure (Tables 5-7): rank the inputs of every failing group by
+// Wang & Yuan 2021's step procedure (Tables 5-7): rank the inputs of every failing group by
 // mean |dR/dsigma_i| * sigma_i, choose the top ones once, lower each chosen stddev by its step
 // per iteration and re-evaluate until every group meets its targets.
 #include <algorithm>
 #include <cmath>
 
+#include "allocation_detail.hpp"
 #include "weilgen/uq/allocation.hpp"
 
 namespace weilgen {

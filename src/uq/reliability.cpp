@@ -6,6 +6,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "reliability_detail.hpp"
 #include "weilgen/base/parallel.hpp"
 
 namespace weilgen {

@@ -2,6 +2,7 @@
 // m = c0 + sum c_i mu_i and s^2 = sum c_i^2 sigma_i^2, and its analytic sensitivities.
 #include <cmath>
 
+#include "reliability_detail.hpp"
 #include "weilgen/uq/reliability.hpp"
 
 namespace weilgen::reliability_detail {

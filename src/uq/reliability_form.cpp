@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "reliability_detail.hpp"
 #include "weilgen/base/constants.hpp"
 #include "weilgen/uq/reliability.hpp"
 

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "reliability_detail.hpp"
 #include "weilgen/base/parallel.hpp"
 #include "weilgen/uq/reliability.hpp"
 

@@ -1,12 +1,13 @@
-// The seed's axis-orthogonal importance sampling (eqs. 23-28). Work is cut into fixed blocks of
-// lines with one random stream per block and per-block partial results combined in block order:
-// bit-identical for any thread count.
+// Wang & Yuan 2021's axis-orthogonal importance sampling (eqs. 23-28). Work is cut into fixed
+// blocks of lines with one random stream per block and per-block partial results combined in block
+// order: bit-identical for any thread count.
 #include <algorithm>
 #include <boost/math/tools/toms748_solve.hpp>
 #include <cmath>
 #include <cstdint>
 #include <limits>
 
+#include "reliability_detail.hpp"
 #include "weilgen/base/constants.hpp"
 #include "weilgen/base/parallel.hpp"
 #include "weilgen/uq/reliability.hpp"

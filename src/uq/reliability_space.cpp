@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "reliability_detail.hpp"
 #include "splitmix64.hpp"
 #include "weilgen/uq/reliability.hpp"
 

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "sobol_detail.hpp"
+#include "splitmix64.hpp"
 #include "weilgen/base/parallel.hpp"
 #include "weilgen/uq/sobol_indices.hpp"
 
@@ -22,16 +23,6 @@ std::mt19937_64 stream(std::uint64_t seed, std::uint64_t block, std::uint32_t ta
                     static_cast<std::uint32_t>(block), static_cast<std::uint32_t>(block >> 32),
                     tag};
   return std::mt19937_64(seq);
-}
-
-// The scramble seed of QMC replicate r of R (R = 1: the seed itself, so 0 stays unrandomised).
-std::uint64_t replicate_seed(std::uint64_t seed, std::size_t r, std::size_t replicates) {
-  if (replicates == 1) return seed;
-  std::uint64_t z = seed + 0x9e3779b97f4a7c15ULL * (r + 1);
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  z ^= z >> 31;
-  return z != 0 ? z : 1;
 }
 
 // Uniform in the open interval (0, 1): the midpoint of one of 2^52 equal cells.
@@ -54,6 +45,13 @@ std::uint32_t bounded(std::mt19937_64& rng, std::uint32_t n) {
 }
 
 }  // namespace
+
+std::uint64_t sobol_replicate_seed(std::uint64_t seed, std::size_t r, std::size_t replicates) {
+  if (replicates == 1) return seed;
+  std::uint64_t state = seed + 0x9e3779b97f4a7c15ULL * r;  // splitmix64 steps to + (r + 1) γ
+  const std::uint64_t z = splitmix64(state);
+  return z != 0 ? z : 1;
+}
 
 namespace sobol_detail {
 
@@ -156,7 +154,7 @@ SobolDesign::SobolDesign(std::vector<InputDistribution> inputs, const SobolOptio
   // (seed != 0) or the plain points (seed 0), as before replicates existed.
   if (sampling_ == Sampling::Qmc && dims > 0)
     for (std::size_t r = 0; r < replicates_; ++r)
-      sequences_.emplace_back(dims, replicate_seed(seed_, r, replicates_), replicates_ > 1);
+      sequences_.emplace_back(dims, sobol_replicate_seed(seed_, r, replicates_), replicates_ > 1);
   if (stored_) {
     a_.resize(samples_ * k);
     b_.resize(samples_ * k);

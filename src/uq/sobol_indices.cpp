@@ -234,6 +234,15 @@ SobolResult SobolAnalysis::run(const SobolDesign& design, std::size_t outputs,
         total[r * kv + j] = v > 0 ? vti / v : 0.0;
       }
     }
+    if (replicates > 1) {
+      res.first_replicates.assign(replicates * k, 0.0);
+      res.total_replicates.assign(replicates * k, 0.0);
+      for (std::size_t r = 0; r < replicates; ++r)
+        for (std::size_t j = 0; j < kv; ++j) {
+          res.first_replicates[r * k + varying[j]] = first[r * kv + j];
+          res.total_replicates[r * k + varying[j]] = total[r * kv + j];
+        }
+    }
     for (std::size_t j = 0; j < kv; ++j) {
       const std::size_t i = varying[j];
       for (int which = 0; which < 2; ++which) {

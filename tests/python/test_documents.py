@@ -1,5 +1,8 @@
 """Every analysis of the module returns the document the CLI's --json writes, number for number,
 on the shipped machines and examples; keywords in the CLI's text or as dicts give the same."""
+import json
+import os
+
 import weilgen
 from conftest import same_document, source
 
@@ -121,12 +124,18 @@ def test_fit_pdge_equals_cli(cli):
 
 def test_identify_equals_cli(cli, tmp_path):
     want = cli.json("identify", "vmc_3axis", "-q", "--data", POINTS, "--predict", BALLBAR,
-                    "--predict", POINTS, "--emit-params", str(tmp_path / "cli.hpp"))
+                    "--predict", POINTS, "--emit-params", str(tmp_path / "cli.hpp"),
+                    "--emit-params-json", str(tmp_path / "cli_params.json"))
     got = weilgen.identify("vmc_3axis", quiet=True, data=POINTS, predict=[BALLBAR, POINTS],
-                           emit_params=str(tmp_path / "module.hpp"))
+                           emit_params=str(tmp_path / "module.hpp"),
+                           emit_params_json=tmp_path / "module.json")
     same_document(got, want)
     assert got["rank"] == 46
     assert (tmp_path / "module.hpp").read_text() == (tmp_path / "cli.hpp").read_text()
+    # The parameters a controller loads at run time (docs/controllers.md, params_file).
+    assert (tmp_path / "module.json").read_text() == (tmp_path / "cli_params.json").read_text()
+    params = json.loads((tmp_path / "module.json").read_text())
+    assert params["machine"] == "vmc_3axis" and params["weilgen_params"] == 1
     want = cli.json("identify", "vmc_3axis", "-q", "--data", POINTS, "--pdge", "E_XX=fourier:2",
                     "--fix", "E_C0Y")
     same_document(weilgen.identify("vmc_3axis", quiet=True, data=POINTS,
@@ -152,3 +161,62 @@ def test_compensation_tables_equal_cli(cli, tmp_path):
     weilgen.identify("vmc_3axis", quiet=True, data=POINTS, comp_table=tmp_path / "module_x.tbl",
                      axis="X", comp_points=11, comp_at={"Y": -200, "Z": -150}, comp_type=1)
     assert (tmp_path / "module_x.tbl").read_text() == (tmp_path / "cli_x.tbl").read_text()
+
+
+CARTO = source("examples", "data", "carto_x.csv")
+
+
+def test_iso230_2_every_flag_equals_cli(cli, tmp_path):
+    """Issue 30, row 1: the instrument reader (a CARTO export), the normalisation to 20 degC,
+    air compensation, tolerances, the HTML report and the CSV, as the CLI's flags."""
+    args = ["--expansion", "11.5", "--material-temperature", "T_material_1,T_material_2",
+            "--tolerance", "10,A=12,R=6", "--datum", "0", "--format", "carto"]
+    want = cli.json("iso230-2", CARTO, *args, "--csv", str(tmp_path / "cli.csv"), "--report",
+                    str(tmp_path / "cli.html"))
+    got = weilgen.iso230_2(CARTO, expansion=11.5, material_temperature="T_material_1,T_material_2",
+                           tolerance="10,A=12,R=6", datum=0, format="carto",
+                           csv=tmp_path / "module.csv", report=tmp_path / "module.html")
+    same_document(got, want)
+    assert got["source_format"] == "carto"
+    assert [c["name"] for c in got["tolerance"]["checks"]] == ["band", "A", "R"]
+    assert got["normalisation"]["material"]["expansion_ppm_per_K"] == 11.5
+    assert (tmp_path / "module.csv").read_text() == (tmp_path / "cli.csv").read_text()
+    assert (tmp_path / "module.html").read_text() == (tmp_path / "cli.html").read_text()
+    # The air: the index from the recorded air (Edlen) with an assumed index and wavelength, forced
+    # over the file's statement that the instrument compensated it.
+    air = ["--normalise", "force", "--air-compensation", "edlen", "--air-temperature", "20.5", "--air-pressure",
+           "1009.5 hPa", "--air-humidity", "45", "--wavelength", "632.991",
+           "--air-index-assumed", "1.00027"]
+    want = cli.json("iso230-2", CARTO, *air)
+    got = weilgen.iso230_2(CARTO, normalise="force", air_compensation="edlen", air_temperature=20.5,
+                           air_pressure="1009.5 hPa", air_humidity=45, wavelength=632.991,
+                           air_index_assumed=1.00027)
+    same_document(got, want)
+
+
+def test_csv_and_plot_where_the_cli_has_them(cli, tmp_path):
+    """Issue 30, row 2: csv on fit_pdge, identify and gap; plot on identify."""
+    line = source("examples", "data", "line6d_x.csv")
+    cli.json("fit-pdge", line, "--csv", str(tmp_path / "cli_fit.csv"))
+    weilgen.fit_pdge(line, csv=tmp_path / "fit.csv")
+    assert (tmp_path / "fit.csv").read_text() == (tmp_path / "cli_fit.csv").read_text()
+    cli.json("identify", "vmc_3axis", "-q", "--data", POINTS, "--csv", str(tmp_path / "cli_id.csv"),
+             "--plot", str(tmp_path / "cli_id.svg"))
+    weilgen.identify("vmc_3axis", data=POINTS, quiet=True, csv=tmp_path / "id.csv",
+                     plot=tmp_path / "id.svg")
+    assert (tmp_path / "id.csv").read_text() == (tmp_path / "cli_id.csv").read_text()
+    assert (tmp_path / "id.svg").read_text().startswith("<?xml")
+    cli.json("gap", "vmc_3axis", "-q", "--data", POINTS, "--csv", str(tmp_path / "cli_gap.csv"))
+    weilgen.gap("vmc_3axis", data=POINTS, quiet=True, csv=tmp_path / "gap.csv")
+    assert (tmp_path / "gap.csv").read_text() == (tmp_path / "cli_gap.csv").read_text()
+
+
+def test_generate_equals_cli(cli, tmp_path):
+    r = cli.run("generate", "two_axis", "--out", str(tmp_path / "cli"))
+    assert r.returncode == 0, r.stderr
+    doc = weilgen.generate("two_axis", out=tmp_path / "module")
+    assert doc["verb"] == "generate" and len(doc["written"]) == 2
+    for path in doc["written"]:
+        name = os.path.basename(path)
+        assert open(path).read() == (tmp_path / "cli" / name).read_text()
+    assert weilgen.generate("two_axis", out=tmp_path / "module", check=True)["stale"] == []

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "effects.hpp"
+#include "weilgen/base/parallel.hpp"
 #include "weilgen/base/text.hpp"
 #include "weilgen/machine/iso_names.hpp"
 #include "weilgen/machine/pdge_basis.hpp"
@@ -26,6 +27,10 @@ std::array<double, 6> exact(const NumericChain& chain, const std::vector<double>
 }
 
 namespace {
+
+void to_measured(std::array<double, 6>& v) {
+  for (std::size_t o = 0; o < 6; ++o) v[o] *= kMeasuredScale[o];
+}
 
 // The higher_order refit (Levenberg-Marquardt): at most this many Jacobians; the damping λ on
 // equilibrated columns starts here, shrinks ×10 on success down to the floor and grows ×10 on
@@ -83,6 +88,15 @@ std::vector<double> higher_order_refit(const EffectContext& ctx,
     for (std::size_t p = 0; p < np; ++p) theta[p] = t[static_cast<Index>(p)];
   }
   std::vector<double> err(ne), jac(np);
+  // The nominal tool frame of every training pose, computed once for all the chain evaluations
+  // there.
+  std::vector<Eigen::Matrix4d> nominal(d.points.poses.size());
+  {
+    std::size_t row = SIZE_MAX;
+    for (std::size_t i : train)
+      if (obs[i].row != row)
+        row = obs[i].row, nominal[row] = ctx.chain->nominal(d.points.poses[row]);
+  }
   auto residual = [&](const std::vector<double>& t) {
     VectorXd r(m);
     std::size_t row = SIZE_MAX;
@@ -92,7 +106,8 @@ std::vector<double> higher_order_refit(const EffectContext& ctx,
       if (ob.row != row) {
         row = ob.row;
         param.errors_at(d.points.poses[row].data(), t.data(), err.data());
-        f = exact(*ctx.chain, d.points.poses[row], err);
+        f = ctx.chain->deviation(d.points.poses[row], err, nominal[row]);
+        to_measured(f);
       }
       r[i] = target[i] - observe(ob, f);
     }
@@ -100,9 +115,16 @@ std::vector<double> higher_order_refit(const EffectContext& ctx,
   };
   VectorXd r = residual(theta);
   std::vector<std::array<double, 6>> g(ne);  // ∂deviation/∂error at one pose (µm per base unit)
-  std::vector<char> fitted(ne, 0);           // errors that some parameter moves
-  for (const IdentParameter& ip : param.parameters())
-    fitted[static_cast<std::size_t>(ip.error)] = 1;
+  // Forward differences over 1 declared unit of every error some parameter moves (half the
+  // chain evaluations of central ones): their error, h/2 of a second derivative, slows the
+  // steps, not the fit, whose residual is exact.
+  std::vector<double> steps(ne, 0.0);
+  for (const IdentParameter& ip : param.parameters()) {
+    const auto k = static_cast<std::size_t>(ip.error);
+    steps[k] = desc.errors[k].to_base;
+  }
+  std::array<double, 6> f0{};
+  std::vector<std::array<double, 6>> stepped;
   double lambda = kInitialDamping;
   for (int it = 0; it < kHigherOrderIterations; ++it) {
     MatrixXd J(m, static_cast<Index>(np));
@@ -114,17 +136,12 @@ std::vector<double> higher_order_refit(const EffectContext& ctx,
         const std::vector<double>& q = d.points.poses[row];
         param.errors_at(q.data(), theta.data(), err.data());
         param.derivatives(q.data(), jac.data());
-        // Forward differences over 1 declared unit (half the chain evaluations of central
-        // ones): their error, h/2 of a second derivative, slows the steps, not the fit, whose
-        // residual is exact.
-        const auto f0 = exact(*ctx.chain, q, err);
+        ctx.chain->deviation_steps(q, err, steps, nominal[row], f0, stepped);
+        to_measured(f0);
         for (std::size_t k = 0; k < ne; ++k) {
-          if (!fitted[k]) continue;
-          const double e0 = err[k], h = desc.errors[k].to_base;
-          err[k] = e0 + h;
-          const auto p = exact(*ctx.chain, q, err);
-          err[k] = e0;
-          for (std::size_t o = 0; o < 6; ++o) g[k][o] = (p[o] - f0[o]) / h;
+          if (steps[k] == 0) continue;
+          to_measured(stepped[k]);
+          for (std::size_t o = 0; o < 6; ++o) g[k][o] = (stepped[k][o] - f0[o]) / steps[k];
         }
       }
       for (std::size_t p = 0; p < np; ++p)
@@ -196,7 +213,7 @@ void add_higher_order(const EffectContext& ctx, std::vector<Candidate>& out) {
   c.describe = [](const Variant&, const VectorXd& coef, EffectFit& fit) {
     fit.params["scale"] = coef[0];
     fit.summary = "second- and higher-order products of the identified errors (scale " +
-                  num(coef[0], 3) +
+                  format_short(coef[0], 3) +
                   " of the exact kinematics' nonlinear part; regenerate at "
                   "algebra order 2)";
   };
@@ -251,54 +268,64 @@ void add_missing_error(const EffectContext& ctx, std::vector<Candidate>& out) {
   };
   auto missing = std::make_shared<std::vector<Missing>>();
   const std::vector<int> axes = desc.axes();
+  // The candidate errors (body, name) in a fixed order; then each one's column in parallel.
+  std::vector<std::pair<std::size_t, std::string>> names;
   for (std::size_t b = 0; b < desc.bodies.size(); ++b) {
     const Joint& j = desc.bodies[b].joint;
     if (j.type == JointType::Fixed || j.link || !iso_not_applicable(j).empty()) continue;
-    std::vector<std::string> names = iso_motion_errors(j);
+    std::vector<std::string> ns = iso_motion_errors(j);
     for (const char* k : {"X", "Y", "Z", "A", "B", "C"})  // squareness and location errors
-      names.push_back(std::string("E_") + k + "0" + j.coordinate);
-    std::sort(names.begin(), names.end());
-    names.erase(std::unique(names.begin(), names.end()), names.end());
-    for (const std::string& n : names) {
-      if (desc.error_index(n) >= 0) continue;
-      const IsoMatch m = match_iso_name(j, n);
-      if (m.status != IsoMatch::Status::Fits) continue;
-      Description aug = desc;
-      ErrorDef e;
-      e.name = e.iso = n;
-      e.effect = m.error.effect;
-      e.direction = m.error.direction;
-      e.group = m.error.group;
-      e.placement = m.error.placement;
-      e.dependence = m.error.dependence;
-      e.unit = m.error.unit;
-      e.to_base = e.effect == ErrorEffect::Rotation ? 1e-6 : 1e-3;  // µrad, µm
-      e.body = static_cast<int>(b);
-      aug.errors.push_back(e);
-      aug.bodies[b].errors.push_back(static_cast<int>(aug.errors.size() - 1));
-      NumericChain chain(aug);
-      chain.set_parameters(ctx.model->parameters());
-      const auto& obs = d.points.observations;
-      const bool pdge = e.dependence == Dependence::PDGE && j.max > j.min;
-      Missing mi{n, j.coordinate, pdge, pdge ? missing_error_basis(desc, *ctx.param, j) : Basis{},
-                 MatrixXd(static_cast<Index>(obs.size()), 1)};
-      std::vector<double> err(aug.errors.size(), 0.0);
-      std::size_t row = SIZE_MAX;
-      std::array<double, 6> g{};
-      for (std::size_t i = 0; i < obs.size(); ++i) {
-        if (obs[i].row != row) {
-          row = obs[i].row;
-          err.back() = e.to_base;  // 1 µm or µrad: central differences, third order ~1e-12
-          const auto p = exact(chain, d.points.poses[row], err);
-          err.back() = -e.to_base;
-          const auto m2 = exact(chain, d.points.poses[row], err);
-          for (std::size_t o = 0; o < 6; ++o) g[o] = (p[o] - m2[o]) / 2;
-        }
-        mi.unit(static_cast<Index>(i), 0) = observe(obs[i], g);
-      }
-      if (mi.unit.norm() > 0) missing->push_back(std::move(mi));
-    }
+      ns.push_back(std::string("E_") + k + "0" + j.coordinate);
+    std::sort(ns.begin(), ns.end());
+    ns.erase(std::unique(ns.begin(), ns.end()), ns.end());
+    for (const std::string& n : ns)
+      if (desc.error_index(n) < 0 && match_iso_name(j, n).status == IsoMatch::Status::Fits)
+        names.emplace_back(b, n);
   }
+  std::vector<std::optional<Missing>> found(names.size());
+  parallel_blocks(
+      names.size(), 1, ctx.threads, [&](std::size_t t, std::size_t, std::size_t, unsigned) {
+        const std::size_t b = names[t].first;
+        const std::string& n = names[t].second;
+        const Joint& j = desc.bodies[b].joint;
+        const IsoMatch m = match_iso_name(j, n);
+        Description aug = desc;
+        ErrorDef e;
+        e.name = e.iso = n;
+        e.effect = m.error.effect;
+        e.direction = m.error.direction;
+        e.group = m.error.group;
+        e.placement = m.error.placement;
+        e.dependence = m.error.dependence;
+        e.unit = m.error.unit;
+        e.to_base = e.effect == ErrorEffect::Rotation ? 1e-6 : 1e-3;  // µrad, µm
+        e.body = static_cast<int>(b);
+        aug.errors.push_back(e);
+        aug.bodies[b].errors.push_back(static_cast<int>(aug.errors.size() - 1));
+        NumericChain chain(aug);
+        chain.set_parameters(ctx.model->parameters());
+        const auto& obs = d.points.observations;
+        const bool pdge = e.dependence == Dependence::PDGE && j.max > j.min;
+        Missing mi{n, j.coordinate, pdge, pdge ? missing_error_basis(desc, *ctx.param, j) : Basis{},
+                   MatrixXd(static_cast<Index>(obs.size()), 1)};
+        std::vector<double> err(aug.errors.size(), 0.0);
+        std::size_t row = SIZE_MAX;
+        std::array<double, 6> g{};
+        for (std::size_t i = 0; i < obs.size(); ++i) {
+          if (obs[i].row != row) {
+            row = obs[i].row;
+            err.back() = e.to_base;  // 1 µm or µrad: central differences, third order ~1e-12
+            const auto p = exact(chain, d.points.poses[row], err);
+            err.back() = -e.to_base;
+            const auto m2 = exact(chain, d.points.poses[row], err);
+            for (std::size_t o = 0; o < 6; ++o) g[o] = (p[o] - m2[o]) / 2;
+          }
+          mi.unit(static_cast<Index>(i), 0) = observe(obs[i], g);
+        }
+        if (mi.unit.norm() > 0) found[t] = std::move(mi);
+      });
+  for (auto& f : found)
+    if (f) missing->push_back(std::move(*f));
   if (missing->empty()) return;
   Candidate c;
   c.name = "missing_error";
@@ -357,7 +384,8 @@ void add_missing_error(const EffectContext& ctx, std::vector<Candidate>& out) {
                     "file)";
     } else if (!mi.pdge) {
       fit.params[mi.name] = coef[0];
-      fit.summary = mi.name + " = " + num(coef[0], 3) + " " + unit + " (not in the machine file)";
+      fit.summary =
+          mi.name + " = " + format_short(coef[0], 3) + " " + unit + " (not in the machine file)";
     } else {
       // Over the positions measured, not the whole travel: the data say nothing beyond them.
       std::size_t a = 0;
@@ -370,8 +398,9 @@ void add_missing_error(const EffectContext& ctx, std::vector<Candidate>& out) {
       for (int k = 0; k <= 40; ++k)
         peak = std::max(peak, std::abs(mi.basis.value(coef.data(), lo + (hi - lo) * k / 40.0)));
       fit.params[mi.name + "_peak"] = peak;
-      fit.summary = mi.name + "(" + mi.coordinate + ") up to " + num(peak, 3) + " " + unit +
-                    " over the measured " + mi.coordinate + " " + num(lo, 4) + " .. " + num(hi, 4) +
+      fit.summary = mi.name + "(" + mi.coordinate + ") up to " + format_short(peak, 3) + " " +
+                    unit + " over the measured " + mi.coordinate + " " + format_short(lo, 4) +
+                    " .. " + format_short(hi, 4) +
                     (a < d.axis_units.size() ? " " + d.axis_units[a] : "") + " (" +
                     mi.basis.name() + "; " + absorbed + "not in the machine file)";
     }
@@ -425,14 +454,14 @@ void add_tool_offset(const EffectContext& ctx, std::vector<Candidate>& out) {
   c.describe = [pname, base](const Variant&, const VectorXd& coef, EffectFit& fit) {
     fit.params["offset_mm"] = coef[0];
     fit.params[pname + "_mm"] = base + coef[0];
-    fit.summary = "tool offset " + num(coef[0], 3) + " mm (" + pname + " " + num(base, 4) + " -> " +
-                  num(base + coef[0], 4) + " mm)";
+    fit.summary = "tool offset " + format_short(coef[0], 3) + " mm (" + pname + " " +
+                  format_short(base, 4) + " -> " + format_short(base + coef[0], 4) + " mm)";
     // The column is nearly in the model's span on a machine whose rotations are only its small
     // angular errors: then a tiny remainder, scaled up hundreds of metres, fits whatever shape
     // is left (a step). No tool set-up error is that large.
     if (!(std::abs(coef[0]) <= kMaxToolOffsetMm)) {
       fit.distinguishable = false;
-      fit.indistinct_reason = "its size (" + num(coef[0], 3) +
+      fit.indistinct_reason = "its size (" + format_short(coef[0], 3) +
                               " mm) is no tool's: a remainder of " +
                               "the column outside the model's errors imitates the gap";
     }

@@ -101,7 +101,7 @@ void add_reversal(const EffectContext& ctx, std::vector<Candidate>& out) {
       const std::string u = index[k] < d.axis_units.size() ? d.axis_units[index[k]] : "mm";
       const bool rotary = u == "deg" || u == "rad";
       const double b = static_cast<Index>(col) < coef.size() ? coef[static_cast<Index>(col)] : 0;
-      fit.summary += (col ? ", " : "reversal of ") + axis + ": " + num(std::abs(b), 2) +
+      fit.summary += (col ? ", " : "reversal of ") + axis + ": " + format_short(std::abs(b), 2) +
                      (rotary ? " µrad" : " µm");
       // One axis: reversal_um; several: reversal_um_<axis> each.
       fit.params[std::string(rotary ? "reversal_urad" : "reversal_um") +

@@ -45,14 +45,15 @@ void add_setup(const EffectContext& ctx, std::vector<Candidate>& out) {
       fit.params["length_um"] = coef[0];
       const double r = d.circle ? d.circle->radius_mm : 0;
       if (r > 0) fit.params["scale_ppm"] = coef[0] / r * 1000;
-      fit.summary = "ballbar length " + num(coef[0], 3) + " µm" +
-                    (r > 0 ? " (" + num(coef[0] / r * 1000, 3) + " µm/m of the radius)" : "");
+      fit.summary =
+          "ballbar length " + format_short(coef[0], 3) + " µm" +
+          (r > 0 ? " (" + format_short(coef[0] / r * 1000, 3) + " µm/m of the radius)" : "");
       return;
     }
     fit.params["scale_ppm"] = coef[0];
     fit.params["quadratic_um_per_m2"] = coef[1];
-    fit.summary = "measuring set-up: scale " + num(coef[0], 3) + " µm/m (ppm) in " + v.label +
-                  ", quadratic " + num(coef[1], 3) + " µm/m²";
+    fit.summary = "measuring set-up: scale " + format_short(coef[0], 3) + " µm/m (ppm) in " +
+                  v.label + ", quadratic " + format_short(coef[1], 3) + " µm/m²";
   };
   out.push_back(std::move(c));
 }

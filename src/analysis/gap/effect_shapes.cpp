@@ -109,8 +109,8 @@ void add_periodic(const EffectContext& ctx, std::vector<Candidate>& out) {
     fit.params["period_" + au] = v.hyper[1];
     fit.params["amplitude_" + eu] = amp;
     describe_error(ae, fit);
-    fit.summary = "periodic " + error_of(ae) + ": period " + num(v.hyper[1], 3) + " " + au + ", " +
-                  num(amp, 2) + (ae.rotation ? " µrad" : " µm");
+    fit.summary = "periodic " + error_of(ae) + ": period " + format_short(v.hyper[1], 3) + " " +
+                  au + ", " + format_short(amp, 2) + (ae.rotation ? " µrad" : " µm");
     fit.region = shape_region(ae, ae.axis.levels.front(), ae.axis.levels.back());
   };
   out.push_back(std::move(c));
@@ -165,8 +165,8 @@ void add_pdge_shape(const EffectContext& ctx, std::vector<Candidate>& out) {
     const char* eus = ae.rotation ? " µrad" : " µm";
     describe_error(ae, fit);
     if (v.hyper[1] == 1) {
-      fit.summary = "more shape of " + error_of(ae) + ": u^4 " + num(coef[0], 2) + ", u^5 " +
-                    num(coef[1], 2) + eus;
+      fit.summary = "more shape of " + error_of(ae) + ": u^4 " + format_short(coef[0], 2) +
+                    ", u^5 " + format_short(coef[1], 2) + eus;
       fit.region = shape_region(ae, ae.axis.levels.front(), ae.axis.levels.back());
       return;
     }
@@ -174,8 +174,9 @@ void add_pdge_shape(const EffectContext& ctx, std::vector<Candidate>& out) {
     fit.params["centre_" + au] = centre;
     fit.params["width_" + au] = width;
     fit.params["amplitude_" + eu] = coef[0];
-    fit.summary = "bump of " + error_of(ae) + ": " + num(coef[0], 2) + eus + " at " + ae.axis.name +
-                  " = " + num(centre, 4) + " " + au + " (width " + num(width, 3) + " " + au + ")";
+    fit.summary = "bump of " + error_of(ae) + ": " + format_short(coef[0], 2) + eus + " at " +
+                  ae.axis.name + " = " + format_short(centre, 4) + " " + au + " (width " +
+                  format_short(width, 3) + " " + au + ")";
     fit.region = shape_region(ae, centre - 2 * width, centre + 2 * width);
     // A bump is resolved when at least 3 sample positions carry a tenth of its height or
     // more (|q - c| < 2.15 w); over one or two it is a step or a single position's offset.

@@ -218,7 +218,7 @@ void add_thermal(const EffectContext& ctx, std::vector<Candidate>& out) {
     for (std::size_t k = 0; k < cols.labels.size() && static_cast<Index>(k) < coef.size(); ++k) {
       const std::string& l = cols.labels[k];
       const double x = coef[static_cast<Index>(k)];
-      const std::string sx = (x >= 0 ? "+" : "") + num(x, 2);
+      const std::string sx = (x >= 0 ? "+" : "") + format_short(x, 2);
       if (l.rfind("scale_", 0) == 0) {
         fit.params[l + "_um_per_m" + per] = x;
         scale += (scale.empty() ? "" : ", ") + std::string("scale of ") + l.substr(6) + " " + sx +
@@ -236,12 +236,12 @@ void add_thermal(const EffectContext& ctx, std::vector<Candidate>& out) {
       what = "drift in time";
     } else if (kind == 1) {
       fit.params["tau_h"] = v.hyper[1] / 3600;
-      what = "heat-up (tau " + num(v.hyper[1] / 3600, 2) + " h)";
+      what = "heat-up (tau " + format_short(v.hyper[1] / 3600, 2) + " h)";
     } else {
       const std::string& s = tc->sensors[static_cast<std::size_t>(v.hyper[2])];
       fit.params["sensor_" + s] = 1;
       fit.params["lag_h"] = v.hyper[1] / 3600;
-      what = s + (v.hyper[1] > 0 ? " (lag " + num(v.hyper[1] / 3600, 2) + " h)" : "");
+      what = s + (v.hyper[1] > 0 ? " (lag " + format_short(v.hyper[1] / 3600, 2) + " h)" : "");
     }
     fit.summary =
         "thermal, " + what + (frame == Frame::Tool ? ", tool side: " : ", machine frame: ") +

@@ -81,7 +81,8 @@ void add_thermal_sensors(const EffectContext& ctx, std::vector<Candidate>& out) 
   auto summary = std::make_shared<RidgeSummary>();
   for (const std::string& n : in->names)
     for (double lag : in->lags_s)
-      summary->features.push_back(n + (lag > 0 ? " lag " + num(lag / 3600, 2) + " h" : ""));
+      summary->features.push_back(n +
+                                  (lag > 0 ? " lag " + format_short(lag / 3600, 2) + " h" : ""));
 
   Candidate c;
   c.name = "thermal_drift";
@@ -162,7 +163,7 @@ void add_thermal_sensors(const EffectContext& ctx, std::vector<Candidate>& out) 
     for (std::size_t k = 0; k < outs.size(); ++k) {
       const std::string o = output_name(static_cast<std::size_t>(outs[k]));
       if (k < static_cast<std::size_t>(coef.size()))
-        per_output += (per_output.empty() ? "" : ", ") + o + " x" + num(coef[Index(k)], 3);
+        per_output += (per_output.empty() ? "" : ", ") + o + " x" + format_short(coef[Index(k)], 3);
       if (summary->lambda.count(outs[k])) fit.params["lambda_" + o] = summary->lambda[outs[k]];
       for (std::size_t f = 0; f < weight.size() && summary->weights.count(outs[k]); ++f)
         weight[f] += std::abs(summary->weights[outs[k]][f]);

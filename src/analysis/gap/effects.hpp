@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "internal.hpp"
+#include "weilgen/base/format.hpp"
 #include "weilgen/model/numeric_chain.hpp"
 
 namespace weilgen::gap_detail {
@@ -30,6 +31,9 @@ struct EffectContext {
   // The axes' motion errors with their sensitivities (axis_errors(ctx, 6)), shared by the shape
   // effects; computed on first use.
   mutable std::shared_ptr<const std::vector<AxisError>> shaped_errors;
+  // axis_jacobians(ctx), shared by the reversal and thermal effects; computed on first use.
+  mutable std::shared_ptr<const std::vector<Eigen::MatrixXd>> jacobians;
+  unsigned threads = 1;  // for the loops over poses and candidate errors (GapOptions::threads)
 };
 
 struct Variant {
@@ -88,9 +92,12 @@ struct Candidate {
   bool determined_part = false;
 };
 
-// The library's candidates that apply to the data (e.g. reversal needs a direction column).
+// The library's candidates that apply to the data (e.g. reversal needs a direction column);
+// the library is the table in effects.cpp.
 std::vector<Candidate> effect_candidates(const EffectContext& ctx,
                                          const std::vector<std::string>& names);
+// Whether the greedy search may accept the effect again (a second sensor or lag).
+bool effect_repeatable(const std::string& name);
 
 // One family of the library each (effect_*.cpp): appends its candidate, if the data allow it.
 void add_thermal(const EffectContext& ctx, std::vector<Candidate>& out);
@@ -106,12 +113,6 @@ void add_setup(const EffectContext& ctx, std::vector<Candidate>& out);
 // ---- Helpers of the effect files --------------------------------------------------------
 
 inline const char* unit_of(int o) { return observation_unit(static_cast<std::size_t>(o)); }
-
-inline std::string num(double v, int digits = 3) {
-  char b[48];
-  std::snprintf(b, sizeof b, "%.*g", digits, v);
-  return b;
-}
 
 // The deviation outputs (0..5) the observations see: their own, and for ballbar dr the
 // in-plane directions.
@@ -145,7 +146,7 @@ inline std::string per_output_text(const std::vector<int>& outs, const VectorXd&
   for (std::size_t k = 0; k < outs.size(); ++k) {
     const double v = c[static_cast<Index>(k)] * scale;
     s += (s.empty() ? "" : ", ") + std::string(output_name(static_cast<std::size_t>(outs[k]))) +
-         " " + (v >= 0 ? "+" : "") + num(v, 2) + " " + unit_of(outs[k]) + unit_suffix;
+         " " + (v >= 0 ? "+" : "") + format_short(v, 2) + " " + unit_of(outs[k]) + unit_suffix;
     fit.params[key + "_" + output_name(static_cast<std::size_t>(outs[k]))] = v;
   }
   return s;

@@ -93,6 +93,7 @@ std::shared_ptr<const BlockFactors> factor_blocks(
     unsigned threads) {
   auto F = std::make_shared<BlockFactors>();
   F->cols = A.cols();
+  F->threads = threads;
   for (std::size_t j = 0; j < parts.size(); ++j) {
     const std::size_t n = parts[j].size();
     const std::size_t pieces = std::max<std::size_t>(1, (n + kBlockRows - 1) / kBlockRows);
@@ -158,12 +159,12 @@ FoldFit fit_split(const BlockFactors& F, const MatrixXd& A, const VectorXd& y, c
   return f;
 }
 
-FoldFit fit_fold(const MatrixXd& A, const VectorXd& y, const Split& s, unsigned threads) {
+FoldFit fit_all_rows(const MatrixXd& A, const VectorXd& y, const Split& s, unsigned threads) {
   const auto F = factor_blocks(A, y, {s.train}, threads);
   return fit_split(*F, A, y, s, /*train_leverage=*/true);
 }
 
-void Engine::fit_full() {
+void DesignLeastSquares::fit_full() {
   const std::size_t n = static_cast<std::size_t>(y.size());
   factors = factor_blocks(A, y, {all_rows(n).train}, threads);
   full = fit_split(*factors, A, y, all_rows(n));
@@ -171,7 +172,7 @@ void Engine::fit_full() {
   full_rank = full.rank;
 }
 
-void Engine::fit_folds() {
+void DesignLeastSquares::fit_folds() {
   const std::size_t n = static_cast<std::size_t>(y.size());
   factors = factor_blocks(A, y, split_parts(splits, n), threads);
   folds.assign(splits.size(), FoldFit{});
@@ -367,21 +368,23 @@ void joint_system(const BlockFactors& F, const VectorXd* y, const MatrixXd& E, M
   N = MatrixXd::Zero(k + q, p + q);
   VectorXd ys(y ? n : 0);
   z = VectorXd::Zero(k + q);
-  Index at = 0, row = 0;
-  for (std::size_t b = 0; b < nb; ++b) {
+  // Every block fills its own rows of N, z, rest and ys: in parallel, the same numbers.
+  std::vector<Index> at(nb + 1, 0), row(nb + 1, 0);
+  for (std::size_t b = 0; b < nb; ++b)
+    at[b + 1] = at[b] + F.R[b].rows(), row[b + 1] = row[b] + F.Q[b].rows();
+  parallel_blocks(nb, 1, F.threads, [&](std::size_t b, std::size_t, std::size_t, unsigned) {
     const Index kb = F.R[b].rows(), m = F.Q[b].rows();
     MatrixXd Eb = rows_of(E, F.rows[b]);
     const MatrixXd G = F.Q[b].transpose() * Eb;
     Eb.noalias() -= F.Q[b] * G;
     const MatrixXd G2 = F.Q[b].transpose() * Eb;
     Eb.noalias() -= F.Q[b] * G2;
-    N.block(at, 0, kb, p) = F.R[b];
-    N.block(at, p, kb, q) = G + G2;
-    z.segment(at, kb) = F.qty[b];
-    rest.middleRows(row, m) = Eb;
-    if (y) ys.segment(row, m) = rows_of(*y, F.rows[b]);
-    at += kb, row += m;
-  }
+    N.block(at[b], 0, kb, p) = F.R[b];
+    N.block(at[b], p, kb, q) = G + G2;
+    z.segment(at[b], kb) = F.qty[b];
+    rest.middleRows(row[b], m) = Eb;
+    if (y) ys.segment(row[b], m) = rows_of(*y, F.rows[b]);
+  });
   if (q > 0 && n > 0) {
     Eigen::HouseholderQR<MatrixXd> qr(rest);
     const Index m = std::min(n, q);

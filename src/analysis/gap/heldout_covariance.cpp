@@ -8,7 +8,7 @@
 
 namespace weilgen::gap_detail {
 
-HeldoutCovariance::HeldoutCovariance(const Engine& e, bool estimable) : e_(&e) {
+HeldoutCovariance::HeldoutCovariance(const DesignLeastSquares& e, bool estimable) : e_(&e) {
   const std::size_t n = static_cast<std::size_t>(e.y.size());
   const std::size_t K = e.splits.size();
   split_.assign(n, -1);

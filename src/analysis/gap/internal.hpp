@@ -36,6 +36,7 @@ struct BlockFactors {
   std::vector<MatrixXd> Q, R;
   std::vector<VectorXd> qty;  // Q_bᵀ y_b
   Index cols = 0;             // p
+  unsigned threads = 1;       // for the loops over the blocks (factor_blocks' `threads`)
 };
 
 // Factors A (rows × p) in blocks: each part of `parts` (observation indices) is cut into
@@ -66,7 +67,7 @@ FoldFit fit_split(const BlockFactors& F, const MatrixXd& A, const VectorXd& y, c
 
 // One fit on all rows (gross readings): factored in blocks on `threads` cores; with the
 // leverage of every row.
-FoldFit fit_fold(const MatrixXd& A, const VectorXd& y, const Split& s, unsigned threads = 1);
+FoldFit fit_all_rows(const MatrixXd& A, const VectorXd& y, const Split& s, unsigned threads = 1);
 
 inline MatrixXd rows_of(const MatrixXd& M, const std::vector<std::size_t>& idx) {
   MatrixXd R(static_cast<Index>(idx.size()), M.cols());
@@ -89,9 +90,12 @@ inline Split all_rows(std::size_t n) {
   return s;
 }
 
-class Engine {
+// The least-squares system over the design: A (the model's coefficient columns, plus the
+// accepted effects' columns) against the measured values y, fitted on all rows and on every
+// split, factored once in the splits' blocks.
+class DesignLeastSquares {
  public:
-  Engine(const GapData& d, MatrixXd design, VectorXd values, unsigned threads_)
+  DesignLeastSquares(const GapData& d, MatrixXd design, VectorXd values, unsigned threads_)
       : data(d), A(std::move(design)), y(std::move(values)), threads(threads_) {}
   const GapData& data;
   MatrixXd A;  // baseline (plus accepted effects)
@@ -109,7 +113,6 @@ class Engine {
   // Factors A in the splits' blocks and fits every split (and all data again, from the same
   // factors) in parallel.
   void fit_folds();
-  void refit() { fit_folds(); }
   // Held-out residual and leverage per observation.
   void heldout(VectorXd& r, VectorXd& h) const {
     r = VectorXd::Constant(y.size(), kNaN);
@@ -142,7 +145,7 @@ class Engine {
 inline constexpr double kEstimableCut = 1e-6;
 class HeldoutCovariance {
  public:
-  explicit HeldoutCovariance(const Engine& e, bool estimable = false);
+  explicit HeldoutCovariance(const DesignLeastSquares& e, bool estimable = false);
   // Replaces the held-out residual `r` by M r (split by split) and sets `h` so that
   // c(k, k) = 1 + h_k; `removed`: the directions taken out over all splits (the degrees of
   // freedom the gap test loses). Without `estimable`, M = I.
@@ -163,7 +166,7 @@ class HeldoutCovariance {
 
  private:
   double cross(std::size_t k, std::size_t l) const;
-  const Engine* e_;
+  const DesignLeastSquares* e_;
   std::vector<int> split_;        // the split holding each observation out (-1: none)
   std::vector<std::size_t> pos_;  // its row in that split's test part
   // The held-out row of k (M_f A_test's with `estimable`).

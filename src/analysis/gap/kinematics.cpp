@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "effects.hpp"
+#include "weilgen/base/parallel.hpp"
 #include "weilgen/machine/iso_names.hpp"
 
 namespace weilgen::gap_detail {
@@ -24,15 +25,20 @@ std::vector<char> rows_needed(const GapData& d) {
 }  // namespace
 
 std::vector<Eigen::MatrixXd> axis_jacobians(const EffectContext& ctx) {
-  const GapData& d = *ctx.data;
-  const NumericChain& chain = *ctx.chain;
-  std::vector<Eigen::MatrixXd> J(d.points.poses.size());
-  const std::vector<char> needed = rows_needed(d);
-  for (std::size_t r = 0; r < J.size(); ++r) {
-    if (!needed[r]) continue;
-    J[r] = chain.nominal_jacobian(d.points.poses[r]);  // 6 x axes, per axis unit
+  if (!ctx.jacobians) {
+    const GapData& d = *ctx.data;
+    const NumericChain& chain = *ctx.chain;
+    auto J = std::make_shared<std::vector<Eigen::MatrixXd>>(d.points.poses.size());
+    const std::vector<char> needed = rows_needed(d);
+    parallel_blocks(J->size(), 64, ctx.threads,
+                    [&](std::size_t, std::size_t begin, std::size_t end, unsigned) {
+                      for (std::size_t r = begin; r < end; ++r)
+                        if (needed[r])  // 6 x axes, per axis unit
+                          (*J)[r] = chain.nominal_jacobian(d.points.poses[r]);
+                    });
+    ctx.jacobians = std::move(J);
   }
-  return J;
+  return *ctx.jacobians;
 }
 
 std::vector<Eigen::Matrix3d> frame_rotations(const EffectContext& ctx, Frame frame) {

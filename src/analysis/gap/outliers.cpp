@@ -147,7 +147,7 @@ std::vector<GapOutlier> gross_readings(const MatrixXd& A, const GapData& d, unsi
     const auto& obs = cur.points.observations;
     VectorXd y(static_cast<Index>(obs.size()));
     for (std::size_t i = 0; i < obs.size(); ++i) y[static_cast<Index>(i)] = obs[i].value;
-    const FoldFit f = fit_fold(rows_of(A, index), y, all_rows(obs.size()), threads);
+    const FoldFit f = fit_all_rows(rows_of(A, index), y, all_rows(obs.size()), threads);
     std::vector<GapOutlier> found = find_outliers(cur, f.res_train, f.lev_train);
     if (found.empty()) break;
     std::vector<std::size_t> kept;

@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 
+#include "weilgen/analysis/per_output_rms.hpp"
 #include "weilgen/base/parallel.hpp"
 
 namespace weilgen::gap_detail {
@@ -35,8 +36,8 @@ struct Score {
 // The columns of a θ-dependent variant for the fit `ff` (on the rows `train`): at its θ, then
 // (theta_iterations) at the θ of the joint fit [A E] with those columns; a candidate's own
 // nonlinear refit instead when it has one.
-MatrixXd theta_columns(const Candidate& c, const Variant& v, const Engine& e, const FoldFit& ff,
-                       std::size_t np, const std::vector<std::size_t>& train) {
+MatrixXd theta_columns(const Candidate& c, const Variant& v, const DesignLeastSquares& e,
+                       const FoldFit& ff, std::size_t np, const std::vector<std::size_t>& train) {
   if (c.refit) return c.columns(v, c.refit(train, ff.theta, e.A, e.y));
   MatrixXd E = c.columns(v, split_theta(ff.theta, np));
   for (int it = 0; it < v.theta_iterations; ++it) {
@@ -48,8 +49,13 @@ MatrixXd theta_columns(const Candidate& c, const Variant& v, const Engine& e, co
   return E;
 }
 
-Score score(const Candidate& c, const Variant& v, const ScoringContext& sc, bool want_after) {
-  const Engine& e = *sc.engine;
+// A θ-dependent variant's columns per split and, last, on all data (theta_columns), computed
+// before the candidates are evaluated (evaluate_candidates); empty: compute them when needed.
+using SplitColumns = std::vector<MatrixXd>;
+
+Score score(const Candidate& c, const Variant& v, const ScoringContext& sc, bool want_after,
+            const SplitColumns* pre = nullptr) {
+  const DesignLeastSquares& e = *sc.engine;
   Score s;
   const bool plain = is_plain(c, v);
   Projection shared, shared_exact;
@@ -65,8 +71,9 @@ Score score(const Candidate& c, const Variant& v, const ScoringContext& sc, bool
     MatrixXd E;
     Projection own, own_exact;
     if (!plain) {
-      E = c.fitted_columns ? c.fitted_columns(v, split.train, ff.res_train)
-                           : theta_columns(c, v, e, ff, sc.np, split.train);
+      E = c.fitted_columns       ? c.fitted_columns(v, split.train, ff.res_train)
+          : pre && !pre->empty() ? (*pre)[f]
+                                 : theta_columns(c, v, e, ff, sc.np, split.train);
       own = project(*e.factors, {E}, e.y);
     }
     const ExtraFit x = plain ? fit_extra(ff, shared, 0, *e.factors, s.columns, e.y, shared_exact)
@@ -88,7 +95,7 @@ Score score(const Candidate& c, const Variant& v, const ScoringContext& sc, bool
 // kBatchColumns columns at a time.
 void score_batch(const Candidate& c, std::size_t begin, std::size_t end, const ScoringContext& sc,
                  std::vector<double>& sse) {
-  const Engine& e = *sc.engine;
+  const DesignLeastSquares& e = *sc.engine;
   std::vector<MatrixXd> cols;
   Index width = 0;
   std::size_t first = begin;
@@ -114,23 +121,27 @@ void score_batch(const Candidate& c, std::size_t begin, std::size_t end, const S
 
 // One candidate: its best grid variant (`grid`: the plain variants' training SSE, already
 // scored; null: score them here), refined, then held-out before/after and the nested F test.
+// `pre`: per variant, its θ-dependent columns when already computed (SplitColumns).
 Evaluated evaluate_one(const Candidate& c, const ScoringContext& sc,
-                       const std::vector<double>* grid) {
-  const Engine& e = *sc.engine;
+                       const std::vector<double>* grid, const std::vector<SplitColumns>& pre) {
+  const DesignLeastSquares& e = *sc.engine;
   Evaluated best;
   double best_train = INFINITY;
   bool have_after = false;
   MatrixXd best_shared;
+  const SplitColumns* best_pre = nullptr;
   for (std::size_t k = 0; k < c.variants.size(); ++k) {
     Score s;
+    const SplitColumns* own = k < pre.size() ? &pre[k] : nullptr;
     if (grid) {
       s.train_sse = (*grid)[k];
     } else {
-      s = score(c, c.variants[k], sc, true);
+      s = score(c, c.variants[k], sc, true, own);
       if (!s.usable) continue;
     }
     if (!(s.train_sse < best_train)) continue;
     best_train = s.train_sse;
+    best_pre = own;
     best.variant = c.variants[k];
     if (!grid) {
       best.heldout = std::move(s.after);
@@ -168,6 +179,7 @@ Evaluated evaluate_one(const Candidate& c, const ScoringContext& sc,
     Score s = score(c, v, sc, true);
     if (s.usable && s.train_sse < best_train) {
       best_train = s.train_sse;
+      best_pre = nullptr;
       best.variant = v;
       best.heldout = std::move(s.after);
       best_shared = std::move(s.columns);
@@ -178,7 +190,7 @@ Evaluated evaluate_one(const Candidate& c, const ScoringContext& sc,
   best.regularised = c.fitted_columns || c.refit;
   if (!std::isfinite(best_train)) return best;
   if (!have_after) {
-    Score s = score(c, best.variant, sc, true);
+    Score s = score(c, best.variant, sc, true, best_pre);
     best.heldout = std::move(s.after);
     best_shared = std::move(s.columns);
   }
@@ -187,32 +199,30 @@ Evaluated evaluate_one(const Candidate& c, const ScoringContext& sc,
   best.columns = c.fitted_columns
                      ? c.fitted_columns(best.variant, all_rows(n).train, e.full.res_train)
                  : best.variant.needs_theta
-                     ? theta_columns(c, best.variant, e, e.full, sc.np, all_rows(n).train)
+                     ? (best_pre && !best_pre->empty()
+                            ? best_pre->back()
+                            : theta_columns(c, best.variant, e, e.full, sc.np, all_rows(n).train))
                      : std::move(best_shared);
   best.fit.tested_variants = static_cast<double>(c.variants.size());
   // Held-out before/after.
   const VectorXd& base_r = *sc.base_r;
   const VectorXd& base_h = *sc.base_h;
   Gap before, afterg;
-  std::array<double, kObservationKinds> sb{}, sa{};
-  std::array<std::size_t, kObservationKinds> no{};
+  PerOutputRms<kObservationKinds> rms_before, rms_after;
   const auto& obs = e.data.points.observations;
   for (Index i = 0; i < e.y.size(); ++i) {
     if (!std::isfinite(best.heldout[i])) continue;
     const auto o = static_cast<std::size_t>(obs[static_cast<std::size_t>(i)].output);
-    sb[o] += base_r[i] * base_r[i];
-    sa[o] += best.heldout[i] * best.heldout[i];
-    ++no[o];
+    rms_before.add(o, base_r[i]);
+    rms_after.add(o, best.heldout[i]);
     before.ss += base_r[i] * base_r[i];
     afterg.ss += best.heldout[i] * best.heldout[i];
     before.expected += sc.s2 * (1 + base_h[i]);
     ++before.n;
   }
   best.heldout_sse = afterg.ss;
-  for (std::size_t o = 0; o < kObservationKinds; ++o) {
-    best.fit.rms_before[o] = no[o] ? std::sqrt(sb[o] / static_cast<double>(no[o])) : kNaN;
-    best.fit.rms_after[o] = no[o] ? std::sqrt(sa[o] / static_cast<double>(no[o])) : kNaN;
-  }
+  best.fit.rms_before = rms_before.rms_per_output();
+  best.fit.rms_after = rms_after.rms_per_output();
   const double nn = static_cast<double>(before.n);
   best.fit.heldout_rms_before_um = std::sqrt(before.ss / nn);
   best.fit.heldout_rms_after_um = std::sqrt(afterg.ss / nn);
@@ -278,6 +288,39 @@ std::vector<Evaluated> evaluate_candidates(const std::vector<Candidate>& candida
                     const Batch& b = batches[t];
                     score_batch(candidates[b.candidate], b.begin, b.end, sc, grid[b.candidate]);
                   });
+  // The θ-dependent variants' columns (a nonlinear refit, or columns at the split's θ) of the
+  // candidates without refinement: one task per variant and split, so that a slow candidate's
+  // splits (higher_order's refit of the exact chain) share the cores instead of running one
+  // after the other on one of them.
+  const DesignLeastSquares& e = *sc.engine;
+  const std::size_t n = static_cast<std::size_t>(e.y.size()), ns = e.splits.size();
+  std::vector<std::vector<SplitColumns>> pre(nc);
+  struct Task {
+    std::size_t candidate, variant, split;  // split ns: all data
+  };
+  std::vector<Task> tasks;
+  for (std::size_t k = 0; k < nc; ++k) {
+    const Candidate& c = candidates[k];
+    if (used[k] || batched[k] || c.fitted_columns ||
+        std::any_of(c.variants.begin(), c.variants.end(),
+                    [](const Variant& v) { return !v.refine.empty(); }))
+      continue;
+    pre[k].resize(c.variants.size());
+    for (std::size_t v = 0; v < c.variants.size(); ++v) {
+      if (!c.variants[v].needs_theta) continue;
+      pre[k][v].resize(ns + 1);
+      for (std::size_t f = 0; f <= ns; ++f) tasks.push_back({k, v, f});
+    }
+  }
+  parallel_blocks(
+      tasks.size(), 1, sc.threads, [&](std::size_t t, std::size_t, std::size_t, unsigned) {
+        const Task& task = tasks[t];
+        const Candidate& c = candidates[task.candidate];
+        const bool all = task.split == ns;
+        pre[task.candidate][task.variant][task.split] =
+            theta_columns(c, c.variants[task.variant], e, all ? e.full : e.folds[task.split], sc.np,
+                          all ? all_rows(n).train : e.splits[task.split].train);
+      });
   // Then each candidate, the longest first (refinement, columns that depend on θ or are fitted
   // per split): the order only balances the cores.
   std::vector<std::size_t> order, rest;
@@ -288,11 +331,11 @@ std::vector<Evaluated> evaluate_candidates(const std::vector<Candidate>& candida
     (refine || !batched[k] ? order : rest).push_back(k);
   }
   order.insert(order.end(), rest.begin(), rest.end());
-  parallel_blocks(order.size(), 1, sc.threads,
-                  [&](std::size_t t, std::size_t, std::size_t, unsigned) {
-                    const std::size_t k = order[t];
-                    out[k] = evaluate_one(candidates[k], sc, batched[k] ? &grid[k] : nullptr);
-                  });
+  parallel_blocks(
+      order.size(), 1, sc.threads, [&](std::size_t t, std::size_t, std::size_t, unsigned) {
+        const std::size_t k = order[t];
+        out[k] = evaluate_one(candidates[k], sc, batched[k] ? &grid[k] : nullptr, pre[k]);
+      });
   for (std::size_t k = 0; k < nc; ++k) out[k].fit.name = candidates[k].name;
   return out;
 }

@@ -24,7 +24,7 @@ struct Evaluated {
 // parameter count (effects read θ's first np entries), the held-out residual and leverage
 // before, the noise floor's variance (µm²), alpha and the number of candidates (Bonferroni).
 struct ScoringContext {
-  const Engine* engine = nullptr;
+  const DesignLeastSquares* engine = nullptr;
   std::size_t np = 0;
   const VectorXd* base_r = nullptr;
   const VectorXd* base_h = nullptr;

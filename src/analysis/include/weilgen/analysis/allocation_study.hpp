@@ -1,4 +1,4 @@
-// Tolerance allocation of a study: the grinder seed's step procedure (tighten the most
+// Tolerance allocation of a study: Wang & Yuan 2021's step procedure (tighten the most
 // reliability-sensitive errors step by step until the targets hold) and, optionally, the
 // cost-aware optimum (min Σ w_i/σ_i under the same targets), over the reliability sweep of the
 // study's poses and tolerances. docs/reliability.md.
@@ -20,8 +20,8 @@ struct AllocationStudyOptions {
   // --step: "10%" (of each error's starting spread), "0.005/6mm" (every length error),
   // "0.005/6000rad" (every angular error), "E_C0X=0.005/3000rad" (one error); default 10 %.
   std::vector<std::string> steps;
-  std::size_t choose = 4;           // errors chosen per output that misses its targets
-  std::string rank = "scaled";      // scaled (|dR/dσ_i| σ_i) | raw (|dR/dσ_i|, the seed's)
+  std::size_t choose = 4;       // errors chosen per output that misses its targets
+  std::string rank = "scaled";  // scaled (|dR/dσ_i| σ_i) | raw (|dR/dσ_i|, Wang & Yuan 2021's)
   std::vector<std::string> errors;  // explicit choice (overrides choose)
   std::size_t max_steps = 100;
   bool per_output = false;  // tighten only the errors of outputs still missing a target

@@ -9,7 +9,11 @@
 // axis the same with the orientation column and the rotation deviation (deg). For an ISO 230-1
 // positioning error such as E_XX of a linear axis, δ is that error: the table is what an ISO
 // 230-2 measurement along the axis would evaluate to (actual − commanded, measure/comp_table.hpp).
-// The model has no reversal error: forward = reverse.
+// The model has no reversal error: forward = reverse. The table is in LinuxCNC's joint
+// coordinates (machine/linuxcnc.hpp: the tool relative to the workpiece, the machine file's
+// `linuxcnc:` signs and offsets, --comp-units): on an axis that carries the workpiece (sign -1)
+// the joint position is minus the model's and so is the deviation, entries ascending in the
+// joint position.
 #pragma once
 
 #include <string>

@@ -158,6 +158,30 @@ struct GapOutlier {
   double sigmas = 0;            // |residual| / the robust spread of its output
 };
 
+// The held-out residual summarised, before or after the accepted effects.
+struct HeldoutSummary {
+  std::array<double, kObservationKinds> rms{}, max{};  // per output (µm, µrad); NaN: not measured
+  double rms_um = 0;                                   // over every held-out residual
+  // Over the noise floor, on the part of the held-out residual the folds can predict: the excess
+  // RMS and the F test's p-value.
+  double excess_um = 0, p_value = 1;
+  // The held-out RMS a right model would leave: floor · sqrt(mean(1 + h)) over the held-out
+  // residuals, h their held-out leverage (prediction error of the folds included), per output and
+  // over all.
+  std::array<double, kObservationKinds> ideal{};
+  double ideal_um = 0;
+};
+
+// The verdict: no gap, an effect of the library, or a gap the library does not explain.
+struct GapVerdict {
+  enum class Kind { None, Effect, Unexplained };
+  Kind kind = Kind::None;
+  std::string effect;       // Kind::Effect: the effect's name
+  std::string reason;       // one sentence: why this verdict
+  std::string str() const;  // "none", "unexplained" or the effect's name
+  bool names(const std::string& name) const { return kind == Kind::Effect && effect == name; }
+};
+
 struct GapResult {
   std::vector<GapOutlier> outliers;  // removed before everything below
   std::string holdout;               // the scheme used
@@ -165,9 +189,7 @@ struct GapResult {
   std::size_t observations = 0, parameters = 0, rank = 0;
   std::array<std::size_t, kObservationKinds> count{};
   NoiseFloor noise;
-  std::array<double, kObservationKinds> baseline_rms{}, baseline_max{};  // held-out, per output
-  double baseline_rms_um = 0;
-  double baseline_excess_um = 0, baseline_p_value = 1;  // held-out gap over the noise floor
+  HeldoutSummary baseline;  // the model alone
   // The baseline's lack of fit on all data (free offsets per output in bins of time and of every
   // moving axis, nested F test, Bonferroni over the coordinates) and the coordinate it is worst
   // along ("time" or an axis): a gap the held-out test misses when the folds cannot predict it.
@@ -176,15 +198,8 @@ struct GapResult {
   std::vector<GapRegion> where;        // significant regions first (by p-value), then the rest
   std::vector<EffectFit> effects;      // ranked by held-out improvement (first step)
   std::vector<EffectFit> explanation;  // the greedy sequence that was accepted
-  std::string verdict;                 // an effect name, "none" or "unexplained"
-  std::string verdict_reason;          // one sentence: why this verdict
-  std::array<double, kObservationKinds> final_rms{};  // held-out after the accepted effects
-  double final_rms_um = 0, final_excess_um = 0, final_p_value = 1;
-  // The held-out RMS a right model would leave: floor · sqrt(mean(1 + h)) over the held-out
-  // residuals, h their held-out leverage (prediction error of the folds included), per output
-  // and over all; before and after the accepted effects.
-  std::array<double, kObservationKinds> baseline_ideal{}, final_ideal{};
-  double baseline_ideal_um = 0, final_ideal_um = 0;
+  GapVerdict verdict;
+  HeldoutSummary final;  // after the accepted effects
   // Held-out residuals for plots: per observation of the data given (NaN when never held out,
   // and for outliers).
   std::vector<double> residual_before, residual_after;
@@ -202,7 +217,14 @@ struct GapOptions {
   void validate() const;
 };
 
-// The effect library's names, in report order.
+// One effect of the library (docs/gap.md, "Effect library").
+struct GapEffectInfo {
+  std::string name;         // thermal_drift, reversal, ...
+  bool repeatable = false;  // the greedy search may accept it again (a second sensor or lag)
+  std::string help;         // one line: what it models
+};
+// The effect library in report order, and its names.
+const std::vector<GapEffectInfo>& gap_effects();
 const std::vector<std::string>& gap_effect_names();
 
 class GapDiagnosis {
@@ -215,13 +237,6 @@ class GapDiagnosis {
                 const HoldoutScheme& scheme, const std::string& reason) const;
 
  private:
-  // `round` counts the diagnoses before this one that removed gross readings.
-  GapResult diagnose(const Model& model, const ErrorParameterisation& param, const GapData& data,
-                     const HoldoutScheme& scheme, const std::string& reason, int round) const;
-  GapResult diagnose_without(const Model& model, const ErrorParameterisation& param,
-                             const GapData& data, const HoldoutScheme& scheme,
-                             const std::string& reason, std::vector<GapOutlier> gross,
-                             int round) const;
   GapOptions options_;
 };
 

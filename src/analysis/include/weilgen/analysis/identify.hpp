@@ -252,6 +252,10 @@ struct IdentifyResult {
   std::array<double, kObservationKinds> rms_before{}, rms_after{}, max_after{};
   std::array<std::size_t, kObservationKinds> count{};
   int gauss_newton_iterations = 0;
+  // The span of the measured poses along every independent axis (Description::axes() order, the
+  // axis' unit): where the PDGEs are identified. A controller holds each PDGE at its axis' span
+  // ends instead of extrapolating the basis (params_header, params_json).
+  std::vector<double> span_min, span_max;
 };
 
 class Identification {

@@ -8,8 +8,8 @@ namespace weilgen {
 // The shortest of 15, 16 or 17 significant digits that reads back as the same double ("%g"
 // style: 0.03, 1e-05, 1500): file values, labels, JSON-equivalent text.
 std::string format_number(double v);
-// "%g" (6 significant digits): numbers inside messages.
-std::string format_short(double v);
+// "%g" with `digits` significant digits (6 by default): numbers inside messages and summaries.
+std::string format_short(double v, int digits = 6);
 // Fixed-point with `decimals` digits after the point; "-" for NaN and infinities: table cells.
 // A value that rounds to zero has no sign ("0.000", never "-0.000").
 std::string format_fixed(double v, int decimals);

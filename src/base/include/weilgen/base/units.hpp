@@ -14,9 +14,9 @@ struct UnitFactor {
   bool angle = false;
 };
 
-// Lengths: mm, um, µm, nm, m; angles: rad, mrad, urad, µrad, deg, arcsec; slopes (angles):
-// mm/m, um/m, µm/m (= 1e-3 rad, 1e-6 rad). µ may be written as the micro sign (U+00B5) or the
-// Greek mu (U+03BC). Throws std::invalid_argument naming the unit and the known ones.
+// Lengths: mm, um, µm, nm, m, inch (25.4 mm); angles: rad, mrad, urad, µrad, deg, arcsec; slopes
+// (angles): mm/m, um/m, µm/m (= 1e-3 rad, 1e-6 rad). µ may be written as the micro sign (U+00B5) or
+// the Greek mu (U+03BC). Throws std::invalid_argument naming the unit and the known ones.
 UnitFactor parse_unit(const std::string& unit);
 
 // The unit's name in ASCII as the table spells it: "µm" and "μm" -> "um", "µrad" -> "urad"
@@ -55,5 +55,21 @@ double parse_duration_s(const std::string& text, const std::string& default_unit
 // A feedrate in mm/min: "1000 mm/min", "16.7 mm/s", "1.2 m/min", "40 in/min", or a number
 // (mm/min); > 0. Throws std::invalid_argument "<what>: <why>".
 double parse_feedrate_mm_min(const std::string& text, const std::string& what);
+
+// An affine conversion to a base unit: value in the base unit = number * factor + offset.
+struct AffineUnit {
+  double factor = 1;
+  double offset = 0;
+  double to_base(double number) const { return number * factor + offset; }
+};
+
+// A temperature unit to °C: degC (C, °C, ºC), degF (F, °F), K. Case, blanks and '_' do not
+// matter; the empty unit is the caller's default. Throws std::invalid_argument
+// "unit '<unit>' (expected degC, degF or K)".
+AffineUnit parse_temperature_unit(const std::string& unit);
+
+// A pressure unit to Pa: Pa, hPa, mbar, kPa, mmHg, inHg (case, blanks and '_' do not matter).
+// Throws std::invalid_argument "unit '<unit>' (expected Pa, hPa, mbar, kPa, mmHg or inHg)".
+AffineUnit parse_pressure_unit(const std::string& unit);
 
 }  // namespace weilgen

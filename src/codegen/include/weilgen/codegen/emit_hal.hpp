@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "weilgen/codegen/generate.hpp"
+#include "weilgen/machine/linuxcnc.hpp"
 
 namespace weilgen::gen {
 
@@ -21,14 +22,22 @@ struct HalComponentOptions {
   // pose; empty: none. `params_header_path` names it in messages.
   std::string params_header;
   std::string params_header_path;
+  // The LinuxCNC joints: --units, --sign, --offset over the machine file's `linuxcnc:` section.
+  LinuxcncOverrides linuxcnc;
+  // Identified parameters read at run time (identify --emit-params-json): the path the .hal
+  // file's loadrt line names as params_file, and the file's text, checked against the model.
+  std::string params_file;
+  std::string params_file_text;
 };
 
 // Every file of the component in `out_dir`: the model header <model>.hpp and its C API
-// (<model>_c.h, <model>_c.cpp), <name>_hal.c, <name>_errors.cpp, <model>_params.hpp (a copy of
-// the identified parameters, when given), Makefile and <name>.hal (configuration lines).
+// (<model>_c.h, <model>_c.cpp), <name>_hal.c, <name>_errors.cpp, the parameter-file reader
+// <model>_params_file.h and .c, <model>_params.hpp (a copy of the identified parameters, when
+// given), Makefile and <name>.hal (the configuration: kinematics, joints, signs, safety wiring).
 // Throws std::invalid_argument for a bad name (naming --name) or one whose pin names exceed
 // HAL's 47 characters, InputError for identified parameters of another model (the file and the
-// line of its kModelKey or namespace) and for names that clash in C (emit_c_api.hpp).
+// line of its kModelKey or namespace; a params file's machine or model_key), for a `linuxcnc:`
+// section that gives two axes one letter or joint, and for names that clash in C.
 std::vector<GeneratedFile> linuxcnc_files(const Description& desc,
                                           const HalComponentOptions& options,
                                           const std::string& out_dir);

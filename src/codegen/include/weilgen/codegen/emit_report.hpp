@@ -9,7 +9,9 @@
 namespace weilgen::gen {
 
 enum class Notation { Iso, Alias };  // error names as in ISO 230-1 or as the file's first alias
-enum class FormStyle { Text, Latex };
+// Text: "dx = -E_XX - z·E_BX ..."; Latex; Sympy: the same terms in Python syntax (`*`, `**`),
+// "dx = -E_XX - z*E_BX ...", whose right-hand side sympy.sympify reads.
+enum class FormStyle { Text, Latex, Sympy };
 
 // "dx = -E_XX - z·E_BX + y·E_CX + ..." grouped by error in declaration order, then higher terms;
 // with max_degree > 0 only the terms up to that degree.

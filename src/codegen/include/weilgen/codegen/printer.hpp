@@ -1,4 +1,5 @@
-// Prints GiNaC expressions as C++ (templated Scalar), readable text or LaTeX, with operands in
+// Prints GiNaC expressions as C++ (templated Scalar), readable text, LaTeX or Python syntax that
+// sympy.sympify reads (`*`, `**`), with operands in
 // canonical order (so output does not depend on GiNaC's hash order) and operation counts.
 #pragma once
 
@@ -21,7 +22,7 @@ struct OpCount {
 
 class ExprPrinter {
  public:
-  enum class Style { Cpp, Text, Latex };
+  enum class Style { Cpp, Text, Latex, Sympy };
   // `names` maps symbol names to the text printed for them (others print as their name).
   ExprPrinter(Style style, std::map<std::string, std::string> names = {});
   std::string print(const GiNaC::ex& e);

@@ -196,6 +196,23 @@ struct OutputTransform {
   SourceLoc loc;
 };
 
+// How a LinuxCNC configuration sees the model's axes (machines/README.md, "linuxcnc"): what
+// the file says; machine/linuxcnc.hpp derives the defaults (signs, letters, joint numbers).
+struct LinuxcncAxisSpec {
+  std::string coordinate;        // the model axis (an independent coordinate)
+  std::optional<int> sign;       // +1 or -1: model = offset + sign * scale * LinuxCNC joint
+  std::optional<double> offset;  // the model coordinate at LinuxCNC's joint zero, axis unit
+  std::string letter;            // LinuxCNC axis letter (X Y Z A B C U V W); empty: default
+  std::optional<int> joint;      // LinuxCNC joint number; default: trivkins order
+  SourceLoc loc;
+};
+
+struct LinuxcncSpec {
+  std::string linear_units;  // LinuxCNC's [TRAJ]LINEAR_UNITS: "mm" or "inch"; empty: mm
+  std::vector<LinuxcncAxisSpec> axes;
+  SourceLoc loc;  // the section (0 when the file has none)
+};
+
 struct Description {
   std::string name;               // identifier, used for file and namespace names
   std::string title;              // human title
@@ -217,6 +234,7 @@ struct Description {
   SourceLoc pdge_basis_loc;                //   of linear axes (prismatic joints)
   std::string pdge_basis_revolute;         // ... of rotary axes (revolute joints)
   SourceLoc pdge_basis_revolute_loc;
+  LinuxcncSpec linuxcnc;  // the `linuxcnc:` section (empty when absent)
 
   // Index lookups; -1 when absent.
   int body_index(const std::string& name) const;

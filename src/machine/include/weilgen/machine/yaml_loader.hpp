@@ -4,6 +4,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "weilgen/machine/description.hpp"
 
@@ -22,10 +23,14 @@ Description load_machine_text(const std::string& yaml, const std::string& filena
 // A path to a file, or the name of a shipped machine (WEILGEN_MACHINES_DIR "/<name>.yaml").
 // Throws InputError (loc.file = the argument) when neither exists.
 std::string resolve_machine(const std::string& name_or_path);
-// Where shipped machines live: $WEILGEN_MACHINES_DIR if set, else the source tree's machines/
-// when it exists, else <prefix>/share/weilgen/machines next to an installed executable, or
-// above an installed module (the Python module in <prefix>/lib/python3.X/dist-packages).
+// Where shipped machines live: $WEILGEN_MACHINES_DIR if set, else the directory a front end chose
+// (the Python package's own copy), else <prefix>/share/weilgen/machines above an installed
+// module (the Python module in <prefix>/lib/python3.X/dist-packages) or next to an installed
+// executable, else the source tree's machines/.
 std::string shipped_machines_dir();
+void use_shipped_machines_dir(const std::string& dir);  // "" : no choice
+// The shipped machine files (<dir>/*.yaml), sorted by name.
+std::vector<std::string> shipped_machine_files();
 
 // The distribution keys of a machine file's error or error_defaults entry, for other files that
 // use the same syntax (tolerance files, weilgen/analysis/tolerance_file.hpp). `mapping` is a YAML

@@ -3,7 +3,8 @@
 // the circle, the predicted radial deviation dr(θ), the ISO 230-4 figures (centre offset,
 // circular deviation G, radial deviation F, hysteresis H), the harmonics of the trace, and the
 // comparison of a prediction with a measured trace. Definitions, approximations and the 6D-laser
-// seed's section 4: docs/ballbar.md; the file format: docs/data-format.md, "Ballbar traces".
+// Zhang & Chen 2021's section 4: docs/ballbar.md; the file format: docs/data-format.md, "Ballbar
+// traces".
 //
 // Angles: θ is measured in the plane from its first coordinate toward its second (XY: from +X
 // toward +Y). A pose at θ has first = c1 + R cos θ, second = c2 + R sin θ (R converted to the
@@ -215,7 +216,7 @@ struct BallbarComparison {
   TraceDifference raw;                                       // as measured and predicted
   TraceDifference centred;  // each with its own LSQ centre (a, b) removed (the set-up offset)
   BallbarEvaluation measured, predicted;  // both at the measured angles
-  // measured − predicted: its G is the seed's "circularity after ideal compensation".
+  // measured − predicted: its G is Zhang & Chen 2021's "circularity after ideal compensation".
   BallbarEvaluation difference;
 };
 

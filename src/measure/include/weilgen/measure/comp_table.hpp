@@ -23,6 +23,7 @@ constexpr std::size_t kMaxCompEntries = 256;
 struct CompTable {
   std::string axis;             // the axis (messages, comments)
   std::string unit;             // machine units of every column: "mm", "inch" or "deg"
+  int joint = -1;               // the LinuxCNC joint when known (a model's table), else -1
   std::vector<double> nominal;  // commanded positions, strictly ascending
   std::vector<double> forward;  // actual − nominal approached in + direction
   std::vector<double> reverse;  // actual − nominal approached in − direction

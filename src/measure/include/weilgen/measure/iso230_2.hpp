@@ -89,7 +89,8 @@ std::vector<IsoObservation> iso_observations(const MeasurementTable& table,
 // ---- Figures -----------------------------------------------------------------------------------
 
 // The ISO 230-2 figures of a set of per-target unidirectional means and estimators, with the
-// coverage factors k (2 in the standard; Student-t widened values for the seed's variant).
+// coverage factors k (2 in the standard; Student-t widened values for Stejskal et al. 2017's
+// variant).
 struct IsoFigures {
   double k_up = 2, k_down = 2;
   // Per target (ascending positions).
@@ -140,7 +141,8 @@ class Iso230_2Evaluation {
   Iso230_2Options options_;
 };
 
-// ---- Drift elimination (the drift seed) ----------------------------------------------------
+// ---- Drift elimination (Stejskal et al. 2017)
+// ----------------------------------------------------
 
 struct DriftOptions {
   std::optional<double> reference_position_mm;  // default: the first (lowest) target
@@ -156,9 +158,9 @@ struct DriftOptions {
 // Adjacent-position differences of one direction: element q (q = 0..m−2) is the difference
 // between targets q and q+1 (ascending), Δ_{q,j} = x_{q+1,j} − x_{q,j}, over the cycles j.
 struct AdjacentDifferences {
-  std::vector<double> mean;  // Δ̄_k (the seed's eq. (4), with the opposite sign)
+  std::vector<double> mean;  // Δ̄_k (Stejskal et al. 2017, eq. (4), with the opposite sign)
   std::vector<double> s;     // sample standard deviation of Δ_{k,j} over j (n − 1)
-  std::vector<double> sem;   // s / √n: the seed's eq. (6)
+  std::vector<double> sem;   // s / √n: Stejskal et al. 2017, eq. (6)
   // Anomaly test: F_q = s_q² / (mean of s_l² over the other differences l of the same parity
   // as q: they share no target with q), F(n−1, p(n−1)) under H0; p-value; flagged when
   // p < alpha / (number of tests of both directions).
@@ -169,10 +171,11 @@ struct AdjacentDifferences {
 
 // The drift-eliminated chart of one direction.
 struct DriftChart {
-  std::vector<double> value;   // x̂_i: the reference value accumulated with the mean differences
-  std::vector<double> s;       // s*_i = s_k/√2 of the difference that links i toward the
-                               // reference (the reference takes its neighbour's)
-  std::vector<double> s_diff;  // that s_k itself (the seed's ±2s band uses it: √2 wider)
+  std::vector<double> value;  // x̂_i: the reference value accumulated with the mean differences
+  std::vector<double> s;      // s*_i = s_k/√2 of the difference that links i toward the
+                              // reference (the reference takes its neighbour's)
+  std::vector<double>
+      s_diff;  // that s_k itself (Stejskal et al. 2017's ±2s band uses it: √2 wider)
   std::vector<std::vector<double>> shifted;  // [i][j]: x_ij − x_rj + x_{r,j0} (seed Fig. 13)
 };
 
@@ -215,7 +218,7 @@ struct DriftResult {
   std::vector<AnomalousPosition> anomalous_positions;
   DriftPerCycle per_cycle;
   // Pooled s of the adjacent differences over pooled classical s, per direction (√2 without
-  // drift: the seed's eq. (10); smaller when drift inflates the classical s).
+  // drift: Stejskal et al. 2017, eq. (10); smaller when drift inflates the classical s).
   std::array<double, 2> s_ratio{};
 };
 
@@ -237,7 +240,8 @@ class DriftElimination {
 double sample_mean(const std::vector<double>& v);
 double sample_sd(const std::vector<double>& v);
 
-// The seed's eq. (7)–(10): b_n = a_n − a_{n+1}; returns sd(b)/sd(a) (√2 for independent a_n).
+// Stejskal et al. 2017, eqs. (7)–(10): b_n = a_n − a_{n+1}; returns sd(b)/sd(a) (√2 for independent
+// a_n).
 double difference_sd_ratio(const std::vector<double>& a);
 
 }  // namespace weilgen

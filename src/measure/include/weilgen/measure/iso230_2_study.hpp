@@ -1,6 +1,6 @@
 // The whole ISO 230-2 evaluation of one axis of a measurement table: the axis and deviation
 // columns, the normalisation to 20 °C and air compensation (optional, normalisation.hpp), the
-// runs, the classical figures (k = 2 and Student-t), the drift seed's drift-eliminated
+// runs, the classical figures (k = 2 and Student-t), Stejskal et al. 2017's drift-eliminated
 // evaluation (with at least 2 targets) and the verdicts against tolerances. What
 // `weilgen iso230-2` computes.
 #pragma once

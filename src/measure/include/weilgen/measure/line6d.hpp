@@ -1,9 +1,9 @@
 // 6D line measurements: the six errors of one linear axis versus its position, as a 6D laser
 // interferometer reports them in a single run, converted to the ISO 230-1 error names of that
-// axis (X: E_XX, E_YX, E_ZX, E_AX, E_BX, E_CX) with the sign conversions of the 6D-laser seed's
-// Table 2, and the straightness reference line removed by least squares (the seed's eq. (1)).
-// CSV variant (`# format: line6d`, `# axis: X`) and every sign and choice: docs/data-format.md,
-// section "6D line measurements".
+// axis (X: E_XX, E_YX, E_ZX, E_AX, E_BX, E_CX) with the sign conversions of Zhang & Chen 2021's
+// Table 2, and the straightness reference line removed by least squares (Zhang & Chen 2021, eq.
+// (1)). CSV variant (`# format: line6d`, `# axis: X`) and every sign and choice:
+// docs/data-format.md, section "6D line measurements".
 #pragma once
 
 #include <map>
@@ -14,7 +14,7 @@
 
 namespace weilgen {
 
-// The six channels of a 6D laser, in the instrument's terms (the seed's Table 2 rows).
+// The six channels of a 6D laser, in the instrument's terms (Zhang & Chen 2021's Table 2 rows).
 enum class LaserChannel { Linear, StraightnessH, StraightnessV, Yaw, Pitch, Roll };
 constexpr int kLaserChannels = 6;
 
@@ -31,8 +31,8 @@ struct ChannelMapping {
 
 // The default mapping of the linear axis "X", "Y" or "Z". The laser's beam runs along the axis
 // K; its horizontal straightness channel measures along H, its vertical one along V; yaw is the
-// rotation about V, pitch about H, roll about K. X: (H, V) = (Y, Z), exactly the seed's Table 2;
-// Y: (X, Z); Z: (X, Y). Signs (Table 2): linear channels +1; yaw -1; pitch -1; roll +1.
+// rotation about V, pitch about H, roll about K. X: (H, V) = (Y, Z), exactly Zhang & Chen 2021,
+// Table 2; Y: (X, Z); Z: (X, Y). Signs (Table 2): linear channels +1; yaw -1; pitch -1; roll +1.
 // Throws std::invalid_argument for other axes.
 std::vector<ChannelMapping> line6d_default_mapping(const std::string& axis);
 
@@ -48,8 +48,8 @@ std::vector<std::string> line6d_iso_errors(const std::string& axis);
 // The CSV column of an ISO error of a line measurement: "E_YX_um", "E_AX_urad".
 std::string line6d_iso_column(const std::string& iso);
 
-// The seed's eq. (1): the least-squares line y ≈ intercept + slope·x of a profile; rows whose
-// y is NaN are ignored. Throws std::invalid_argument with fewer than two distinct positions.
+// Zhang & Chen 2021, eq. (1): the least-squares line y ≈ intercept + slope·x of a profile; rows
+// whose y is NaN are ignored. Throws std::invalid_argument with fewer than two distinct positions.
 struct ReferenceLine {
   double intercept = 0;  // unit of y at x = 0
   double slope = 0;      // unit of y per mm

@@ -1,5 +1,5 @@
 // Least-squares fits of a position-dependent error y(x) (µm or µrad versus mm) on a basis
-// (pdge_basis.hpp), with the 6D-laser seed's Table 4 metrics (e_max, R², SSE, RMSE), k-fold
+// (pdge_basis.hpp), with Zhang & Chen 2021's Table 4 metrics (e_max, R², SSE, RMSE), k-fold
 // cross-validation to choose the order (contiguous blocks of positions, or leave-one-cycle-out),
 // and a Fourier period search. Algorithm objects (LeastSquaresFit, PeriodSearch, PdgeFit: options
 // in, run() const) are separate from the results they return (FitResult, PeriodSearchResult,
@@ -15,8 +15,8 @@
 
 namespace weilgen {
 
-// The seed's Table 4 metrics (eqs. (6)-(8)) of a fit's residuals r_i = y_i - ỹ_i, in the unit
-// of y (SSE in its square).
+// Zhang & Chen 2021's Table 4 metrics (eqs. (6)-(8)) of a fit's residuals r_i = y_i - ỹ_i, in the
+// unit of y (SSE in its square).
 struct FitMetrics {
   std::size_t n = 0;
   double e_max = NAN;  // max |r_i|

@@ -38,6 +38,26 @@ class NumericChain {
   std::array<double, 6> deviation(const std::vector<double>& axes,
                                   const std::vector<double>& errors) const;
 
+  // The nominal tool frame at `axes` (tool_in_workpiece at zero errors): what deviation()
+  // compares with. Many error vectors at one pose share it: deviation(axes, errors, nominal).
+  Eigen::Matrix4d nominal(const std::vector<double>& axes) const;
+  // deviation() with the pose's nominal frame given (nominal(axes)): the same numbers.
+  std::array<double, 6> deviation(const std::vector<double>& axes,
+                                  const std::vector<double>& errors,
+                                  const Eigen::Matrix4d& nominal) const;
+
+  // Forward steps of the deviation in one error at a time: `at` = deviation(axes, errors) and,
+  // for every k with steps[k] != 0, stepped[k] = deviation(axes, errors with errors[k] +
+  // steps[k]) (entries with steps[k] == 0 are left as they are; stepped is resized to
+  // num_errors()). The same operations in the same order as those calls, hence the same numbers,
+  // but a step recomputes only the transform of the body that holds the error and the products
+  // after it in its branch (a serial machine; with linked coordinates or an output transform
+  // every step is a whole deviation()). Finite-difference Jacobians of the exact chain.
+  void deviation_steps(const std::vector<double>& axes, const std::vector<double>& errors,
+                       const std::vector<double>& steps, const Eigen::Matrix4d& nominal,
+                       std::array<double, 6>& at,
+                       std::vector<std::array<double, 6>>& stepped) const;
+
   // d(nominal pose)/d(axes) at zero errors by central differences (step 1e-3 of the axis unit:
   // µm, millidegree; far above rounding, far below any curvature), 6 x num_axes: rows dx, dy, dz
   // in mm and the rotation rate da, db, dc in rad (the axial vector of dR·Rᵀ), per axis unit.
@@ -53,8 +73,15 @@ class NumericChain {
                                  const std::vector<double>& errors) const;
   Eigen::Matrix4d error_transform(int body, ErrorPlacement placement,
                                   const std::vector<double>& errors) const;
-  Eigen::Matrix4d branch(const PointSpec& end, const std::vector<double>& q_body,
+  // The frame of `point` (mm, in `body`'s frame) in the base frame: the bodies' transforms
+  // from the base down to `body`, multiplied in that order.
+  Eigen::Matrix4d branch(int body, const Eigen::Vector3d& point, const std::vector<double>& q_body,
                          const std::vector<double>& errors) const;
+  Eigen::Vector3d point_of(const PointSpec& end) const;
+  std::vector<double> body_values(const std::vector<double>& axes) const;  // q_body
+  // The parameters' parts of the chain: each body's fixed offset and revolute axis point, the
+  // tool and workpiece points (set_parameters recomputes them).
+  void cache_parameters();
   // Parameters, independent coordinates (from `axes`) and linked coordinates by name.
   std::map<std::string, double> coordinate_values(const std::vector<double>& axes) const;
   // Chain points, derived quantities (by name, into `values`) and the output transform.
@@ -66,6 +93,11 @@ class NumericChain {
   std::vector<int> axis_bodies_;
   std::vector<int> linked_bodies_;  // bodies with a linked joint
   std::map<std::string, double> params_;
+  std::vector<std::vector<int>> paths_;                  // per body: chain_to(body)
+  std::vector<std::array<std::vector<int>, 3>> placed_;  // per body and placement: its errors
+  std::vector<Eigen::Matrix4d> offsets_;                 // per body: Trans(t) · its rotations
+  std::vector<Eigen::Vector3d> through_;                 // per body: a revolute axis' point, mm
+  Eigen::Vector3d tool_point_, workpiece_point_;         // mm, in their bodies' frames
 };
 
 }  // namespace weilgen

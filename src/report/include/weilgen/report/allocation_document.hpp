@@ -1,4 +1,4 @@
-// The documents of a tolerance allocation: the text of `weilgen allocate` (the grinder seed's
+// The documents of a tolerance allocation: the text of `weilgen allocate` (Wang & Yuan 2021's
 // Tables 5-7 and the cost-aware optimum), its JSON and CSV (docs/reliability.md), and the
 // tolerance file of the final spreads.
 #pragma once

@@ -1,5 +1,5 @@
 // The documents of an ISO 230-2 evaluation: the text of `weilgen iso230-2` (per-target table,
-// axis figures classical / Student-t / drift-eliminated, the drift seed's tables), its JSON
+// axis figures classical / Student-t / drift-eliminated, Stejskal et al. 2017's tables), its JSON
 // (docs/iso230-2.md) and its deviation charts.
 #pragma once
 

@@ -1,6 +1,6 @@
 // The documents of the PDGE fits of a file: the text of `weilgen fit-pdge` (a comparison like
-// the 6D seed's Table 4 per profile, optionally the CV curves), its JSON (docs/fit-pdge.md) and
-// its CSV and charts (data and fits, residuals).
+// Zhang & Chen 2021's Table 4 per profile, optionally the CV curves), its JSON (docs/fit-pdge.md)
+// and its CSV and charts (data and fits, residuals).
 #pragma once
 
 #include <nlohmann/json.hpp>

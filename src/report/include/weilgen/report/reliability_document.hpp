@@ -1,5 +1,5 @@
 // The documents of a reliability sweep: the text of `weilgen reliability` (tables like the
-// grinder seed's Tables 2-4 for two grid axes), its JSON and CSV (docs/reliability.md) and its
+// Wang & Yuan 2021's Tables 2-4 for two grid axes), its JSON and CSV (docs/reliability.md) and its
 // charts (a heat map over two grid axes, a line over one, small multiples over more, bars
 // otherwise).
 #pragma once

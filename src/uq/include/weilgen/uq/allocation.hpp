@@ -2,7 +2,8 @@
 // reliability requirement group meets its targets (min over its cases >= min_target and mean over
 // its cases >= mean_target). Generic: the caller's `evaluate` computes every case (e.g. one output
 // over a grid of poses) for a set of input distributions, with dR/dsigma per input.
-//   StepAllocation       the seed's procedure (Tables 5-7): choose the most sensitive inputs once,
+//   StepAllocation       Wang & Yuan 2021's procedure (Tables 5-7): choose the most sensitive
+//   inputs once,
 //                        lower each chosen stddev by a fixed step per iteration, re-evaluate.
 //   CostAwareAllocation  minimise sum_i w_i / sigma_i subject to the same targets (NLopt SLSQP,
 //                        gradients from dR/dsigma), started from the step procedure's end point.
@@ -91,7 +92,7 @@ struct AllocationResult {
   std::size_t cost_aware_evaluations = 0;  // calls of AllocationProblem::evaluate
 };
 
-// The seed's step procedure.
+// Wang & Yuan 2021's step procedure.
 class StepAllocation {
  public:
   explicit StepAllocation(AllocationOptions options);  // validates the options
@@ -118,29 +119,4 @@ class CostAwareAllocation {
   AllocationOptions options_;
 };
 
-// ---- Implementation pieces shared by the allocation*.cpp files (not a stable API) ----------
-
-namespace allocation_detail {
-
-struct GroupStats {
-  std::vector<double> min, mean;
-  std::vector<std::size_t> argmin;
-  bool met = false;
-  std::vector<bool> group_met;
-};
-
-// Checks the problem and options (see StepAllocation).
-void validate(const AllocationProblem& problem, const AllocationOptions& options);
-// evaluate() with its result checked.
-std::vector<AllocationCase> evaluate_checked(const AllocationProblem& problem,
-                                             const std::vector<InputDistribution>& inputs);
-GroupStats group_stats(const AllocationProblem& problem, const std::vector<AllocationCase>& cases,
-                       const AllocationOptions& options);
-// The inputs with every stddev replaced (location-scale move, means kept).
-std::vector<InputDistribution> with_stddevs(const std::vector<InputDistribution>& inputs,
-                                            const std::vector<double>& stddev);
-std::vector<double> stddevs(const std::vector<InputDistribution>& inputs);
-std::string input_name(const AllocationProblem& problem, std::size_t i);
-
-}  // namespace allocation_detail
 }  // namespace weilgen

@@ -53,6 +53,11 @@ struct SobolOptions {
 // (design, resample multiplicities, f(A), f(B), accumulators, replicates): checked before a run.
 double sobol_memory_bytes(const SobolOptions& options, std::size_t inputs, std::size_t outputs);
 
+// The seed of QMC replicate r of R: its SobolSequence(2k', seed, /*scramble=*/R > 1) is the
+// replicate's design (R = 1: `seed` itself, so 0 stays unrandomised). splitmix64's output for
+// the state seed + (r + 1) γ; never 0.
+std::uint64_t sobol_replicate_seed(std::uint64_t seed, std::size_t r, std::size_t replicates);
+
 // "replicates" | "bootstrap" | "none": the interval method as written in documents.
 const char* interval_method_name(SobolIntervals intervals);
 
@@ -125,6 +130,10 @@ struct SobolIndices {             // one output
   double mean = 0, variance = 0;  // of the output over [A; B] (variance with divisor 2N)
   std::vector<double> first, first_lo, first_hi;  // S_i and its confidence interval
   std::vector<double> total, total_lo, total_hi;  // S_Ti (Jansen) and its CI
+  // With replicates (R > 1): every replicate's own estimates, replicate-major (entry r k + i is
+  // replicate r's S_i or S_Ti; first and total are their means). Empty otherwise, and for an
+  // output at rounding level.
+  std::vector<double> first_replicates, total_replicates;
 };
 
 struct SobolResult {
