@@ -370,14 +370,7 @@ void ballbar_candidates(const Model& model, const CandidateSpec& spec, const Lev
       std::vector<double> rest(na);
       for (std::size_t a = 0; a < na; ++a) rest[a] = rest_value(d.axis_joint(a));
       f.centre = pose_text(d, rest);
-      BallbarCircle circle;
-      try {
-        circle = parse_ballbar_circle(f, bm);
-      } catch (const std::invalid_argument& e) {
-        std::string m = e.what();
-        if (m.rfind("--plane", 0) == 0) m = m.substr(7);
-        throw std::invalid_argument("--planes" + m);
-      }
+      const BallbarCircle circle = parse_ballbar_circle(f, bm);  // names --plane when bad
       std::size_t a1 = na, a2 = na;
       for (std::size_t a = 0; a < na; ++a) {
         if (name_of(a) == circle.first) a1 = a;
