@@ -89,6 +89,12 @@ bool better(double a, double b, DesignCriterion c) {
   return c == DesignCriterion::D || c == DesignCriterion::E ? a > b : a < b;
 }
 
+// The value of a design with a regular information matrix (a singular one is −inf for D, +inf
+// for A and I, 0 for E).
+bool regular_value(double v, DesignCriterion c) {
+  return c == DesignCriterion::E ? v > 0 : std::isfinite(v);
+}
+
 struct Choice {
   std::vector<std::size_t> selected;  // candidate indices
   ExchangeResult exchange;
@@ -122,9 +128,31 @@ void plan_budget(Context& cx, PlanResult& R) {
   auto instrument_of_bit = [&](std::size_t b) {
     return b < groups.size() ? c.setups[groups[b]].instrument : Instrument::Ballbar;
   };
+  // The information of every set-up's candidates together: a choice of set-ups whose union
+  // cannot reach the candidates' rank plans a singular design, which loses to any regular one.
+  const Eigen::Index r = cx.frame.Q.cols();
+  std::vector<MatrixXd> setup_info(c.setups.size(), MatrixXd::Zero(r, r));
+  for (std::size_t j = 0; j < c.units.size(); ++j)
+    setup_info[c.units[j].setup].noalias() += cx.frame.Z[j].transpose() * cx.frame.Z[j];
+  // Each unit's rows enter the criteria only through ZᵀZ: a circle's hundreds of rows become
+  // as many as its rank (L with LᵀL = ZᵀZ), which the exchange's updates are cubic in.
+  std::vector<MatrixXd> compact(c.units.size());
+  for (std::size_t j = 0; j < c.units.size(); ++j) {
+    const MatrixXd& z = cx.frame.Z[j];
+    if (z.rows() <= r) {
+      compact[j] = z;
+      continue;
+    }
+    const Eigen::SelfAdjointEigenSolver<MatrixXd> es(z.transpose() * z);
+    const double cut = 1e-14 * std::max(es.eigenvalues().maxCoeff(), 0.0);
+    const Eigen::Index keep = (es.eigenvalues().array() > cut).count();
+    compact[j] =
+        (es.eigenvectors().rightCols(keep) * es.eigenvalues().tail(keep).cwiseSqrt().asDiagonal())
+            .transpose();
+  }
   Choice best;
   std::map<Instrument, Choice> alone;
-  for (std::size_t mask = 1; mask < (std::size_t{1} << bits); ++mask) {
+  auto run_mask = [&](std::size_t mask) {
     double fixed = 0;
     std::vector<char> open(c.setups.size(), 0);
     std::set<Instrument> used;
@@ -139,14 +167,14 @@ void plan_budget(Context& cx, PlanResult& R) {
           if (c.setups[s].instrument == Instrument::Ballbar) open[s] = 1;
       }
     }
-    if (fixed > o.budget_s) continue;
+    if (fixed > o.budget_s) return;
     DesignProblem p;
     std::vector<std::size_t> index;  // problem unit -> candidate
     for (std::size_t j = 0; j < c.units.size(); ++j) {
       const PlanSetup& s = c.setups[c.units[j].setup];
       if (!open[c.units[j].setup]) continue;
       index.push_back(j);
-      p.units.push_back(cx.frame.Z[j]);
+      p.units.push_back(compact[j]);
       p.cost.push_back(s.instrument == Instrument::Ballbar ? s.setup_s + s.pose_s : s.pose_s);
     }
     bool forced_ok = true;
@@ -157,9 +185,9 @@ void plan_budget(Context& cx, PlanResult& R) {
       else
         p.forced.push_back(static_cast<std::size_t>(at - index.begin()));
     }
-    if (!forced_ok || p.units.empty()) continue;
+    if (!forced_ok || p.units.empty()) return;
     p.budget = o.budget_s - fixed;
-    if (*std::min_element(p.cost.begin(), p.cost.end()) > p.budget) continue;
+    if (*std::min_element(p.cost.begin(), p.cost.end()) > p.budget) return;
     p.weight = cx.frame.W;
     ExchangeOptions eo;
     eo.criterion = o.criterion;
@@ -180,7 +208,7 @@ void plan_budget(Context& cx, PlanResult& R) {
                                             ch.selected.begin(), ch.selected.end(),
                                             [&](std::size_t j) { return c.units[j].setup == s; }));
     ch.found = !ch.selected.empty();
-    if (!ch.found) continue;
+    if (!ch.found) return;
     // Among equals (singular designs all −inf): the ridge's value, then the shorter time.
     ch.ridged = ch.exchange.restart_values[ch.exchange.best_restart];
     auto take = [&](Choice& slot) {
@@ -191,7 +219,39 @@ void plan_budget(Context& cx, PlanResult& R) {
     };
     take(best);
     if (used.size() == 1) take(alone[*used.begin()]);
-  }
+  };
+  // First the choices whose union reaches the rank, then, when one of them gave a regular
+  // design, only the single-instrument ones (each instrument alone, for the comparison);
+  // otherwise every choice (the best singular design, by its ridge).
+  auto union_rank = [&](std::size_t mask) {
+    MatrixXd m = MatrixXd::Zero(r, r);
+    for (std::size_t b = 0; b < bits; ++b) {
+      if (!(mask >> b & 1)) continue;
+      for (std::size_t s = 0; s < c.setups.size(); ++s)
+        if (b < groups.size() ? s == groups[b] : c.setups[s].instrument == Instrument::Ballbar)
+          m += setup_info[s];
+    }
+    const Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<MatrixXd>(m).eigenvalues();
+    // A loose cut counts near-null directions as present: a choice is skipped only when it
+    // surely cannot reach the rank.
+    const double cut = 1e-13 * std::max(ev.maxCoeff(), 0.0);
+    return static_cast<Eigen::Index>((ev.array() > cut).count());
+  };
+  auto single_instrument = [&](std::size_t mask) {
+    std::set<Instrument> used;
+    for (std::size_t b = 0; b < bits; ++b)
+      if (mask >> b & 1) used.insert(instrument_of_bit(b));
+    return used.size() == 1;
+  };
+  std::vector<char> done(std::size_t{1} << bits, 0);
+  for (std::size_t mask = 1; mask < (std::size_t{1} << bits); ++mask)
+    if (union_rank(mask) >= r) {
+      run_mask(mask);
+      done[mask] = 1;
+    }
+  const bool regular = best.found && regular_value(best.value, o.criterion);
+  for (std::size_t mask = 1; mask < (std::size_t{1} << bits); ++mask)
+    if (!done[mask] && (!regular || single_instrument(mask))) run_mask(mask);
   if (!best.found)
     throw std::invalid_argument("--time-budget: no set-up and unit fit in " +
                                 format_significant(o.budget_s / 3600, 3) + " h");

@@ -579,6 +579,20 @@ const char* instrument_name(Instrument i) {
   return "?";
 }
 
+std::vector<std::size_t> observed_kinds(Instrument i) {
+  switch (i) {
+    case Instrument::Points:
+    case Instrument::RTest:
+      return {0, 1, 2};
+    case Instrument::Ballbar:
+      return {static_cast<std::size_t>(kRadialOutput)};
+    case Instrument::Line6d:
+      return {static_cast<std::size_t>(kLinePositioning),
+              static_cast<std::size_t>(kLineStraightness), static_cast<std::size_t>(kLineAngular)};
+  }
+  return {};
+}
+
 bool hold_nest(const Model& model, const PlanSetup& setup, std::vector<double>& pose) {
   const NestSolver solver(model);
   const Eigen::Vector3d nest(setup.nest_mm[0], setup.nest_mm[1], setup.nest_mm[2]);

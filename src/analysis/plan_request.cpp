@@ -59,21 +59,6 @@ std::vector<std::pair<Instrument, std::string>> parse_instruments(const std::str
   return out;
 }
 
-// The kinds an instrument's observations have.
-std::vector<std::size_t> kinds_of(Instrument i) {
-  switch (i) {
-    case Instrument::Points:
-    case Instrument::RTest:
-      return {0, 1, 2};
-    case Instrument::Ballbar:
-      return {static_cast<std::size_t>(kRadialOutput)};
-    case Instrument::Line6d:
-      return {static_cast<std::size_t>(kLinePositioning),
-              static_cast<std::size_t>(kLineStraightness), static_cast<std::size_t>(kLineAngular)};
-  }
-  return {};
-}
-
 }  // namespace
 
 void PlanRequest::validate() const {
@@ -170,7 +155,7 @@ PlanRun run_plan(const PlanRequest& rq) {
       const double v = q.unit.angle ? q.in(parse_unit("urad")) : q.in(parse_unit("um"));
       if (!(v > 0) || !std::isfinite(v))
         throw std::invalid_argument(what + ": the noise must be > 0");
-      for (std::size_t k : kinds_of(inst))
+      for (std::size_t k : observed_kinds(inst))
         if ((std::string(observation_unit(k)) == "µrad") == q.unit.angle) noise[k] = v;
     }
     const InstrumentTimes t = times.count(inst) ? times.at(inst) : InstrumentTimes{};

@@ -48,6 +48,46 @@ json observability_json(const ObservabilityIndices& o) {
           {"O5", json_number(o.o5)}};
 }
 
+// The noise of `kinds` as {dx_um: .., ang_urad: ..}.
+json noise_json(const std::vector<std::size_t>& kinds, const KindNoise& noise) {
+  json j = json::object();
+  for (std::size_t k : kinds)
+    j[std::string(observation_name(k)) +
+      (std::string(observation_unit(k)) == "µrad" ? "_urad" : "_um")] = noise[k];
+  return j;
+}
+
+// " dx 1 µm dy 1 µm dz 1 µm"
+std::string noise_text(const std::vector<std::size_t>& kinds, const KindNoise& noise) {
+  std::string s;
+  for (std::size_t k : kinds)
+    s += " " + std::string(observation_name(k)) + " " + format_significant(noise[k], 3) + " " +
+         observation_unit(k);
+  return s;
+}
+
+// Time budget: an instrument's first set-up (its noise and times are every set-up's).
+const PlanSetup& setup_of(const PlanResult& r, Instrument i) {
+  for (const PlanSetup& s : r.candidates.setups)
+    if (s.instrument == i) return s;
+  return r.candidates.setups.front();
+}
+
+// A duration for people: "45 s", "12 min", "3 h 52 min".
+std::string duration_text(double s) {
+  if (s < 60) return format_significant(s, 3) + " s";
+  const long minutes = std::lround(s / 60);
+  if (minutes < 60) return std::to_string(minutes) + " min";
+  return std::to_string(minutes / 60) + " h" +
+         (minutes % 60 ? " " + std::to_string(minutes % 60) + " min" : std::string());
+}
+
+// How much lower the plan's prediction SD is than `f`'s, in %: one decimal below 100 %.
+std::string below_text(double plan_sd, double sd) {
+  const double pct = 100 * (1 - plan_sd / sd);
+  return format_fixed(pct, std::abs(pct) < 100 ? 1 : 0) + " %";
+}
+
 json unit_json(const PlanRun& run, const PlanUnit& u) {
   const Description& d = run.model->description();
   const PlanSetup& s = run.result.candidates.setups[u.setup];
@@ -114,24 +154,32 @@ json plan_json(const PlanRun& run, const std::vector<std::string>& files) {
   const PlanResult& r = run.result;
   const Description& d = run.model->description();
   const ErrorParameterisation& param = *run.param;
-  json noise = json::object();
-  std::vector<std::size_t> kinds;
-  switch (r.instrument) {
-    case Instrument::Points:
-    case Instrument::RTest:
-      kinds = {0, 1, 2};
-      break;
-    case Instrument::Ballbar:
-      kinds = {static_cast<std::size_t>(kRadialOutput)};
-      break;
-    case Instrument::Line6d:
-      kinds = {static_cast<std::size_t>(kLinePositioning),
-               static_cast<std::size_t>(kLineStraightness), static_cast<std::size_t>(kLineAngular)};
-      break;
+  const bool budget = !r.instruments.empty();
+  json noise = noise_json(observed_kinds(r.instrument), r.noise);
+  json instruments = nullptr, time_budget = nullptr;
+  if (budget) {
+    noise = json::object();
+    instruments = json::array();
+    for (Instrument i : r.instruments) {
+      const PlanSetup& s = setup_of(r, i);
+      noise[instrument_name(i)] = noise_json(observed_kinds(i), s.noise);
+      instruments.push_back({{"name", instrument_name(i)},
+                             {"noise", noise_json(observed_kinds(i), s.noise)},
+                             {"setup_s", s.setup_s},
+                             {"unit_s", s.pose_s}});
+    }
+    json uses = json::array();
+    for (const TimeUse& t : r.time_use) {
+      const PlanSetup& s = r.candidates.setups[t.setup];
+      uses.push_back({{"setup", s.tag},
+                      {"instrument", instrument_name(s.instrument)},
+                      {"what", s.what},
+                      {"units", t.units},
+                      {"setup_s", t.setup_s},
+                      {"units_s", t.units_s}});
+    }
+    time_budget = {{"budget_s", run.options.budget_s}, {"used_s", r.time_used_s}, {"setups", uses}};
   }
-  for (std::size_t k : kinds)
-    noise[std::string(observation_name(k)) +
-          (std::string(observation_unit(k)) == "µrad" ? "_urad" : "_um")] = r.noise[k];
   json poses = json::array(), units = json::array();
   for (const PlanUnit& u : r.plan.layout) {
     poses.push_back(pose_object(d, u.pose));
@@ -169,58 +217,71 @@ json plan_json(const PlanRun& run, const std::vector<std::string>& files) {
               {"y", r.sd_map.y},
               {"sd_um", json_numbers(r.sd_map.sd_um)},
               {"other_axes", pose_object(d, r.sd_map.middle)}};
-  return json_document("plan", {{"model", model_json(*run.model)},
-                                {"instrument", instrument_name(r.instrument)},
-                                {"criterion", design_criterion_name(run.options.criterion)},
-                                {"noise", noise},
-                                {"units", r.plan.layout.size()},
-                                {"unit", unit_word(r.instrument)},
-                                {"poses", poses},
-                                {"layout", units},
-                                {"setups", setups},
-                                {"files", files},
-                                {"free_parameters", r.free_parameters},
-                                {"log_det", json_number(r.plan.log_det)},
-                                {"criterion_value", json_number(r.plan.criterion)},
-                                {"rank", r.plan.rank},
-                                {"condition", json_number(r.plan.condition)},
-                                {"observations", r.plan.observations},
-                                {"candidates",
-                                 {{"units", r.candidates.units.size()},
-                                  {"dropped", r.candidates.dropped},
-                                  {"forced", r.candidates.forced.size()},
-                                  {"rank", r.candidate_rank},
-                                  {"minimum_units", r.minimum_units},
-                                  {"sequential_full_rank_units", r.greedy_units}}},
-                                {"unidentifiable", null},
-                                {"prediction_sd_um", json_number(r.plan.prediction_sd_um)},
-                                {"parameters", params},
-                                {"observability", observability_json(r.plan.observability)},
-                                {"compare", compare},
-                                {"bound",
-                                 {{"iterations", r.bound_iterations},
-                                  {"criterion_value", json_number(r.criterion_bound)},
-                                  {"prediction_sd_um", json_number(r.prediction_sd_bound_um)}}},
-                                {"random_sd_um", json_numbers(r.random_sd_um)},
-                                {"target", target},
-                                {"exchange",
-                                 {{"restarts", run.options.restarts},
-                                  {"seed", run.options.seed},
-                                  {"best_restart", r.exchange.best_restart},
-                                  {"restart_values", json_numbers(r.exchange.restart_values)},
-                                  {"passes", r.exchange.passes},
-                                  {"exchanges", r.exchange.exchanges}}},
-                                {"sd_map", map},
-                                {"seconds", r.seconds}});
+  return json_document(
+      "plan", {{"model", model_json(*run.model)},
+               {"instrument", budget ? json(nullptr) : json(instrument_name(r.instrument))},
+               {"instruments", instruments},
+               {"time_budget", time_budget},
+               {"criterion", design_criterion_name(run.options.criterion)},
+               {"noise", noise},
+               {"units", r.plan.layout.size()},
+               {"unit", budget ? "units" : unit_word(r.instrument)},
+               {"poses", poses},
+               {"layout", units},
+               {"setups", setups},
+               {"files", files},
+               {"free_parameters", r.free_parameters},
+               {"log_det", json_number(r.plan.log_det)},
+               {"criterion_value", json_number(r.plan.criterion)},
+               {"rank", r.plan.rank},
+               {"condition", json_number(r.plan.condition)},
+               {"observations", r.plan.observations},
+               {"candidates",
+                {{"units", r.candidates.units.size()},
+                 {"dropped", r.candidates.dropped},
+                 {"forced", r.candidates.forced.size()},
+                 {"rank", r.candidate_rank},
+                 {"minimum_units", r.minimum_units},
+                 {"sequential_full_rank_units", r.greedy_units}}},
+               {"unidentifiable", null},
+               {"prediction_sd_um", json_number(r.plan.prediction_sd_um)},
+               {"parameters", params},
+               {"observability", observability_json(r.plan.observability)},
+               {"compare", compare},
+               {"bound",
+                {{"iterations", r.bound_iterations},
+                 {"criterion_value", json_number(r.criterion_bound)},
+                 {"prediction_sd_um", json_number(r.prediction_sd_bound_um)}}},
+               {"random_sd_um", json_numbers(r.random_sd_um)},
+               {"target", target},
+               {"exchange",
+                {{"restarts", run.options.restarts},
+                 {"seed", run.options.seed},
+                 {"best_restart", r.exchange.best_restart},
+                 {"restart_values", json_numbers(r.exchange.restart_values)},
+                 {"passes", r.exchange.passes},
+                 {"exchanges", r.exchange.exchanges}}},
+               {"sd_map", map},
+               {"seconds", r.seconds}});
 }
 
 std::string plan_text(const PlanRun& run, const std::vector<std::string>& files) {
   const PlanResult& r = run.result;
   const Description& d = run.model->description();
   std::ostringstream os;
-  os << "plan " << d.name << " (" << instrument_name(r.instrument) << ", criterion "
-     << design_criterion_name(run.options.criterion) << "): " << r.plan.layout.size() << " "
-     << unit_word(r.instrument) << " of " << r.candidates.units.size() << " candidates";
+  const bool budget = !r.instruments.empty();
+  const std::string units = budget ? "units" : unit_word(r.instrument);
+  os << "plan " << d.name << " (";
+  if (budget) {
+    for (std::size_t i = 0; i < r.instruments.size(); ++i)
+      os << (i ? ", " : "") << instrument_name(r.instruments[i]);
+    os << " within " << duration_text(run.options.budget_s);
+  } else {
+    os << instrument_name(r.instrument);
+  }
+  os << ", criterion " << design_criterion_name(run.options.criterion)
+     << "): " << r.plan.layout.size() << " " << units << " of " << r.candidates.units.size()
+     << " candidates";
   if (r.candidates.dropped) os << " (" << r.candidates.dropped << " outside the travel left out)";
   os << "\nparameters: " << r.free_parameters << " free; the candidates identify "
      << r.candidate_rank << " combinations";
@@ -228,27 +289,27 @@ std::string plan_text(const PlanRun& run, const std::vector<std::string>& files)
     os << " (" << r.unidentifiable.size() << " not identifiable by any candidate set, below)";
   os << "\nplan: rank " << r.plan.rank << ", condition " << format_significant(r.plan.condition, 3)
      << ", log det " << format_significant(r.plan.log_det, 6) << ", " << r.plan.observations
-     << " observations; "
-     << "at least " << r.minimum_units << " " << unit_word(r.instrument)
-     << " for full rank (the sequential design needed " << r.greedy_units << ")\n";
-  os << "noise:";
-  for (std::size_t k = 0; k < kObservationKinds; ++k) {
-    bool used = false;
-    switch (r.instrument) {
-      case Instrument::Points:
-      case Instrument::RTest:
-        used = k < 3;
-        break;
-      case Instrument::Ballbar:
-        used = k == static_cast<std::size_t>(kRadialOutput);
-        break;
-      case Instrument::Line6d:
-        used = k >= static_cast<std::size_t>(kLinePositioning);
-        break;
+     << " observations";
+  if (!budget)
+    os << "; at least " << r.minimum_units << " " << units
+       << " for full rank (the sequential design needed " << r.greedy_units << ")";
+  os << "\nnoise:";
+  if (budget) {
+    for (std::size_t i = 0; i < r.instruments.size(); ++i)
+      os << (i ? ";" : "") << " " << instrument_name(r.instruments[i])
+         << noise_text(observed_kinds(r.instruments[i]), setup_of(r, r.instruments[i]).noise);
+    os << "\ntime: " << duration_text(r.time_used_s) << " of "
+       << duration_text(run.options.budget_s) << ":";
+    for (std::size_t i = 0; i < r.time_use.size(); ++i) {
+      const TimeUse& t = r.time_use[i];
+      const PlanSetup& s = r.candidates.setups[t.setup];
+      std::string word = unit_word(s.instrument);
+      if (t.units == 1) word.pop_back();  // "1 circle"
+      os << (i ? ";" : "") << " " << s.tag << " " << duration_text(t.setup_s) << " + " << t.units
+         << " " << word << " " << duration_text(t.units_s);
     }
-    if (used)
-      os << " " << observation_name(k) << " " << format_significant(r.noise[k], 3) << " "
-         << observation_unit(k);
+  } else {
+    os << noise_text(observed_kinds(r.instrument), r.noise);
   }
   os << "\n\nlayout                      units  rank  prediction SD  vs plan   O1        O2        "
         "O3        O4        O5\n";
@@ -258,8 +319,7 @@ std::string plan_text(const PlanRun& run, const std::vector<std::string>& files)
        << " um" << std::setw(9)
        << (is_plan
                ? std::string("")
-               : format_significant(100 * (1 - r.plan.prediction_sd_um / f.prediction_sd_um), 2) +
-                     " %");
+               : below_text(r.plan.prediction_sd_um, f.prediction_sd_um) + (f.lost ? "*" : " "));
     for (double v : {f.observability.o1, f.observability.o2, f.observability.o3, f.observability.o4,
                      f.observability.o5})
       os << std::setw(10) << format_significant(v, 3);
@@ -269,11 +329,17 @@ std::string plan_text(const PlanRun& run, const std::vector<std::string>& files)
   for (const LayoutFigures& f : r.compare) row(f, false);
   os << "(prediction SD: √ of the mean variance of dx, dy, dz over a 5-level grid of every "
         "axis's travel; 'vs plan': how much lower the plan's is)\n";
+  if (budget && r.plan.lost)
+    os << "note: within " << duration_text(run.options.budget_s) << " the plan determines "
+       << r.plan.rank << " of the " << r.candidate_rank
+       << " combinations the candidates identify; its prediction SD leaves the other "
+       << r.plan.lost << " out (a bias of unknown size): a longer budget determines them\n";
   for (const LayoutFigures& f : r.compare)
     if (f.lost)
       os << "note: " << f.name << " does not determine " << f.lost << " of the " << r.candidate_rank
          << " combinations the candidates identify: its prediction SD "
-         << "leaves them out (they are a bias of unknown size)\n";
+         << "leaves them out (they are a bias of unknown size), so its 'vs plan' (*) flatters "
+            "it\n";
   if (r.bound_iterations) {
     os << "bound (continuous design, " << r.bound_iterations
        << " iterations): no design of this size on these candidates reaches a prediction SD "
@@ -293,7 +359,7 @@ std::string plan_text(const PlanRun& run, const std::vector<std::string>& files)
          << ")";
     os << "; the fewest reaching it: " << r.plan.layout.size() << "\n";
   }
-  os << "\nplanned " << unit_word(r.instrument) << ":\n";
+  os << "\nplanned " << units << ":\n";
   for (std::size_t i = 0; i < r.plan.layout.size(); ++i) {
     const PlanUnit& u = r.plan.layout[i];
     const PlanSetup& s = r.candidates.setups[u.setup];

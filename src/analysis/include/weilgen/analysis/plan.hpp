@@ -36,6 +36,8 @@ enum class Instrument { Points, Line6d, Ballbar, RTest };
 // "points", "line6d", "ballbar", "rtest"; std::invalid_argument naming `flag` otherwise.
 Instrument parse_instrument(const std::string& text, const std::string& flag = "--instrument");
 const char* instrument_name(Instrument instrument);
+// The observation kinds (identify.hpp: 0-2 dx dy dz, kRadialOutput, kLine*) an instrument measures.
+std::vector<std::size_t> observed_kinds(Instrument instrument);
 
 // The noise of each observation kind (identify.hpp kinds: dx … dc, dr, lin, str, ang), µm or µrad.
 using KindNoise = std::array<double, kObservationKinds>;
