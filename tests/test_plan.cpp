@@ -693,3 +693,109 @@ TEST_CASE("plan: candidates that cannot reach the machine's rank name what they 
   CHECK(j["unidentifiable"].size() == run.result.unidentifiable.size());
   CHECK(j["candidates"]["rank"] == run.result.candidate_rank);
 }
+
+TEST_CASE(
+    "plan --time-budget: ballbar and 6D laser within 3 h, the time kept, the files through "
+    "identify") {
+  const auto dir = test::fresh_dir("plan_budget");
+  std::ofstream(dir / "times.yaml")
+      << "ballbar: {setup: 5 min, pose: 2 min}\nline6d:\n  setup: 40 min\n  pose: 30 s\n";
+  const std::string common =
+      "plan vmc_3axis --quiet --instruments ballbar:1um,line6d:1um --times " +
+      (dir / "times.yaml").string() + " --angles 90 --json " + (dir / "plan.json").string();
+  const test::Run plan =
+      test::run(test::cli(common + " --time-budget 3h --out " + (dir / "poses.csv").string()));
+  REQUIRE(plan.status == 0);
+  const nlohmann::json pj = read_json(dir / "plan.json");
+  const nlohmann::json& tb = pj["time_budget"];
+  CHECK(tb["budget_s"].get<double>() == 3 * 3600.0);
+  // The time: each set-up's own time plus its units' at the times file's rates, within the budget.
+  std::map<std::string, std::size_t> per_setup;
+  for (const auto& u : pj["layout"]) ++per_setup[u["setup"].get<std::string>()];
+  std::set<std::string> instruments;
+  double used = 0;
+  std::size_t units = 0;
+  for (const auto& s : tb["setups"]) {
+    const bool ballbar = s["instrument"] == "ballbar";
+    instruments.insert(s["instrument"].get<std::string>());
+    CHECK(s["setup_s"].get<double>() == (ballbar ? 300.0 : 2400.0));
+    CHECK(s["units_s"].get<double>() == s["units"].get<double>() * (ballbar ? 120.0 : 30.0));
+    CHECK(s["units"].get<std::size_t>() == per_setup[s["setup"].get<std::string>()]);
+    used += s["setup_s"].get<double>() + s["units_s"].get<double>();
+    units += s["units"].get<std::size_t>();
+  }
+  CHECK(units == pj["units"].get<std::size_t>());
+  CHECK(used == doctest::Approx(tb["used_s"].get<double>()));
+  CHECK(used <= 3 * 3600.0 + 1e-6);
+  // Together the instruments determine everything the candidates can; neither alone does.
+  CHECK(instruments == std::set<std::string>{"ballbar", "line6d"});
+  CHECK(pj["rank"] == pj["candidates"]["rank"]);
+  REQUIRE(pj["compare"].size() == 2);
+  for (const auto& c : pj["compare"]) {
+    CHECK(c["name"].get<std::string>().find(" alone") != std::string::npos);
+    CHECK(c["rank"].get<std::size_t>() < pj["rank"].get<std::size_t>());
+    CHECK(c["lost_combinations"].get<std::size_t>() > 0);
+  }
+  CHECK(plan.out.find("time: 3 h of 3 h") != std::string::npos);
+  CHECK(plan.out.find("noise: ballbar dr 1 µm; line6d lin 1 µm") != std::string::npos);
+
+  // Measure every file the plan wrote (the exact chain, set-up references, 1 µm and 1 µrad
+  // noise); identify reads them all unedited and reaches the plan's rank.
+  REQUIRE(pj["files"].size() == tb["setups"].size());
+  const auto model = test::builtin_model("vmc_3axis");
+  const Truth truth(*model, 31);
+  Measurement measure(*model, truth, 1.0, 9);
+  std::string data;
+  for (const auto& f : pj["files"]) {
+    const std::string path = f.get<std::string>();
+    const std::string filled = fill(test::read_text(path), std::ref(measure));
+    std::ofstream(path) << filled;
+    data += " --data " + path;
+  }
+  const test::Run id = test::run(
+      test::cli("identify vmc_3axis --quiet" + data + " --json " + (dir / "id.json").string()));
+  REQUIRE(id.status == 0);
+  const nlohmann::json ij = read_json(dir / "id.json");
+  CHECK(ij["rank"] == pj["rank"]);
+  CHECK(ij["residual_sigma"].get<double>() == doctest::Approx(1.0).epsilon(0.25));
+  const ErrorParameterisation param(model->description(), {}, model->parameters());
+  const std::vector<double> t = truth.theta(param);
+  std::size_t checked = 0;
+  for (std::size_t p = 0; p < param.size(); ++p) {
+    const nlohmann::json& est = ij["parameters"][p];
+    const nlohmann::json& pred = pj["parameters"][p];
+    CHECK(est["identifiable"] == pred["identifiable"]);
+    if (!est["identifiable"].get<bool>()) continue;
+    CAPTURE(param.parameters()[p].label);
+    CHECK(std::abs(est["value"].get<double>() - t[p]) < 4.5 * pred["sd"].get<double>());
+    ++checked;
+  }
+  CHECK(checked > 20);
+
+  // 20 min: no 6D laser set-up (40 min) fits, two circles (7 min each) do; the plan says what it
+  // cannot determine within the budget.
+  std::filesystem::remove(dir / "plan.json");
+  const test::Run tight = test::run(test::cli(common + " --time-budget 20min"));
+  REQUIRE(tight.status == 0);
+  const nlohmann::json tj = read_json(dir / "plan.json");
+  CHECK(tj["time_budget"]["used_s"].get<double>() <= 1200);
+  CHECK(tj["units"] == 2);
+  for (const auto& s : tj["time_budget"]["setups"]) CHECK(s["instrument"] == "ballbar");
+  CHECK(tj["rank"].get<std::size_t>() < tj["candidates"]["rank"].get<std::size_t>());
+  CHECK(tight.out.find("a longer budget determines them") != std::string::npos);
+
+  // Nothing fits: exit 2 naming the flag; a bad times file: exit 3 with its line and column.
+  std::filesystem::remove(dir / "plan.json");
+  const test::Run none = test::run(test::cli(common + " --time-budget 1min"));
+  CHECK(none.status == 2);
+  CHECK(none.out.find("--time-budget: no set-up and unit fit") != std::string::npos);
+  std::ofstream(dir / "bad.yaml")
+      << "ballbar: {setup: 5 min, pose: 2 min}\nline6d:\n  posse: 30 s\n";
+  const test::Run bad = test::run(
+      test::cli("plan vmc_3axis --quiet --instruments ballbar:1um "
+                "--time-budget 1h --json " +
+                (dir / "plan.json").string() + " --times " + (dir / "bad.yaml").string()));
+  CHECK(bad.status == 3);
+  CHECK(bad.out.find("bad.yaml:3:3: line6d: unknown key 'posse'") != std::string::npos);
+  CHECK_FALSE(std::filesystem::exists(dir / "plan.json"));
+}
