@@ -610,7 +610,7 @@ TEST_CASE("plan: every instrument on every shipped machine, or a clear refusal")
   }
 }
 
-TEST_CASE("plan: the same plan for any thread count; --include poses stay") {
+TEST_CASE("plan: the same plan for any thread count, --include poses stay") {
   PlanRequest rq = request("two_axis", "points", 20);
   rq.threads = 1;
   const PlanRun one = run_plan(rq);

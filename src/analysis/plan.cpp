@@ -242,100 +242,84 @@ void PlanOptions::validate() const {
 
 Planner::Planner(PlanOptions options) : options_(std::move(options)) { options_.validate(); }
 
-PlanResult Planner::run(const PlanInput& in) const {
-  const auto t0 = std::chrono::steady_clock::now();
-  const PlanOptions& o = options_;
-  const Description& d = in.model->description();
-  PlanResult R;
-  R.instrument = in.instrument;
-  R.instruments = in.instruments;
-  R.candidates = in.candidates;
-  R.noise = in.noise;
-  // The free parameters: identify's --fix.
-  std::vector<bool> fixed(in.param->size(), false);
-  for (const std::string& f : o.fixed)
-    for (const ErrorTarget& t : select_errors(d, f, "--fix " + quoted(f)))
-      for (std::size_t p = 0; p < in.param->size(); ++p)
-        if (in.param->parameters()[p].error == static_cast<int>(t.error)) fixed[p] = true;
-  std::vector<std::size_t> cols;
-  for (std::size_t p = 0; p < in.param->size(); ++p)
-    if (!fixed[p]) cols.push_back(p);
-  if (cols.empty()) throw std::invalid_argument("--fix: every error is fixed: nothing to plan");
-  R.free_parameters = cols.size();
-  Context cx(in, o, cols);
-  // The volumetric prediction grid.
-  {
-    const PointData g = prediction_grid(d);
-    const MatrixXd G = design_matrix(*in.model, *in.param, g);
-    MatrixXd Gf(G.rows(), static_cast<Eigen::Index>(cols.size()));
-    for (std::size_t q = 0; q < cols.size(); ++q)
-      Gf.col(static_cast<Eigen::Index>(q)) = G.col(static_cast<Eigen::Index>(cols[q]));
-    cx.Wg = Gf.transpose() * Gf / static_cast<double>(G.rows());
-  }
-  // Every candidate at once: what identify would determine from all of them.
-  std::vector<std::size_t> all(in.candidates.units.size());
-  std::iota(all.begin(), all.end(), 0);
-  {
-    EquilibratedSvd all_svd(MatrixXd::Zero(1, 1), 0.5, false);
-    const LayoutFigures every =
-        evaluate(cx, "every candidate", in.candidates.units, nullptr, &all_svd, nullptr, false);
-    R.candidate_rank = every.rank;
-    R.unidentifiable = null_combinations(all_svd, cols);
-  }
-  // The frame from every candidate: at most identify's rank and the set-up references'.
-  const std::vector<MatrixXd> blocks = cx.model.blocks(in.candidates.units, true);
-  cx.frame = make_frame(blocks, o.rank_tolerance,
-                        static_cast<Eigen::Index>(R.candidate_rank + cx.model.nuisance()));
-  {
-    const Eigen::Index w = cx.frame.scale.size(), nf = static_cast<Eigen::Index>(cols.size());
-    MatrixXd Wfull = MatrixXd::Zero(w, w);
-    Wfull.topLeftCorner(nf, nf) = cx.Wg;
-    const VectorXd inv = cx.frame.scale.cwiseInverse();
-    // Prediction rows are θ rows: in the frame's scaled coordinates they are g·S⁻¹... the
-    // weight of φ = S θ is S⁻¹ Wg S⁻¹.
-    const MatrixXd Ws = inv.asDiagonal() * Wfull * inv.asDiagonal();
-    cx.frame.W = cx.frame.Q.transpose() * Ws * cx.frame.Q;
-  }
-  const Eigen::Index r = cx.frame.Q.cols();
-  std::size_t widest = 1;
-  for (const MatrixXd& z : cx.frame.Z)
-    widest = std::max<std::size_t>(widest, static_cast<std::size_t>(z.rows()));
-  R.minimum_units = std::max<std::size_t>(in.candidates.forced.size(),
-                                          (static_cast<std::size_t>(r) + widest - 1) / widest);
-  R.greedy_units = greedy_rank_units(cx.frame, in.candidates.forced);
+namespace {
 
-  const char* what = in.instrument == Instrument::Ballbar  ? "circles"
-                     : in.instrument == Instrument::Line6d ? "positions"
-                                                           : "poses";
-  auto plan_of = [&](std::size_t n) {
-    DesignProblem p;
-    p.units = cx.frame.Z;
-    p.weight = cx.frame.W;
-    p.forced = in.candidates.forced;
-    ExchangeOptions eo;
-    eo.criterion = o.criterion;
-    eo.size = n;
-    eo.restarts = o.restarts;
-    eo.seed = o.seed;
-    eo.threads = o.threads;
-    R.exchange = ExchangeDesign(eo).run(p);
-    return evaluate_candidates(cx, "plan", R.exchange.selected);
-  };
-  const std::size_t candidates = in.candidates.units.size();
-  auto check_size = [&](std::size_t n, const std::string& flag) {
-    if (n < R.minimum_units)
-      throw std::invalid_argument(
-          flag + ": " + std::to_string(n) + " " + what + " cannot determine the " +
-          std::to_string(r) + " combinations the candidates identify (at most " +
-          std::to_string(widest) + " per unit): at least " + std::to_string(R.minimum_units) +
-          " are needed, and the sequential design reaches full rank with " +
-          std::to_string(R.greedy_units));
-    if (n > candidates)
-      throw std::invalid_argument(flag + ": " + std::to_string(n) + " " + what + " but only " +
-                                  std::to_string(candidates) +
-                                  " candidates (give more with --candidates)");
-  };
-  if (o.target_sd_um > 0) {
+using namespace plan_detail;
+
+// The steps of Planner::run, in order; each fills its part of the result.
+class PlanSteps {
+ public:
+  PlanSteps(Context& cx, PlanResult& R)
+      : cx_(cx), R_(R), in_(cx.in), o_(cx.o), d_(cx.in.model->description()) {
+    what_ = in_.instrument == Instrument::Ballbar  ? "circles"
+            : in_.instrument == Instrument::Line6d ? "positions"
+                                                   : "poses";
+  }
+
+  // The volumetric prediction grid, what every candidate determines, the exchange's frame, the
+  // fewest units that can reach the rank.
+  void prepare() {
+    Context& cx = cx_;
+    PlanResult& R = R_;
+    const PlanInput& in = in_;
+    const PlanOptions& o = o_;
+    const Description& d = d_;
+    const std::vector<std::size_t>& cols = cx.cols;
+    all_.resize(in.candidates.units.size());
+    std::iota(all_.begin(), all_.end(), 0);
+    // The volumetric prediction grid.
+    {
+      const PointData g = prediction_grid(d);
+      const MatrixXd G = design_matrix(*in.model, *in.param, g);
+      MatrixXd Gf(G.rows(), static_cast<Eigen::Index>(cols.size()));
+      for (std::size_t q = 0; q < cols.size(); ++q)
+        Gf.col(static_cast<Eigen::Index>(q)) = G.col(static_cast<Eigen::Index>(cols[q]));
+      cx.Wg = Gf.transpose() * Gf / static_cast<double>(G.rows());
+    }
+    // Every candidate at once: what identify would determine from all of them.
+    {
+      EquilibratedSvd all_svd(MatrixXd::Zero(1, 1), 0.5, false);
+      const LayoutFigures every =
+          evaluate(cx, "every candidate", in.candidates.units, nullptr, &all_svd, nullptr, false);
+      R.candidate_rank = every.rank;
+      R.unidentifiable = null_combinations(all_svd, cols);
+    }
+    // The frame from every candidate: at most identify's rank and the set-up references'.
+    const std::vector<MatrixXd> blocks = cx.model.blocks(in.candidates.units, true);
+    cx.frame = make_frame(blocks, o.rank_tolerance,
+                          static_cast<Eigen::Index>(R.candidate_rank + cx.model.nuisance()));
+    {
+      const Eigen::Index w = cx.frame.scale.size(), nf = static_cast<Eigen::Index>(cols.size());
+      MatrixXd Wfull = MatrixXd::Zero(w, w);
+      Wfull.topLeftCorner(nf, nf) = cx.Wg;
+      const VectorXd inv = cx.frame.scale.cwiseInverse();
+      // Prediction rows are θ rows: in the frame's scaled coordinates they are g·S⁻¹... the
+      // weight of φ = S θ is S⁻¹ Wg S⁻¹.
+      const MatrixXd Ws = inv.asDiagonal() * Wfull * inv.asDiagonal();
+      cx.frame.W = cx.frame.Q.transpose() * Ws * cx.frame.Q;
+    }
+    r_ = cx.frame.Q.cols();
+    for (const MatrixXd& z : cx.frame.Z)
+      widest_ = std::max<std::size_t>(widest_, static_cast<std::size_t>(z.rows()));
+    R.minimum_units = std::max<std::size_t>(in.candidates.forced.size(),
+                                            (static_cast<std::size_t>(r_) + widest_ - 1) / widest_);
+    R.greedy_units = greedy_rank_units(cx.frame, in.candidates.forced);
+  }
+
+  // --poses N.
+  void plan_count() {
+    check_size(o_.units, "--poses");
+    R_.plan = plan_of(o_.units);
+  }
+
+  // --target-sd: the fewest units whose plan reaches the target.
+  void plan_target() {
+    Context& cx = cx_;
+    PlanResult& R = R_;
+    const PlanOptions& o = o_;
+    const std::vector<std::size_t>& all = all_;
+    const char* what = what_;
+    const std::size_t candidates = in_.candidates.units.size();
     // The fewest units whose plan reaches the target: the candidates' own figure first (no
     // plan of fewer can do better), then upward from the minimum and a bisection.
     const LayoutFigures every = evaluate_candidates(cx, "every candidate", all);
@@ -405,21 +389,26 @@ PlanResult Planner::run(const PlanInput& in) const {
       R.plan = seen.at(hi);
     }
     R.plan.name = "plan";
-  } else if (o.budget_s > 0) {
-    plan_budget(cx, R);
-  } else {
-    check_size(o.units, "--poses");
-    R.plan = plan_of(o.units);
   }
-  if (R.plan.rank < R.candidate_rank && !(o.budget_s > 0))
-    throw std::invalid_argument("--poses: the " + std::to_string(R.plan.units.size()) +
-                                " planned " + what + " reach rank " + std::to_string(R.plan.rank) +
-                                " of the candidates' " + std::to_string(R.candidate_rank) +
-                                "; the sequential design reaches full rank with " +
-                                std::to_string(R.greedy_units));
-  const std::size_t n = R.plan.units.size();
-  R.plan.lost = R.candidate_rank - R.plan.rank;
-  if (o.bound_iterations > 0) {
+
+  // Count and target modes plan the candidates' full rank.
+  void check_rank() const {
+    const PlanResult& R = R_;
+    if (R.plan.rank < R.candidate_rank)
+      throw std::invalid_argument(
+          "--poses: the " + std::to_string(R.plan.units.size()) + " planned " + what_ +
+          " reach rank " + std::to_string(R.plan.rank) + " of the candidates' " +
+          std::to_string(R.candidate_rank) + "; the sequential design reaches full rank with " +
+          std::to_string(R.greedy_units));
+  }
+
+  // --bound: the continuous design's bound for the plan's size.
+  void add_bound() {
+    Context& cx = cx_;
+    PlanResult& R = R_;
+    const PlanOptions& o = o_;
+    const std::size_t n = R.plan.units.size();
+    const Eigen::Index r = r_;
     DesignProblem p;
     p.units = cx.frame.Z;
     p.weight = cx.frame.W;
@@ -433,7 +422,15 @@ PlanResult Planner::run(const PlanInput& in) const {
                                   .for_units(n, o.criterion, rr);
     R.bound_iterations = o.bound_iterations;
   }
-  if (o.compare && !(o.budget_s > 0)) {
+
+  // The regular layout and the best of the random sets, of the plan's size.
+  void add_comparisons() {
+    Context& cx = cx_;
+    PlanResult& R = R_;
+    const PlanInput& in = in_;
+    const PlanOptions& o = o_;
+    const std::vector<std::size_t>& all = all_;
+    const std::size_t n = R.plan.units.size();
     std::string name;
     const std::vector<PlanUnit> grid = regular_layout(in, n, name, o.seed);
     R.compare.push_back(evaluate(cx, name, grid, nullptr));
@@ -465,9 +462,15 @@ PlanResult Planner::run(const PlanInput& in) const {
     for (LayoutFigures& f : R.compare)
       f.lost = R.candidate_rank > f.rank ? R.candidate_rank - f.rank : 0;
   }
+
   // The prediction SD map of the plan over two axes (the first two linear ones, else the first
   // two), the others at the middle of their travel.
-  {
+  void add_sd_map() {
+    Context& cx = cx_;
+    PlanResult& R = R_;
+    const PlanInput& in = in_;
+    const Description& d = d_;
+    const std::vector<std::size_t>& cols = cx.cols;
     MatrixXd cov;
     evaluate(cx, "plan", R.plan.layout, nullptr, nullptr, &cov);
     std::vector<std::size_t> axes;
@@ -517,6 +520,90 @@ PlanResult Planner::run(const PlanInput& in) const {
       map.sd_um.push_back(std::sqrt(std::max(0.0, (var[p] + var[p + 1] + var[p + 2]) / 3)));
     map.middle = middle;
   }
+
+ private:
+  LayoutFigures plan_of(std::size_t n) {
+    DesignProblem p;
+    p.units = cx_.frame.Z;
+    p.weight = cx_.frame.W;
+    p.forced = in_.candidates.forced;
+    ExchangeOptions eo;
+    eo.criterion = o_.criterion;
+    eo.size = n;
+    eo.restarts = o_.restarts;
+    eo.seed = o_.seed;
+    eo.threads = o_.threads;
+    R_.exchange = ExchangeDesign(eo).run(p);
+    return evaluate_candidates(cx_, "plan", R_.exchange.selected);
+  }
+
+  void check_size(std::size_t n, const std::string& flag) const {
+    const std::size_t candidates = in_.candidates.units.size();
+    if (n < R_.minimum_units)
+      throw std::invalid_argument(
+          flag + ": " + std::to_string(n) + " " + what_ + " cannot determine the " +
+          std::to_string(r_) + " combinations the candidates identify (at most " +
+          std::to_string(widest_) + " per unit): at least " + std::to_string(R_.minimum_units) +
+          " are needed, and the sequential design reaches full rank with " +
+          std::to_string(R_.greedy_units));
+    if (n > candidates)
+      throw std::invalid_argument(flag + ": " + std::to_string(n) + " " + what_ + " but only " +
+                                  std::to_string(candidates) +
+                                  " candidates (give more with --candidates)");
+  }
+
+  Context& cx_;
+  PlanResult& R_;
+  const PlanInput& in_;
+  const PlanOptions& o_;
+  const Description& d_;
+  const char* what_ = "poses";
+  std::vector<std::size_t> all_;  // every candidate's index
+  std::size_t widest_ = 1;        // the most rows of one unit
+  Eigen::Index r_ = 0;            // the frame's rank
+};
+
+// The free parameters: identify's --fix.
+std::vector<std::size_t> free_columns(const PlanInput& in, const PlanOptions& o) {
+  const Description& d = in.model->description();
+  std::vector<bool> fixed(in.param->size(), false);
+  for (const std::string& f : o.fixed)
+    for (const ErrorTarget& t : select_errors(d, f, "--fix " + quoted(f)))
+      for (std::size_t p = 0; p < in.param->size(); ++p)
+        if (in.param->parameters()[p].error == static_cast<int>(t.error)) fixed[p] = true;
+  std::vector<std::size_t> cols;
+  for (std::size_t p = 0; p < in.param->size(); ++p)
+    if (!fixed[p]) cols.push_back(p);
+  if (cols.empty()) throw std::invalid_argument("--fix: every error is fixed: nothing to plan");
+  return cols;
+}
+
+}  // namespace
+
+PlanResult Planner::run(const PlanInput& in) const {
+  const auto t0 = std::chrono::steady_clock::now();
+  const PlanOptions& o = options_;
+  PlanResult R;
+  R.instrument = in.instrument;
+  R.instruments = in.instruments;
+  R.candidates = in.candidates;
+  R.noise = in.noise;
+  Context cx(in, o, free_columns(in, o));
+  R.free_parameters = cx.cols.size();
+  PlanSteps steps(cx, R);
+  steps.prepare();
+  if (o.target_sd_um > 0) {
+    steps.plan_target();
+  } else if (o.budget_s > 0) {
+    plan_budget(cx, R);  // plan_budget.cpp
+  } else {
+    steps.plan_count();
+  }
+  if (!(o.budget_s > 0)) steps.check_rank();
+  R.plan.lost = R.candidate_rank - R.plan.rank;
+  if (o.bound_iterations > 0) steps.add_bound();
+  if (o.compare && !(o.budget_s > 0)) steps.add_comparisons();
+  steps.add_sd_map();
   R.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return R;
 }

@@ -104,6 +104,63 @@ struct Choice {
   bool found = false;
 };
 
+// The set-ups a selection of candidate units uses, with their units and times.
+std::vector<TimeUse> time_use(const PlanCandidates& c, const std::vector<std::size_t>& selected) {
+  std::vector<TimeUse> out;
+  std::set<std::size_t> setups;
+  for (std::size_t j : selected) setups.insert(c.units[j].setup);
+  for (std::size_t s : setups) {
+    TimeUse t;
+    t.setup = s;
+    t.units = static_cast<std::size_t>(std::count_if(
+        selected.begin(), selected.end(), [&](std::size_t j) { return c.units[j].setup == s; }));
+    t.setup_s = c.setups[s].setup_s;
+    t.units_s = c.setups[s].pose_s * static_cast<double>(t.units);
+    out.push_back(t);
+  }
+  return out;
+}
+
+// Each unit's rows enter the criteria only through ZᵀZ: a circle's hundreds of rows become as
+// many as its rank (L with LᵀL = ZᵀZ), which the exchange's updates are cubic in.
+std::vector<MatrixXd> compact_units(const Frame& frame) {
+  const Eigen::Index r = frame.Q.cols();
+  std::vector<MatrixXd> out(frame.Z.size());
+  for (std::size_t j = 0; j < frame.Z.size(); ++j) {
+    const MatrixXd& z = frame.Z[j];
+    if (z.rows() <= r) {
+      out[j] = z;
+      continue;
+    }
+    const Eigen::SelfAdjointEigenSolver<MatrixXd> es(z.transpose() * z);
+    const double cut = 1e-14 * std::max(es.eigenvalues().maxCoeff(), 0.0);
+    const Eigen::Index keep = (es.eigenvalues().array() > cut).count();
+    out[j] =
+        (es.eigenvectors().rightCols(keep) * es.eigenvalues().tail(keep).cwiseSqrt().asDiagonal())
+            .transpose();
+  }
+  return out;
+}
+
+// The rank of the information of a choice of set-ups (bit b: groups[b], or every ballbar circle
+// for the bit after them). A loose cut counts near-null directions as present: a choice is
+// skipped only when it surely cannot reach the rank.
+Eigen::Index union_rank(const std::vector<MatrixXd>& setup_info,
+                        const std::vector<PlanSetup>& setups,
+                        const std::vector<std::size_t>& groups, std::size_t mask) {
+  const Eigen::Index r = setup_info.front().rows();
+  MatrixXd m = MatrixXd::Zero(r, r);
+  for (std::size_t s = 0; s < setups.size(); ++s) {
+    const auto g = std::find(groups.begin(), groups.end(), s);
+    const std::size_t bit = g != groups.end() ? static_cast<std::size_t>(g - groups.begin())
+                                              : groups.size();  // a ballbar circle
+    if (mask >> bit & 1) m += setup_info[s];
+  }
+  const Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<MatrixXd>(m).eigenvalues();
+  const double cut = 1e-13 * std::max(ev.maxCoeff(), 0.0);
+  return static_cast<Eigen::Index>((ev.array() > cut).count());
+}
+
 }  // namespace
 
 void plan_budget(Context& cx, PlanResult& R) {
@@ -134,22 +191,7 @@ void plan_budget(Context& cx, PlanResult& R) {
   std::vector<MatrixXd> setup_info(c.setups.size(), MatrixXd::Zero(r, r));
   for (std::size_t j = 0; j < c.units.size(); ++j)
     setup_info[c.units[j].setup].noalias() += cx.frame.Z[j].transpose() * cx.frame.Z[j];
-  // Each unit's rows enter the criteria only through ZᵀZ: a circle's hundreds of rows become
-  // as many as its rank (L with LᵀL = ZᵀZ), which the exchange's updates are cubic in.
-  std::vector<MatrixXd> compact(c.units.size());
-  for (std::size_t j = 0; j < c.units.size(); ++j) {
-    const MatrixXd& z = cx.frame.Z[j];
-    if (z.rows() <= r) {
-      compact[j] = z;
-      continue;
-    }
-    const Eigen::SelfAdjointEigenSolver<MatrixXd> es(z.transpose() * z);
-    const double cut = 1e-14 * std::max(es.eigenvalues().maxCoeff(), 0.0);
-    const Eigen::Index keep = (es.eigenvalues().array() > cut).count();
-    compact[j] =
-        (es.eigenvectors().rightCols(keep) * es.eigenvalues().tail(keep).cwiseSqrt().asDiagonal())
-            .transpose();
-  }
+  const std::vector<MatrixXd> compact = compact_units(cx.frame);
   Choice best;
   std::map<Instrument, Choice> alone;
   auto run_mask = [&](std::size_t mask) {
@@ -199,14 +241,7 @@ void plan_budget(Context& cx, PlanResult& R) {
     for (std::size_t& j : ch.exchange.selected) j = index[j];
     ch.selected = ch.exchange.selected;
     ch.value = ch.exchange.value;
-    // The time: the set-ups actually used and their units.
-    std::set<std::size_t> setups;
-    for (std::size_t j : ch.selected) setups.insert(c.units[j].setup);
-    for (std::size_t s : setups)
-      ch.time_s += c.setups[s].setup_s +
-                   c.setups[s].pose_s * static_cast<double>(std::count_if(
-                                            ch.selected.begin(), ch.selected.end(),
-                                            [&](std::size_t j) { return c.units[j].setup == s; }));
+    for (const TimeUse& t : time_use(c, ch.selected)) ch.time_s += t.setup_s + t.units_s;
     ch.found = !ch.selected.empty();
     if (!ch.found) return;
     // Among equals (singular designs all −inf): the ridge's value, then the shorter time.
@@ -223,20 +258,6 @@ void plan_budget(Context& cx, PlanResult& R) {
   // First the choices whose union reaches the rank, then, when one of them gave a regular
   // design, only the single-instrument ones (each instrument alone, for the comparison);
   // otherwise every choice (the best singular design, by its ridge).
-  auto union_rank = [&](std::size_t mask) {
-    MatrixXd m = MatrixXd::Zero(r, r);
-    for (std::size_t b = 0; b < bits; ++b) {
-      if (!(mask >> b & 1)) continue;
-      for (std::size_t s = 0; s < c.setups.size(); ++s)
-        if (b < groups.size() ? s == groups[b] : c.setups[s].instrument == Instrument::Ballbar)
-          m += setup_info[s];
-    }
-    const Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<MatrixXd>(m).eigenvalues();
-    // A loose cut counts near-null directions as present: a choice is skipped only when it
-    // surely cannot reach the rank.
-    const double cut = 1e-13 * std::max(ev.maxCoeff(), 0.0);
-    return static_cast<Eigen::Index>((ev.array() > cut).count());
-  };
   auto single_instrument = [&](std::size_t mask) {
     std::set<Instrument> used;
     for (std::size_t b = 0; b < bits; ++b)
@@ -245,7 +266,7 @@ void plan_budget(Context& cx, PlanResult& R) {
   };
   std::vector<char> done(std::size_t{1} << bits, 0);
   for (std::size_t mask = 1; mask < (std::size_t{1} << bits); ++mask)
-    if (union_rank(mask) >= r) {
+    if (union_rank(setup_info, c.setups, groups, mask) >= r) {
       run_mask(mask);
       done[mask] = 1;
     }
@@ -259,18 +280,7 @@ void plan_budget(Context& cx, PlanResult& R) {
   R.plan = evaluate_candidates(cx, "plan", best.selected);
   R.plan.name = "plan";
   R.time_used_s = best.time_s;
-  std::set<std::size_t> setups;
-  for (std::size_t j : best.selected) setups.insert(c.units[j].setup);
-  for (std::size_t s : setups) {
-    TimeUse t;
-    t.setup = s;
-    t.units = static_cast<std::size_t>(
-        std::count_if(best.selected.begin(), best.selected.end(),
-                      [&](std::size_t j) { return c.units[j].setup == s; }));
-    t.setup_s = c.setups[s].setup_s;
-    t.units_s = c.setups[s].pose_s * static_cast<double>(t.units);
-    R.time_use.push_back(t);
-  }
+  R.time_use = time_use(c, best.selected);
   for (auto& [inst, ch] : alone) {
     if (!ch.found) continue;
     LayoutFigures f =
