@@ -415,6 +415,42 @@ nlohmann::json read_json(const std::filesystem::path& p) {
   return nlohmann::json::parse(test::read_text(p.string()));
 }
 
+// Measures every file the plan (its JSON `pj`) wrote, from the exact chain with set-up references
+// and `noise` (µm and µrad), and identifies from them all, unedited: identify reaches the plan's
+// rank, fits to the noise, and every parameter it identifies lies within 4.5 predicted SDs of the
+// truth's parameter of the same basis. Returns how many parameters were checked.
+std::size_t measure_and_identify(const Model& model, const Truth& truth, double noise,
+                                 unsigned seed, const nlohmann::json& pj,
+                                 const std::filesystem::path& dir) {
+  Measurement measure(model, truth, noise, seed);
+  std::string data;
+  for (const auto& f : pj["files"]) {
+    const std::string path = f.get<std::string>();
+    const std::string filled = fill(test::read_text(path), std::ref(measure));
+    std::ofstream(path) << filled;
+    data += " --data " + path;
+  }
+  const test::Run id = test::run(test::cli("identify " + model.description().name + " --quiet" +
+                                           data + " --json " + (dir / "id.json").string()));
+  REQUIRE(id.status == 0);
+  const nlohmann::json ij = read_json(dir / "id.json");
+  CHECK(ij["rank"] == pj["rank"]);
+  CHECK(ij["residual_sigma"].get<double>() == doctest::Approx(noise).epsilon(0.25));
+  const ErrorParameterisation param(model.description(), {}, model.parameters());
+  const std::vector<double> t = truth.theta(param);
+  std::size_t checked = 0;
+  for (std::size_t p = 0; p < param.size(); ++p) {
+    const nlohmann::json& est = ij["parameters"][p];
+    const nlohmann::json& pred = pj["parameters"][p];
+    CHECK(est["identifiable"] == pred["identifiable"]);
+    if (!est["identifiable"].get<bool>()) continue;
+    CAPTURE(param.parameters()[p].label);
+    CHECK(std::abs(est["value"].get<double>() - t[p]) < 4.5 * pred["sd"].get<double>());
+    ++checked;
+  }
+  return checked;
+}
+
 // 200 random poses with dx, dy, dz measured on the truth with N(0, noise²); the noise-free
 // truth in `exact` (µm).
 std::string verify_points(const Model& model, const Truth& truth, double noise, unsigned seed,
@@ -521,35 +557,7 @@ TEST_CASE("plan -> measure -> identify: the templates of ballbar, 6D line and R-
         (dir / "plan.json").string()));
     REQUIRE(plan.status == 0);
     const nlohmann::json pj = read_json(dir / "plan.json");
-    const Truth truth(*model, 23);
-    Measurement measure(*model, truth, c.noise, 8);
-    std::string data;
-    for (const auto& f : pj["files"]) {
-      const std::string path = f.get<std::string>();
-      const std::string filled = fill(test::read_text(path), std::ref(measure));
-      std::ofstream(path) << filled;
-      data += " --data " + path;
-    }
-    const test::Run id = test::run(test::cli(std::string("identify ") + c.machine + " --quiet" +
-                                             data + " --json " + (dir / "id.json").string()));
-    REQUIRE(id.status == 0);
-    const nlohmann::json ij = read_json(dir / "id.json");
-    CHECK(ij["rank"] == pj["rank"]);
-    CHECK(ij["residual_sigma"].get<double>() == doctest::Approx(c.noise).epsilon(0.25));
-    const ErrorParameterisation param(model->description(), {}, model->parameters());
-    const std::vector<double> t = truth.theta(param);
-    std::size_t checked = 0;
-    for (std::size_t p = 0; p < param.size(); ++p) {
-      const nlohmann::json& est = ij["parameters"][p];
-      const nlohmann::json& pred = pj["parameters"][p];
-      CHECK(est["identifiable"] == pred["identifiable"]);
-      if (!est["identifiable"].get<bool>()) continue;
-      const double sd = pred["sd"].get<double>();
-      CAPTURE(param.parameters()[p].label);
-      CHECK(std::abs(est["value"].get<double>() - t[p]) < 4.5 * sd);
-      ++checked;
-    }
-    CHECK(checked > 5);
+    CHECK(measure_and_identify(*model, Truth(*model, 23), c.noise, 8, pj, dir) > 5);
   }
 }
 
@@ -743,34 +751,7 @@ TEST_CASE(
   // noise); identify reads them all unedited and reaches the plan's rank.
   REQUIRE(pj["files"].size() == tb["setups"].size());
   const auto model = test::builtin_model("vmc_3axis");
-  const Truth truth(*model, 31);
-  Measurement measure(*model, truth, 1.0, 9);
-  std::string data;
-  for (const auto& f : pj["files"]) {
-    const std::string path = f.get<std::string>();
-    const std::string filled = fill(test::read_text(path), std::ref(measure));
-    std::ofstream(path) << filled;
-    data += " --data " + path;
-  }
-  const test::Run id = test::run(
-      test::cli("identify vmc_3axis --quiet" + data + " --json " + (dir / "id.json").string()));
-  REQUIRE(id.status == 0);
-  const nlohmann::json ij = read_json(dir / "id.json");
-  CHECK(ij["rank"] == pj["rank"]);
-  CHECK(ij["residual_sigma"].get<double>() == doctest::Approx(1.0).epsilon(0.25));
-  const ErrorParameterisation param(model->description(), {}, model->parameters());
-  const std::vector<double> t = truth.theta(param);
-  std::size_t checked = 0;
-  for (std::size_t p = 0; p < param.size(); ++p) {
-    const nlohmann::json& est = ij["parameters"][p];
-    const nlohmann::json& pred = pj["parameters"][p];
-    CHECK(est["identifiable"] == pred["identifiable"]);
-    if (!est["identifiable"].get<bool>()) continue;
-    CAPTURE(param.parameters()[p].label);
-    CHECK(std::abs(est["value"].get<double>() - t[p]) < 4.5 * pred["sd"].get<double>());
-    ++checked;
-  }
-  CHECK(checked > 20);
+  CHECK(measure_and_identify(*model, Truth(*model, 31), 1.0, 9, pj, dir) > 20);
 
   // 20 min: no 6D laser set-up (40 min) fits, two circles (7 min each) do; the plan says what it
   // cannot determine within the budget.

@@ -103,6 +103,15 @@ void PlanRequest::validate() const {
         "--candidates: give one pose file or grid items (AXIS=start:stop:count), not both");
 }
 
+std::vector<PathArg> PlanRequest::input_files() const {
+  std::vector<PathArg> inputs;
+  for (const std::string& c : candidates)
+    if (c.find('=') == std::string::npos) inputs.push_back({"--candidates", c});
+  for (const std::string& f : include) inputs.push_back({"--include", f});
+  if (!times.empty()) inputs.push_back({"--times", times});
+  return inputs;
+}
+
 PlanRun run_plan(const PlanRequest& rq) {
   rq.validate();
   PlanRun run;

@@ -101,10 +101,7 @@ int verb_plan(const Args& args) {
     return usage_error("plan", e.what());
   }
   std::vector<PathArg> inputs = study_inputs(flags);
-  for (const std::string& c : rq.candidates)
-    if (c.find('=') == std::string::npos) inputs.push_back({"--candidates", c});
-  for (const std::string& f : rq.include) inputs.push_back({"--include", f});
-  if (!rq.times.empty()) inputs.push_back({"--times", rq.times});
+  for (const PathArg& f : rq.input_files()) inputs.push_back(f);
   check_output_paths(inputs, {{"--out", out}, {"--json", json_path}, {"--plot", plot_path}});
   if (!plot_path.empty()) check_plot_target(plot_path);
 

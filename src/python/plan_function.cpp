@@ -61,12 +61,7 @@ py::object plan(py::handle machine, const py::kwargs& kwargs) {
   kw.set("out", out);
   kw.set("plot", plot);
   rq.validate();
-  // The files read, which no output may overwrite (as the CLI checks them).
-  std::vector<PathArg> inputs;
-  for (const std::string& c : rq.candidates)
-    if (c.find('=') == std::string::npos) inputs.push_back({"--candidates", c});
-  for (const std::string& f : rq.include) inputs.push_back({"--include", f});
-  if (!rq.times.empty()) inputs.push_back({"--times", rq.times});
+  const std::vector<PathArg> inputs = rq.input_files();
   check_output_paths(inputs, {{"--out", out}, {"--plot", plot}});
   if (!plot.empty()) check_plot_target(plot);
   const nlohmann::json doc = run_analysis([&] {

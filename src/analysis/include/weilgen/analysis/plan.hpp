@@ -19,6 +19,7 @@
 
 #include "weilgen/analysis/identify.hpp"
 #include "weilgen/analysis/study.hpp"
+#include "weilgen/base/output_paths.hpp"
 #include "weilgen/measure/ballbar.hpp"
 #include "weilgen/measure/measurement_csv.hpp"
 #include "weilgen/uq/optimal_design.hpp"
@@ -208,6 +209,8 @@ struct PlanRequest : MeasurementRequest {
   unsigned threads = 0;
   // The flags alone, before any file is read (std::invalid_argument naming the flag).
   void validate() const;
+  // The files the plan reads (--candidates FILE, --include, --times), which no output may be.
+  std::vector<PathArg> input_files() const;
 };
 
 struct PlanRun {
