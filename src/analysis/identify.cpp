@@ -19,175 +19,13 @@
 namespace weilgen {
 
 const char* observation_name(std::size_t output) {
-  return output == kRadialOutput ? "dr" : output_name(output);
+  static const char* const line[] = {"dr", "lin", "str", "ang"};
+  return output >= 6 ? line[output - 6] : output_name(output);
 }
 
 const char* observation_unit(std::size_t output) {
-  return output == kRadialOutput ? "µm" : measured_unit(output);
-}
-
-namespace {
-
-int error_of_name(const Description& d, const std::string& name, const std::string& what) {
-  const int k = d.error_index(name);
-  if (k < 0)
-    throw std::invalid_argument(what + ": unknown error '" + name + "' (machine " + d.name +
-                                " has " + join(error_names(d)) + ")");
-  return k;
-}
-
-}  // namespace
-
-PdgeBasisChoice parse_pdge_flags(const Description& desc, const std::vector<std::string>& flags,
-                                 PdgeBasisChoice base) {
-  for (const std::string& flag : flags) {
-    const auto eq = flag.find('=');
-    const std::string what = "--pdge \"" + flag + "\"";
-    try {
-      if (eq == std::string::npos) {
-        parse_basis(trim(flag));
-        base.all = trim(flag);
-      } else {
-        const std::string name = trim(flag.substr(0, eq)), spec = trim(flag.substr(eq + 1));
-        const int k = error_of_name(desc, name, what);
-        parse_basis(spec);
-        base.per_error.emplace_back(desc.errors[static_cast<std::size_t>(k)].name, spec);
-      }
-    } catch (const std::invalid_argument& e) {
-      const std::string m = e.what();
-      throw std::invalid_argument(m.rfind("--pdge", 0) == 0 ? m : what + ": " + m);
-    }
-  }
-  return base;
-}
-
-ErrorParameterisation::ErrorParameterisation(const Description& desc, const PdgeBasisChoice& choice,
-                                             std::vector<double> parameters)
-    : desc_(&desc), param_values_(std::move(parameters)) {
-  if (param_values_.empty())
-    for (const Parameter& p : desc.parameters) param_values_.push_back(p.value);
-  const std::vector<int> axes = desc.axes();
-  const std::size_t ne = desc.errors.size();
-  bases_.resize(ne);
-  first_.resize(ne);
-  axis_index_.assign(ne, -1);
-  coordinate_.resize(ne);
-  to_base_.resize(ne);
-  for (std::size_t k = 0; k < ne; ++k) {
-    const ErrorDef& e = desc.errors[k];
-    to_base_[k] = e.to_base;
-    first_[k] = params_.size();
-    const Joint& j = desc.bodies[static_cast<std::size_t>(e.body)].joint;
-    if (e.dependence == Dependence::PIGE || j.type == JointType::Fixed) {
-      params_.push_back({static_cast<int>(k), 0, e.name, e.unit});
-      continue;
-    }
-    // Precedence: per-error flag, run-wide flag, the error's basis, the machine's, fallback.
-    std::string spec = choice.fallback.empty() ? default_pdge_basis(j) : choice.fallback;
-    SourceLoc where;
-    const bool rotary = j.type == JointType::Revolute;
-    const std::string& machine = rotary ? desc.pdge_basis_revolute : desc.pdge_basis;
-    if (!machine.empty())
-      spec = machine, where = rotary ? desc.pdge_basis_revolute_loc : desc.pdge_basis_loc;
-    if (!e.basis.empty()) spec = e.basis, where = e.basis_loc;
-    if (choice.all) spec = *choice.all, where = {};
-    for (const auto& [name, s] : choice.per_error)
-      if (name == e.name) spec = s, where = {};
-    if (!(j.max > j.min)) {
-      throw InputError(j.loc, "joint " + j.coordinate + ": " + e.name +
-                                  " is position dependent but the joint has no travel range "
-                                  "(range: [min, max]) to place its basis on");
-    }
-    try {
-      bases_[k] = basis_on_joint(parse_basis(spec), j);
-    } catch (const std::invalid_argument& ex) {
-      if (where.line > 0) throw InputError(where, ex.what());
-      throw std::invalid_argument(e.name + ": " + ex.what());
-    }
-    coordinate_[k] = j.coordinate;
-    for (std::size_t a = 0; a < axes.size(); ++a)
-      if (axes[a] == e.body) axis_index_[k] = static_cast<int>(a);
-    const std::vector<std::string> names = bases_[k]->term_names();
-    for (std::size_t t = 0; t < names.size(); ++t)
-      params_.push_back({static_cast<int>(k), t, e.name + "[" + names[t] + "]", e.unit});
-  }
-}
-
-double ErrorParameterisation::position_of(std::size_t k, const double* axes) const {
-  if (axis_index_[k] >= 0) return axes[axis_index_[k]];
-  // A linked coordinate: evaluate the links from the independent axes and the parameters.
-  std::map<std::string, double> values;
-  for (std::size_t p = 0; p < desc_->parameters.size(); ++p)
-    values[desc_->parameters[p].name] = param_values_[p];
-  const std::vector<int> ax = desc_->axes();
-  for (std::size_t a = 0; a < ax.size(); ++a)
-    values[desc_->bodies[static_cast<std::size_t>(ax[a])].joint.coordinate] = axes[a];
-  resolve_links(*desc_, values);
-  return values.at(coordinate_[k]);
-}
-
-void ErrorParameterisation::derivatives(const double* axes, double* jac) const {
-  for (std::size_t k = 0; k < bases_.size(); ++k) {
-    double* out = jac + first_[k];
-    if (!bases_[k]) {
-      out[0] = to_base_[k];
-      continue;
-    }
-    bases_[k]->evaluate(position_of(k, axes), out);
-    for (std::size_t t = 0; t < bases_[k]->size(); ++t) out[t] *= to_base_[k];
-  }
-}
-
-void ErrorParameterisation::errors_at(const double* axes, const double* theta,
-                                      double* errors) const {
-  std::vector<double> jac(params_.size());
-  derivatives(axes, jac.data());
-  std::fill(errors, errors + bases_.size(), 0.0);
-  for (std::size_t p = 0; p < params_.size(); ++p) errors[params_[p].error] += jac[p] * theta[p];
-}
-
-PointData point_data(const MeasurementTable& table, const Description& desc) {
-  PointData out;
-  out.file = table.file;
-  std::vector<const std::vector<double>*> dev(6, nullptr);
-  bool any = false;
-  for (int o = 0; o < 6; ++o)
-    if (table.has(kDeviationColumns[o])) dev[o] = &table.column(kDeviationColumns[o]), any = true;
-  if (!any)
-    throw InputError(SourceLoc{table.file, table.header_line, 0},
-                     "no deviation column (dx_um, dy_um, dz_um, da_urad, db_urad, dc_urad; "
-                     "columns: " +
-                         join(table.columns) + ")");
-  std::vector<std::string> names;
-  std::vector<const std::vector<double>*> coord;
-  for (int b : desc.axes()) {
-    names.push_back(desc.bodies[static_cast<std::size_t>(b)].joint.coordinate);
-    coord.push_back(&table.column(names.back()));
-  }
-  out.poses.assign(table.rows(), std::vector<double>(names.size(), kNaN));
-  for (std::size_t r = 0; r < table.rows(); ++r) {
-    bool measured = false;
-    for (int o = 0; o < 6; ++o) measured = measured || (dev[o] && std::isfinite((*dev[o])[r]));
-    if (!measured) continue;
-    for (std::size_t a = 0; a < names.size(); ++a) {
-      const double v = (*coord[a])[r];
-      if (!std::isfinite(v))
-        throw InputError(table.cell(r, names[a]),
-                         "column '" + names[a] +
-                             "' is empty but a deviation is measured (every "
-                             "observation needs the machine's coordinates)");
-      out.poses[r][a] = v;
-    }
-    for (int o = 0; o < 6; ++o) {
-      if (!dev[o] || !std::isfinite((*dev[o])[r])) continue;
-      out.observations.push_back({r, table.lines[r], o, (*dev[o])[r]});
-      ++out.count[static_cast<std::size_t>(o)];
-    }
-  }
-  if (out.observations.empty())
-    throw InputError(SourceLoc{table.file, 0, 0},
-                     "no observations (no row has a measured deviation)");
-  return out;
+  if (output >= 6) return output == static_cast<std::size_t>(kLineAngular) ? "µrad" : "µm";
+  return measured_unit(output);
 }
 
 std::string NullCombination::str(const std::vector<IdentParameter>& params) const {
@@ -213,6 +51,8 @@ struct SvdSolve {
   SvdSolve(const MatrixXd& A, const VectorXd& y, double tol)
       : svd(A, tol, /*full_v=*/true), x(svd.solve(y)) {}
 };
+
+}  // namespace
 
 // Readable null-space basis: reduced row echelon form of Nᵀ (each combination has a leading
 // parameter the others do not contain), in θ units, leading coefficient 1.
@@ -247,8 +87,6 @@ std::vector<NullCombination> null_combinations(const EquilibratedSvd& s,
   return out;
 }
 
-}  // namespace
-
 MatrixXd design_matrix(const Model& model, const ErrorParameterisation& param,
                        const PointData& data) {
   const std::size_t m = data.observations.size(), np = param.size(), ne = model.num_errors();
@@ -264,6 +102,14 @@ MatrixXd design_matrix(const Model& model, const ErrorParameterisation& param,
       param.derivatives(pose, jac.data());
       last_row = ob.row;
     }
+    if (ob.error >= 0) {
+      // An error observed directly (a 6D line): µm per mm or µrad per rad of that error.
+      const double scale = error_measured_scale(model.description().errors[ob.error]);
+      for (std::size_t p = 0; p < np; ++p)
+        A(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(p)) =
+            param.parameters()[p].error == ob.error ? scale * jac[p] : 0.0;
+      continue;
+    }
     for (std::size_t p = 0; p < np; ++p) {
       const auto err = static_cast<std::size_t>(param.parameters()[p].error);
       double v = 0;
@@ -277,6 +123,43 @@ MatrixXd design_matrix(const Model& model, const ErrorParameterisation& param,
     }
   }
   return A;
+}
+
+std::size_t remove_references(const PointData& data, MatrixXd& A, VectorXd* y) {
+  std::size_t removed = 0;
+  for (const ObservationReference& ref : data.references) {
+    const auto n = static_cast<Eigen::Index>(ref.observations.size());
+    const auto k = static_cast<Eigen::Index>(ref.basis.size());
+    if (n == 0 || k == 0) continue;
+    MatrixXd N(n, k);
+    for (Eigen::Index j = 0; j < k; ++j)
+      for (Eigen::Index i = 0; i < n; ++i)
+        N(i, j) = ref.basis[static_cast<std::size_t>(j)][static_cast<std::size_t>(i)];
+    // An orthonormal basis of the functions' span at these observations (rank-revealing: a
+    // function the observations cannot tell from the others takes no degree of freedom).
+    const Eigen::ColPivHouseholderQR<MatrixXd> qr(N);
+    const auto rank = qr.rank();
+    if (rank == 0) continue;
+    const MatrixXd Q = MatrixXd(qr.householderQ()).leftCols(rank);
+    MatrixXd block(n, A.cols());
+    for (Eigen::Index i = 0; i < n; ++i)
+      block.row(i) =
+          A.row(static_cast<Eigen::Index>(ref.observations[static_cast<std::size_t>(i)]));
+    block -= Q * (Q.transpose() * block);
+    for (Eigen::Index i = 0; i < n; ++i)
+      A.row(static_cast<Eigen::Index>(ref.observations[static_cast<std::size_t>(i)])) =
+          block.row(i);
+    if (y) {
+      VectorXd v(n);
+      for (Eigen::Index i = 0; i < n; ++i)
+        v[i] = (*y)[static_cast<Eigen::Index>(ref.observations[static_cast<std::size_t>(i)])];
+      v -= Q * (Q.transpose() * v);
+      for (Eigen::Index i = 0; i < n; ++i)
+        (*y)[static_cast<Eigen::Index>(ref.observations[static_cast<std::size_t>(i)])] = v[i];
+    }
+    removed += static_cast<std::size_t>(rank);
+  }
+  return removed;
 }
 
 void IdentifyOptions::validate() const {
@@ -322,8 +205,10 @@ IdentifyResult Identification::run(const Model& model_, const ErrorParameterisat
   VectorXd y(static_cast<Eigen::Index>(m));
   for (std::size_t i = 0; i < m; ++i) y[static_cast<Eigen::Index>(i)] = data.observations[i].value;
 
-  // Linear model at zero error, without the fixed parameters.
-  const MatrixXd full = design_matrix(model_, param_, data);
+  // Linear model at zero error, without the fixed parameters; the set-up references removed
+  // from the data and the model alike.
+  MatrixXd full = design_matrix(model_, param_, data);
+  R.references = remove_references(data, full, &y);
   MatrixXd A(static_cast<Eigen::Index>(m), static_cast<Eigen::Index>(cols.size()));
   for (std::size_t q = 0; q < cols.size(); ++q)
     A.col(static_cast<Eigen::Index>(q)) = full.col(static_cast<Eigen::Index>(cols[q]));
@@ -333,17 +218,10 @@ IdentifyResult Identification::run(const Model& model_, const ErrorParameterisat
 
   // Residuals of the full model (exact at order 1; the Gauss-Newton objective above).
   auto residual = [&](const std::vector<double>& theta) {
-    VectorXd r(static_cast<Eigen::Index>(m));
-    std::size_t row = SIZE_MAX;
-    std::array<double, 6> f{};
-    for (std::size_t i = 0; i < m; ++i) {
-      const PointObservation& ob = data.observations[i];
-      if (ob.row != row) {
-        f = predict_deviation(model_, md, param_, theta, data.poses[ob.row].data());
-        row = ob.row;
-      }
-      r[static_cast<Eigen::Index>(i)] = ob.value - f[static_cast<std::size_t>(ob.output)];
-    }
+    VectorXd f = predict_observations(model_, md, param_, theta, data);
+    MatrixXd none(static_cast<Eigen::Index>(m), 0);
+    VectorXd r = y - f;
+    remove_references(data, none, &r);
     return r;
   };
   VectorXd r = model_.order() > 1 ? residual(R.theta) : VectorXd(y - A * S.x);
@@ -391,7 +269,8 @@ IdentifyResult Identification::run(const Model& model_, const ErrorParameterisat
   R.condition =
       sv.rank() ? sv.sigma()[0] / sv.sigma()[static_cast<Eigen::Index>(sv.rank() - 1)] : kNaN;
   const double sse = r.squaredNorm();
-  const double dof = static_cast<double>(m) - static_cast<double>(sv.rank());
+  const double dof =
+      static_cast<double>(m) - static_cast<double>(sv.rank()) - static_cast<double>(R.references);
   R.residual_sigma = dof > 0 ? std::sqrt(sse / dof) : kNaN;
   const Eigen::Index nf = static_cast<Eigen::Index>(cols.size());
   for (Eigen::Index q = 0; q < nf; ++q) {
@@ -406,18 +285,44 @@ IdentifyResult Identification::run(const Model& model_, const ErrorParameterisat
   }
   R.unidentifiable = null_combinations(sv, cols);
 
+  // Before: the measured values with the set-up references removed, as the fit sees them.
   PerOutputRms<kObservationKinds> before, after;
   for (std::size_t i = 0; i < m; ++i) {
     const auto o = static_cast<std::size_t>(data.observations[i].output);
-    before.add(o, data.observations[i].value);
+    before.add(o, y[static_cast<Eigen::Index>(i)]);
     after.add(o, r[static_cast<Eigen::Index>(i)]);
   }
-  for (std::size_t o = 0; o < 6; ++o) {
+  for (std::size_t o = 0; o < kObservationKinds; ++o) {
     R.rms_before[o] = before.rms(o);
     R.rms_after[o] = after.rms(o);
     R.max_after[o] = after.max_abs(o);
   }
   return R;
+}
+
+VectorXd predict_observations(const Model& model, ModelData& md, const ErrorParameterisation& param,
+                              const std::vector<double>& theta, const PointData& data) {
+  const Description& desc = model.description();
+  VectorXd f(static_cast<Eigen::Index>(data.observations.size()));
+  std::size_t row = SIZE_MAX;
+  std::array<double, 6> dev{};
+  std::vector<double> errors(desc.errors.size());
+  for (std::size_t i = 0; i < data.observations.size(); ++i) {
+    const PointObservation& ob = data.observations[i];
+    const double* pose = data.poses[ob.row].data();
+    if (ob.error >= 0) {
+      param.errors_at(pose, theta.data(), errors.data());
+      const auto k = static_cast<std::size_t>(ob.error);
+      f[static_cast<Eigen::Index>(i)] = error_measured_scale(desc.errors[k]) * errors[k];
+      continue;
+    }
+    if (ob.row != row) {
+      dev = predict_deviation(model, md, param, theta, pose);
+      row = ob.row;
+    }
+    f[static_cast<Eigen::Index>(i)] = observe(ob, dev);
+  }
+  return f;
 }
 
 std::array<double, 6> predict_deviation(const Model& model, ModelData& data,
@@ -428,28 +333,6 @@ std::array<double, 6> predict_deviation(const Model& model, ModelData& data,
   model.deviation(data, axes, data.errors.data(), out.data());
   for (std::size_t o = 0; o < 6; ++o) out[o] *= kMeasuredScale[o];
   return out;
-}
-
-// All --data files as one set of observations (rows keep their file for messages).
-PointData merged_point_data(const std::vector<std::string>& files, const Description& desc,
-                            const ReadOptions& ro,
-                            const std::function<void(const std::string&)>& warn) {
-  PointData all;
-  for (const std::string& f : files) {
-    const MeasurementTable t = read_measurements(f, ro);
-    if (warn)
-      for (const auto& w : t.warnings) warn(w);
-    PointData d = point_data(t, desc);
-    const std::size_t base = all.poses.size();
-    for (auto& p : d.poses) all.poses.push_back(std::move(p));
-    for (PointObservation ob : d.observations) {
-      ob.row += base;
-      all.observations.push_back(ob);
-    }
-    for (std::size_t o = 0; o < 6; ++o) all.count[o] += d.count[o];
-    all.file += (all.file.empty() ? "" : ", ") + f;
-  }
-  return all;
 }
 
 }  // namespace weilgen

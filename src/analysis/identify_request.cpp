@@ -34,7 +34,7 @@ IdentifyRun run_identify(const IdentifyRequest& rq) {
   const PdgeBasisChoice choice = parse_pdge_flags(desc, rq.pdge);
   for (const std::string& f : rq.fixed) select_errors(desc, f, "--fix " + quoted(f));
   const ReadOptions ro = machine_read_options(desc, rq.allow_unknown);
-  run.points = merged_point_data(rq.data, desc, ro, rq.warn);
+  run.points = merged_point_data(rq.data, desc, ro, rq.warn, rq.circle, rq.parameters(desc));
   std::vector<MeasurementTable> tables;
   for (const std::string& p : rq.predict) {
     tables.push_back(read_measurements(p, ro));

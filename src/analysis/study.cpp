@@ -115,6 +115,13 @@ Description MeasurementRequest::description() const {
   return opened ? opened->description() : load_machine_file(resolve_machine(model.machine));
 }
 
+std::vector<double> MeasurementRequest::parameters(const Description& desc) const {
+  if (opened) return opened->parameters();
+  std::vector<double> values;
+  for (const Parameter& p : desc.parameters) values.push_back(p.value);
+  return parse_params(desc, model.params, values);
+}
+
 std::shared_ptr<const Model> MeasurementRequest::open(const Description& desc) const {
   return opened ? opened : open_model(model, desc);
 }

@@ -254,6 +254,16 @@ PoseSet parse_poses(const Description& desc, const std::vector<std::string>& at,
   return set;
 }
 
+std::vector<std::pair<std::size_t, std::vector<double>>> parse_axis_values(
+    const Description& desc, const std::string& flag, const std::string& text) {
+  const std::vector<Axis> axes = machine_axes(desc);
+  const std::string context = flag_context(flag, text);
+  std::vector<std::pair<std::size_t, std::vector<double>>> out;
+  for (const auto& [index, value] : axis_items(desc, axes, text, context, kGridForm))
+    out.emplace_back(index, grid_axis_values(axes[index], value, context));
+  return out;
+}
+
 // ---- Outputs and tolerances -------------------------------------------------------------------
 
 std::vector<OutputTolerance> parse_tolerances(const std::vector<std::string>& flags) {
@@ -346,10 +356,28 @@ std::vector<ErrorTarget> select_errors(const Description& desc, const std::strin
     }
     return targets;
   }
+  if (name.compare(0, 5, "axis:") == 0) {
+    // Every error of the body an axis moves: its motion errors, and the location and squareness
+    // errors the machine file places on it.
+    const std::string axis = trim(name.substr(5));
+    std::vector<std::string> axes;
+    for (int b : desc.axes()) {
+      const std::string& c = desc.bodies[static_cast<std::size_t>(b)].joint.coordinate;
+      axes.push_back(c);
+      if (c != axis) continue;
+      for (std::size_t i = 0; i < desc.errors.size(); ++i)
+        if (desc.errors[i].body == b) targets.push_back({i, 1});
+    }
+    if (std::find(axes.begin(), axes.end(), axis) == axes.end())
+      fail(context, "unknown axis " + quoted(abbreviated(axis)) + " (machine " + desc.name +
+                        " has axes " + join(axes) + ")");
+    if (targets.empty()) fail(context, "axis " + axis + " has no errors in machine " + desc.name);
+    return targets;
+  }
   const int index = desc.error_index(name);
   if (index < 0) {
     fail(context, "unknown error " + quoted(abbreviated(name)) + " (machine " + desc.name +
-                      " has " + join(error_names(desc)) + "; or group:<group>)");
+                      " has " + join(error_names(desc)) + "; or group:<group>, axis:<axis>)");
   }
   int sign = 1;
   for (const Alias& a : desc.errors[static_cast<std::size_t>(index)].aliases) {

@@ -134,6 +134,38 @@ double parse_quantity(const std::string& text, const std::string& default_unit,
   return parse_quantity_unit(text, default_unit, what).value();
 }
 
+double parse_duration_s(const std::string& text, const std::string& default_unit,
+                        const std::string& what) {
+  const std::string t = trim(text);
+  std::size_t cut = t.size();
+  while (cut > 0 && std::isalpha(static_cast<unsigned char>(t[cut - 1]))) --cut;
+  const std::string unit = t.substr(cut).empty() ? default_unit : t.substr(cut);
+  double factor = 0;
+  if (unit == "s")
+    factor = 1;
+  else if (unit == "min")
+    factor = 60;
+  else if (unit == "h")
+    factor = 3600;
+  else
+    fail(what, "unit \"" + unit + "\" in \"" + abbreviated(t) + "\" is not a time (s, min, h)");
+  // The number as a quantity without unit (an expression allowed).
+  const std::string number = trim(t.substr(0, cut));
+  if (number.empty()) fail(what, "\"" + abbreviated(t) + "\" has no number before the unit");
+  Expr e;
+  try {
+    e = parse_expr(number);
+  } catch (const std::invalid_argument& ex) {
+    fail(what, "\"" + abbreviated(t) + "\" is not a number or expression: " + ex.what());
+  }
+  if (!e.params().empty())
+    fail(what,
+         "\"" + abbreviated(t) + "\" is not a number: unknown name \"" + e.params().front() + "\"");
+  const double v = e.eval({}) * factor;
+  if (!std::isfinite(v)) fail(what, "\"" + abbreviated(t) + "\" is not a finite number");
+  return v;
+}
+
 double parse_feedrate_mm_min(const std::string& text, const std::string& what) {
   static const std::pair<const char*, double> units[] = {
       {"mm/min", 1}, {"mm/s", 60}, {"m/min", 1000}, {"in/min", 25.4}, {"mm/sec", 60}};

@@ -66,6 +66,11 @@ const std::map<std::string, Verb>& verbs() {
         "identify <machine> --data FILE [--pdge poly:3|E_YY=fourier:3] [--predict FILE]\n"
         "      [--emit-params FILE]\n"
         "      fit the error parameters, report what cannot be identified, predict, emit"}},
+      {"plan",
+       {weilgen::cli::verb_plan,
+        "plan <machine> --poses N|--target-sd 2um [--instrument points|line6d|ballbar|rtest]\n"
+        "      [--noise 1um] [--criterion D|A|E|I] [--out poses.csv] [--json F] [--plot F]\n"
+        "      where to measure: the fewest poses that identify the machine, their uncertainty"}},
       {"gap",
        {weilgen::cli::verb_gap,
         "gap <machine> --data FILE [--holdout ...] [--effects ...] [--json F] [--report F.md]\n"

@@ -22,6 +22,7 @@ int verb_import(const Args& args);
 int verb_fit_pdge(const Args& args);
 int verb_identify(const Args& args);
 int verb_gap(const Args& args);
+int verb_plan(const Args& args);
 int verb_linuxcnc(const Args& args);
 
 // Prints "weilgen <verb>: <message>" to stderr and returns 2 (usage error).

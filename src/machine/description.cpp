@@ -64,6 +64,10 @@ std::vector<int> Description::axes() const {
   return out;
 }
 
+const Joint& Description::axis_joint(std::size_t axis) const {
+  return bodies[static_cast<std::size_t>(axes()[axis])].joint;
+}
+
 std::vector<int> Description::linked_axes() const {
   std::vector<int> out;
   for (size_t i = 0; i < bodies.size(); ++i) {

@@ -148,6 +148,7 @@ nlohmann::json run_analysis(const std::function<nlohmann::json()>& f);
 void register_study_functions(py::module_& m);    // sensitivity, reliability, allocate
 void register_data_functions(py::module_& m);     // iso230_2, fit_pdge, identify, gap
 void register_generate_function(py::module_& m);  // generate
+void register_plan_function(py::module_& m);      // plan
 
 template <typename T>
 void Keywords::set(const char* name, T& field) const {

@@ -21,4 +21,5 @@ PYBIND11_MODULE(_weilgen, m) {
   wp::register_study_functions(m);
   wp::register_data_functions(m);
   wp::register_generate_function(m);
+  wp::register_plan_function(m);
 }

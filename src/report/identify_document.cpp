@@ -13,10 +13,26 @@
 namespace weilgen {
 
 namespace {
+// "_um" or "_urad": the JSON key suffix of an observation kind's figures.
+std::string unit_suffix(std::size_t kind) {
+  return std::string(observation_unit(kind)) == "µrad" ? "_urad" : "_um";
+}
 
 }  // namespace
 
 using nlohmann::json;
+
+json null_combinations_json(const ErrorParameterisation& param,
+                            const std::vector<NullCombination>& combinations) {
+  json null = json::array();
+  for (const NullCombination& c : combinations) {
+    json terms = json::array();
+    for (const auto& [p, v] : c.terms)
+      terms.push_back({{"parameter", param.parameters()[p].label}, {"coefficient", v}});
+    null.push_back({{"text", c.str(param.parameters())}, {"terms", terms}});
+  }
+  return null;
+}
 
 json identify_json(const Model& model, const ErrorParameterisation& param, const IdentifyResult& r,
                    const std::vector<std::string>& files) {
@@ -44,22 +60,15 @@ json identify_json(const Model& model, const ErrorParameterisation& param, const
                                  {"from", b->a},
                                  {"to", b->b}};
   }
-  json null = json::array();
-  for (const NullCombination& c : r.unidentifiable) {
-    json terms = json::array();
-    for (const auto& [p, v] : c.terms)
-      terms.push_back({{"parameter", param.parameters()[p].label}, {"coefficient", v}});
-    null.push_back({{"text", c.str(param.parameters())}, {"terms", terms}});
-  }
+  const json null = null_combinations_json(param, r.unidentifiable);
   json outputs = json::object();
-  for (int o = 0; o < 6; ++o) {
-    if (!r.count[static_cast<std::size_t>(o)]) continue;
-    const std::string u = o < 3 ? "_um" : "_urad";
-    outputs[output_name(static_cast<std::size_t>(o))] = {
-        {"observations", r.count[static_cast<std::size_t>(o)]},
-        {"rms_before" + u, json_number(r.rms_before[static_cast<std::size_t>(o)])},
-        {"rms_after" + u, json_number(r.rms_after[static_cast<std::size_t>(o)])},
-        {"max_after" + u, json_number(r.max_after[static_cast<std::size_t>(o)])}};
+  for (std::size_t o = 0; o < kObservationKinds; ++o) {
+    if (!r.count[o]) continue;
+    const std::string u = unit_suffix(o);
+    outputs[observation_name(o)] = {{"observations", r.count[o]},
+                                    {"rms_before" + u, json_number(r.rms_before[o])},
+                                    {"rms_after" + u, json_number(r.rms_after[o])},
+                                    {"max_after" + u, json_number(r.max_after[o])}};
   }
   return json_document("identify", {{"model", model_json(model)},
                                     {"data", files},
@@ -72,6 +81,7 @@ json identify_json(const Model& model, const ErrorParameterisation& param, const
                                     {"singular_values", r.singular_values},
                                     {"unidentifiable", null},
                                     {"residual_sigma", json_number(r.residual_sigma)},
+                                    {"references_removed", r.references},
                                     {"gauss_newton_iterations", r.gauss_newton_iterations},
                                     {"outputs", outputs}});
 }
@@ -83,12 +93,17 @@ std::string identify_text(const Model& model, const ErrorParameterisation& param
   os << "identify " << d.name << " (order " << model.order() << ", " << model.origin()
      << "): " << r.observations << " observations from " << data.file << " (";
   bool first = true;
-  for (int o = 0; o < 6; ++o)
-    if (r.count[static_cast<std::size_t>(o)])
-      os << (first ? "" : ", ") << output_name(static_cast<std::size_t>(o)) << " "
-         << r.count[static_cast<std::size_t>(o)],
-          first = false;
+  for (std::size_t o = 0; o < kObservationKinds; ++o)
+    if (r.count[o])
+      os << (first ? "" : ", ") << observation_name(o) << " " << r.count[o], first = false;
   os << ")\n";
+  if (!data.references.empty()) {
+    os << "set-up references removed (" << r.references << " functions):";
+    for (std::size_t i = 0; i < data.references.size() && i < 6; ++i)
+      os << (i ? "; " : " ") << data.references[i].what;
+    if (data.references.size() > 6) os << "; and " << data.references.size() - 6 << " more";
+    os << "\n";
+  }
   std::map<std::string, int> kinds;
   for (std::size_t k = 0; k < d.errors.size(); ++k)
     ++kinds[param.basis_of(k) ? param.basis_of(k)->name() : std::string("constant")];
@@ -97,28 +112,28 @@ std::string identify_text(const Model& model, const ErrorParameterisation& param
   for (const auto& [k, n] : kinds) os << (first ? "" : ", ") << n << " " << k, first = false;
   os << ")";
   if (r.free_parameters < param.size()) os << ", " << param.size() - r.free_parameters << " fixed";
-  os << "\nrank " << r.rank << " of " << r.free_parameters << " (condition " << format_significant(r.condition, 3)
-     << ")";
+  os << "\nrank " << r.rank << " of " << r.free_parameters << " (condition "
+     << format_significant(r.condition, 3) << ")";
   if (!r.unidentifiable.empty())
     os << ": " << r.unidentifiable.size() << " combination"
        << (r.unidentifiable.size() > 1 ? "s" : "") << " not identifiable (below)";
   os << "\nresidual sigma " << format_significant(r.residual_sigma, 3) << " (µm, µrad as measured)";
   if (r.gauss_newton_iterations) os << ", " << r.gauss_newton_iterations << " Gauss-Newton steps";
   os << "\n\noutput  rms before  rms after  max after\n";
-  for (int o = 0; o < 6; ++o) {
-    const auto u = static_cast<std::size_t>(o);
+  for (std::size_t u = 0; u < kObservationKinds; ++u) {
     if (!r.count[u]) continue;
-    os << std::left << std::setw(8) << output_name(u) << std::right << std::setw(10)
-       << format_significant(r.rms_before[u], 3) << std::setw(11) << format_significant(r.rms_after[u], 3) << std::setw(11)
-       << format_significant(r.max_after[u], 3) << "  " << observation_unit(static_cast<std::size_t>(o)) << "\n";
+    os << std::left << std::setw(8) << observation_name(u) << std::right << std::setw(10)
+       << format_significant(r.rms_before[u], 3) << std::setw(11)
+       << format_significant(r.rms_after[u], 3) << std::setw(11)
+       << format_significant(r.max_after[u], 3) << "  " << observation_unit(u) << "\n";
   }
   os << "\nparameter" << std::string(16, ' ') << "value      ± s.e.  unit\n";
   for (std::size_t p = 0; p < param.size(); ++p) {
     const IdentParameter& ip = param.parameters()[p];
     os << std::left << std::setw(24) << ip.label << std::right << std::setw(10)
        << (r.fixed[p] ? "fixed" : format_significant(r.theta[p], 4)) << std::setw(10)
-       << (r.identifiable[p] ? format_significant(r.standard_error[p], 2) : std::string("n.i.")) << "  " << ip.unit
-       << "\n";
+       << (r.identifiable[p] ? format_significant(r.standard_error[p], 2) : std::string("n.i."))
+       << "  " << ip.unit << "\n";
   }
   if (!r.unidentifiable.empty()) {
     os << "\nNot identifiable from these data (n.i.): adding any multiple of a combination "
@@ -171,11 +186,12 @@ std::vector<Panel> identify_panels(const ErrorParameterisation& param, const Ide
   std::vector<Panel> panels;
   BarChart res;
   res.title = "RMS residual per output";
-  res.ylabel = "RMS (um for dx dy dz, urad for da db dc)";
+  res.ylabel = "RMS (um for dx dy dz dr lin str, urad for da db dc ang)";
   BarSeries before{"before (model without errors)", {}, {}, {}}, after{"after", {}, {}, {}};
-  for (std::size_t o = 0; o < 6; ++o) {
+  for (std::size_t o = 0; o < kObservationKinds; ++o) {
     if (!r.count[o]) continue;
-    res.categories.push_back(std::string(output_name(o)) + (o < 3 ? " (um)" : " (urad)"));
+    res.categories.push_back(std::string(observation_name(o)) + " (" + unit_suffix(o).substr(1) +
+                             ")");
     before.value.push_back(r.rms_before[o]);
     after.value.push_back(r.rms_after[o]);
   }

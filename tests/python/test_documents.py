@@ -220,3 +220,25 @@ def test_generate_equals_cli(cli, tmp_path):
         name = os.path.basename(path)
         assert open(path).read() == (tmp_path / "cli" / name).read_text()
     assert weilgen.generate("two_axis", out=tmp_path / "module", check=True)["stale"] == []
+
+
+def test_plan_equals_cli(cli, tmp_path):
+    """weilgen.plan returns the plan --json writes and writes the same measurement template,
+    which identify reads once filled (docs/planning.md)."""
+    args = ("plan", "vmc_3axis", "-q", "--poses", "30", "--noise", "1um", "--random-sets", "5",
+            "--restarts", "3", "--seed", "4", "--out", str(tmp_path / "cli.csv"))
+    want = cli.json(*args)
+    got = weilgen.plan("vmc_3axis", quiet=True, poses=30, noise="1um", random_sets=5,
+                       restarts=3, seed=4, out=tmp_path / "module.csv")
+    # The run time and the written file's name are the only differences.
+    same_document(got, want, ignore={"seconds", "files"})
+    assert got["files"] == [str(tmp_path / "module.csv")]
+    assert (tmp_path / "module.csv").read_text() == (tmp_path / "cli.csv").read_text()
+    assert got["poses"] and len(got["poses"]) == 30 and got["rank"] == want["rank"] > 0
+    # An instrument with its own keywords: ballbar circles in one plane, with a bar length.
+    want = cli.json("plan", "vmc_3axis", "-q", "--instrument", "ballbar", "--poses", "6",
+                    "--plane", "XY", "--radius", "150mm", "--angles", "36", "--random-sets", "3",
+                    "--restarts", "2")
+    got = weilgen.plan("vmc_3axis", quiet=True, instrument="ballbar", poses=6, plane="XY",
+                       radius="150mm", angles=36, random_sets=3, restarts=2)
+    same_document(got, want, ignore={"seconds"})

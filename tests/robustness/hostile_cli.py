@@ -37,6 +37,7 @@ IDENT = "identify vmc_3axis --data p.csv --quiet --json keep.json"
 GAP = "gap vmc_3axis --data p.csv --quiet --json keep.json"
 BALL = "identify vmc_3axis --data p.csv --predict b.csv --quiet --json keep.json"
 BB = "ballbar b.csv --json keep.json"
+PLAN = "plan vmc_3axis --poses 30 --quiet --json keep.json --out plan.csv"
 
 # Values no numeric flag accepts.
 NOT_NUMBERS = ["abc", "nan", "inf", "-inf", "1e999", "12abc", "0x10", "''", "' 5'", "1,5", "--"]
@@ -58,6 +59,13 @@ NUMERIC = [
     (ALLOC, "--min", ["0", "1", "1.5", "-0.1"]),
     (ALLOC, "--mean", ["0", "1", "97"]),
     (ALLOC, "--choose", ["0", "-1", "1e9"]),
+    (PLAN, "--poses", ["0", "-1", "2.5", "1e7"]),
+    (PLAN, "--restarts", ["0", "-1", "1001"]),
+    (PLAN, "--random-sets", ["0", "1.5"]),
+    (PLAN, "--bound", ["-1", "1e9"]),
+    (PLAN, "--rank-tol", ["0", "1", "-1e-9"]),
+    (PLAN, "--angles", ["3", "100001"]),
+    (PLAN, "--seed", ["-1", "18446744073709551616"]),
     (ALLOC, "--max-steps", ["0", "-5"]),
     (ALLOC, "--max-loosen", ["0.5", "-1", "1e300"]),
     (ALLOC, "--samples", ["0"]),
@@ -224,6 +232,36 @@ CASES = [
     (GAP + " --holdout forward:2", 2, ["--holdout"]),
     (GAP + " --effects magic", 2, ["--effects"]),
     (GAP + " --at Q=0", 2, ["--at"]),
+    # Issue 28, weilgen plan: every refusal names the flag (or the file), writes nothing.
+    (PLAN + " --instrument laser", 2, ["--instrument", "laser"]),
+    (PLAN + " --criterion Z", 2, ["--criterion"]),
+    (PLAN + " --noise 1kg", 2, ["--noise", "kg"]),
+    (PLAN + " --noise dq=1um", 2, ["--noise", "dq"]),
+    (PLAN + " --target-sd 2um", 2, ["--poses", "--target-sd"]),
+    (PLAN.replace("--poses 30", "--target-sd -1um"), 2, ["--target-sd"]),
+    (PLAN.replace("--poses 30", "--target-sd 0.001um"), 2, ["--target-sd", "candidate"]),
+    (PLAN.replace("--poses 30", ""), 2, ["--poses"]),
+    (PLAN.replace("--poses 30", "--poses 5"), 2, ["--poses", "at least 16"]),
+    (PLAN.replace("--poses 30", "--poses 4000"), 2, ["--poses", "candidates"]),
+    (PLAN + " --set Q=0", 2, ["--set", "Q"]),
+    (PLAN + " --candidates X=0:500:21 --set X=5", 2, ["--candidates", "--set"]),
+    (PLAN + " --instrument rtest", 2, ["rtest", "no rotary axis"]),
+    (PLAN + " --instrument ballbar --plane XQ", 2, ["--plane", "XQ"]),
+    (PLAN + " --instrument ballbar --radius -5", 2, ["--radius"]),
+    (PLAN + " --nest X=0", 2, ["--nest"]),
+    (PLAN + " --time-budget 4h", 2, ["--time-budget"]),
+    (PLAN + " --times t.yaml", 2, ["--times"]),
+    (PLAN.replace("--poses 30", "--instruments points:1um"), 2, ["--time-budget"]),
+    (PLAN.replace("--poses 30", "--instruments points:abc --time-budget 4h"), 2,
+     ["--instruments", "abc"]),
+    (PLAN.replace("--poses 30", "--instruments points:1um,laser:1um --time-budget 4h"), 2,
+     ["--instruments", "laser"]),
+    (PLAN.replace("--poses 30", "--instruments points:1um --time-budget soon"), 2,
+     ["--time-budget"]),
+    (PLAN + " --include missing.csv", 3, ["missing.csv:"]),
+    (PLAN + " --include b.csv", 3, ["b.csv:"]),
+    (PLAN.replace("--out plan.csv", "--out keep.json"), 2, ["--json", "--out"]),
+    (PLAN.replace("--out plan.csv", "--out p.csv --include p.csv"), 2, ["--out", "is the input"]),
     ("show two_axis --format pdf", 2, ["--format"]),
     ("show two_axis --notation greek", 2, ["--notation"]),
     ("show two_axis --output dq", 2, ["dq"]),

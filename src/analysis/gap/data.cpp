@@ -16,47 +16,6 @@ namespace weilgen {
 
 using namespace gap_detail;
 
-namespace {
-
-// A ballbar trace's dr observations: poses on the circle, the ball-to-ball unit vectors.
-PointData ballbar_points(const MeasurementTable& t, const Description& desc,
-                         const BallbarFlags& flags, const std::vector<double>& parameters,
-                         std::optional<BallbarCircle>& circle) {
-  const BallbarMachine machine = ballbar_machine(desc, parameters);
-  circle = parse_ballbar_circle(t, machine, flags);
-  if (!t.has("angle_deg"))
-    throw InputError(SourceLoc{t.file, t.header_line, 0},
-                     "a ballbar trace needs an 'angle_deg' column beside 'dr_um' (columns: " +
-                         join(t.columns) + ")");
-  const std::vector<double>& angle = t.column("angle_deg");
-  const std::vector<double>& dr = t.column("dr_um");
-  PointData p;
-  p.file = t.file;
-  p.poses.assign(t.rows(), {});
-  std::vector<double> angles;  // of the measured rows, for one call to ballbar_directions
-  for (std::size_t r = 0; r < t.rows(); ++r) {
-    if (!std::isfinite(dr[r])) continue;
-    if (!std::isfinite(angle[r]))
-      throw InputError(t.cell(r, "angle_deg"), "column 'angle_deg' is empty but dr_um is measured");
-    p.poses[r] = ballbar_pose(machine, *circle, angle[r]);
-    PointObservation ob;
-    ob.row = r;
-    ob.line = t.lines[r];
-    ob.output = kRadialOutput;
-    ob.value = dr[r];
-    p.observations.push_back(ob);
-    angles.push_back(angle[r]);
-  }
-  if (p.observations.empty())
-    throw InputError(SourceLoc{t.file, 0, 0}, "no observations (no row has a measured dr_um)");
-  const std::vector<std::array<double, 3>> u = ballbar_directions(machine, *circle, angles);
-  for (std::size_t i = 0; i < u.size(); ++i) p.observations[i].radial = u[i];
-  p.count[kRadialOutput] = p.observations.size();
-  return p;
-}
-
-}  // namespace
-
 GapData gap_data(const MeasurementTable& table, const Description& desc,
                  const std::map<std::string, double>& fixed, const BallbarFlags& ballbar,
                  const std::vector<double>& parameters) {
@@ -84,7 +43,8 @@ GapData gap_data(const MeasurementTable& table, const Description& desc,
   }
   // A rotary coordinate in radians where the machine says degrees is the reader's check
   // (measurement_csv.cpp, check_radians): identify reads the same columns.
-  g.points = trace ? ballbar_points(t, desc, ballbar, parameters, g.circle) : point_data(t, desc);
+  g.points =
+      trace ? ballbar_point_data(t, desc, ballbar, parameters, g.circle) : point_data(t, desc);
   const std::size_t rows = t.rows();
   g.time_s = t.has("t_s") ? t.column("t_s") : std::vector<double>(rows, kNaN);
   g.cycle = t.has("cycle") ? t.column("cycle") : std::vector<double>(rows, kNaN);

@@ -15,6 +15,7 @@ _DEFAULT = {
     "identify": "parameters",
     "gap": "effects",
     "generate": "files",
+    "plan": "poses",
 }
 
 
@@ -91,13 +92,13 @@ def to_frame(document, table=None):
     ----------
     document : dict
         a document of weilgen.sensitivity, reliability, allocate, iso230_2, fit_pdge,
-        identify, gap or generate (or json.load of the CLI's --json)
+        identify, gap, generate or plan (or json.load of the CLI's --json)
     table : str, optional
         which table: None for the verb's main one (sensitivity and reliability: 'results',
         one row per pose, output and error or output; allocate: 'steps'; iso230_2: 'targets',
         one row per target; fit_pdge: 'fits', one row per profile and basis; identify:
-        'parameters'; gap: 'effects'; generate: 'files'), or the key of another list of
-        records ('summary', 'inputs', 'where', ...) or of a dict of equally long arrays
+        'parameters'; gap: 'effects'; generate: 'files'; plan: 'poses'), or the key of another
+        list of records ('summary', 'inputs', 'where', ...) or of a dict of equally long arrays
         ('drift_per_cycle'); dotted for nested keys
 
     Returns

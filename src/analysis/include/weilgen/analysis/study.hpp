@@ -64,6 +64,9 @@ struct MeasurementRequest {
   void check_machine() const;
   // The opened model's description, or the machine file's (InputError).
   Description description() const;
+  // The machine parameters the model will have (Description::parameters order, mm/deg): the
+  // opened model's, or the file's defaults with --param applied (std::invalid_argument).
+  std::vector<double> parameters(const Description& desc) const;
   // The opened model, or open_model(model, desc).
   std::shared_ptr<const Model> open(const Description& desc) const;
 };

@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "weilgen/base/units.hpp"
@@ -43,6 +44,13 @@ struct PoseSet {
 PoseSet parse_poses(const Description& desc, const std::vector<std::string>& at,
                     const std::vector<std::string>& grid);
 
+// One flag of --grid items without their product: each named axis (index into
+// Description::axes()) with its values in the axis unit (a value, or start:stop:count), checked
+// as --grid checks them; `flag` names the flag in messages ("--candidates").
+std::vector<std::pair<std::size_t, std::vector<double>>> parse_axis_values(const Description& desc,
+                                                                           const std::string& flag,
+                                                                           const std::string& text);
+
 // Most poses a grid may have (the product of its counts).
 constexpr std::size_t kMaxGridPoses = 10'000'000;
 
@@ -74,7 +82,8 @@ std::vector<InputDistribution> error_distributions(const Description& desc,
                                                    const std::vector<std::string>& set_flags);
 
 // The errors a name selects in --set, identify --fix, ...: an error name, an alias (with the
-// alias's sign) or "group:<group>" (every error of the group, sign +1). Throws
+// alias's sign), "group:<group>" (every error of the group, sign +1) or "axis:<axis>" (every
+// error of the body the axis moves, sign +1). Throws
 // std::invalid_argument "<context>: unknown error ..." / "no errors in group ..." naming the
 // machine's errors or groups.
 struct ErrorTarget {

@@ -47,6 +47,11 @@ Quantity parse_quantity_unit(const std::string& text, const std::string& default
 double parse_quantity(const std::string& text, const std::string& default_unit,
                       const std::string& what);
 
+// A duration in seconds: "4h", "30 min", "90 s", "1.5h" (an expression allowed); units s, min, h,
+// `default_unit` when none is written. Throws std::invalid_argument "<what>: <why>".
+double parse_duration_s(const std::string& text, const std::string& default_unit,
+                        const std::string& what);
+
 // A feedrate in mm/min: "1000 mm/min", "16.7 mm/s", "1.2 m/min", "40 in/min", or a number
 // (mm/min); > 0. Throws std::invalid_argument "<what>: <why>".
 double parse_feedrate_mm_min(const std::string& text, const std::string& what);

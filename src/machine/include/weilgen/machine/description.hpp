@@ -242,6 +242,8 @@ struct Description {
   // The model's input axes in tree order: bodies with a prismatic or revolute joint that is not
   // linked to other coordinates.
   std::vector<int> axes() const;
+  // The joint of input axis `axis` (an index into axes()).
+  const Joint& axis_joint(std::size_t axis) const;
   // Bodies with a linked joint, in tree order.
   std::vector<int> linked_axes() const;
   // Body whose joint coordinate is `coordinate` (independent or linked); -1 when none.

@@ -16,6 +16,10 @@ namespace weilgen {
 std::string identify_text(const Model& model, const ErrorParameterisation& param,
                           const IdentifyResult& result, const PointData& data);
 // `files`: the --data files; without "predictions" (identify_json(run) adds them).
+// Unidentifiable combinations as JSON: a list of `text` and `terms` [`parameter`, `coefficient`].
+nlohmann::json null_combinations_json(const ErrorParameterisation& param,
+                                      const std::vector<NullCombination>& combinations);
+
 nlohmann::json identify_json(const Model& model, const ErrorParameterisation& param,
                              const IdentifyResult& result, const std::vector<std::string>& files);
 
