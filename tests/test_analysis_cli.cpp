@@ -349,7 +349,8 @@ TEST_CASE("analysis CLI: --plot draws PNG and SVG through gnuplot") {
   CHECK(s.find("<svg") != std::string::npos);
 }
 
-TEST_CASE("allocate CLI: the seed's x-direction procedure, and its saved tolerances read back") {
+TEST_CASE(
+    "allocate CLI: Wang & Yuan 2021's x-direction procedure, and its saved tolerances read back") {
   const auto dir = test::fresh_dir("cli_allocate");
   const std::string json_path = (dir / "a.json").string(), tol = (dir / "tol.yaml").string();
   const std::string grid =

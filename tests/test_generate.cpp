@@ -340,7 +340,7 @@ TEST_CASE("CLI: --check reports stale files and exits 1") {
   CHECK(r.out.find("two_axis.hpp: stale, 1 of") != std::string::npos);
 }
 
-TEST_CASE("CLI: show prints closed forms in text, LaTeX, JSON and the seed's notation") {
+TEST_CASE("CLI: show prints closed forms in text, LaTeX, JSON and the papers' notation") {
   const Run t = run(cli("show gantry_grinder --output dx"));
   CHECK(t.status == 0);
   CHECK(t.out.rfind("dx = -E_XX", 0) == 0);

@@ -399,7 +399,7 @@ TEST_CASE("iso230-2 drift: the rebuilt chart recovers the static profile within 
 // = √2
 // ("1.4076" from its Monte Carlo run on 1000 samples). One run of 1000 samples has a standard
 // error of about 0.04 on the ratio; the mean of 1000 such runs has about 0.0013: tolerance 0.01.
-TEST_CASE("iso230-2 drift: the seed's Monte Carlo check of s_b / s_a = sqrt(2)") {
+TEST_CASE("iso230-2 drift: Stejskal et al. 2017's Monte Carlo check of s_b / s_a = sqrt(2)") {
   Normal rng(1000);
   double sum = 0;
   const int runs = 1000;
@@ -428,7 +428,8 @@ TEST_CASE("iso230-2 drift: the seed's Monte Carlo check of s_b / s_a = sqrt(2)")
 // ---- The anomaly test ------------------------------------------------------------------------
 
 TEST_CASE(
-    "iso230-2 drift: the seed's 'position 3' anomaly is found, at the stated false-positive rate") {
+    "iso230-2 drift: Stejskal et al. 2017's 'position 3' anomaly is found, at the stated "
+    "false-positive rate") {
   // Power: target 3 (index 2) with 4× the noise in the up direction, under drift.
   Synth s;
   s.noisy_target = 2;
@@ -664,7 +665,9 @@ TEST_CASE("iso230-2 CLI: bad input exits 3, bad flags exit 2, and nothing is wri
   CHECK(r.out.find("Drift elimination: needs at least 2 targets") != std::string::npos);
 }
 
-TEST_CASE("iso230-2 CLI: the drift example finds the seed's position 3 and draws the charts") {
+TEST_CASE(
+    "iso230-2 CLI: the drift example finds Stejskal et al. 2017's position 3 and draws the "
+    "charts") {
   const std::string data = std::string(WEILGEN_SOURCE_DIR) + "/examples/data/iso230_2_drift.csv";
   const auto dir = test::fresh_dir("cli_iso230_2_drift");
   const std::string out = (dir / "drift.json").string();

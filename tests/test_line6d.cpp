@@ -59,7 +59,7 @@ MeasurementTable table(const std::string& text) {
 
 }  // namespace
 
-TEST_CASE("pdge line6d: the default mappings follow the seed's Table 2") {
+TEST_CASE("pdge line6d: the default mappings follow Zhang & Chen 2021's Table 2") {
   const auto x = line6d_default_mapping("X");
   REQUIRE(x.size() == 6);
   // Table 2 (X axis): positioning d_x(x), straightness XX d_y(x), straightness YY d_z(x),

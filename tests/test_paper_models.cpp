@@ -1,4 +1,4 @@
-// The generated grinder and VMC models against the seeds' printed closed forms, term by term.
+// The generated grinder and VMC models against the papers' printed closed forms, term by term.
 // Where a printed equation is wrong, the correct term is pinned here and the machine file's notes
 // (and so the generated report) say why.
 #include <doctest/doctest.h>
@@ -24,7 +24,7 @@ GiNaC::ex parse(const gen::SymbolicModel& m, const std::string& text) {
   return reader(text);
 }
 
-// Checks that output o has exactly the expected linear terms (tool_length = 0 as in the seeds).
+// Checks that output o has exactly the expected linear terms (tool_length = 0 as in the papers).
 void check_output(const gen::SymbolicModel& m, int o, const Terms& printed,
                   const Terms& corrections,
                   const std::vector<std::string>& printed_but_wrong = {}) {

@@ -197,7 +197,7 @@ std::array<double, 2> radial_and_roll_variance(const Description& d,
 
 }  // namespace
 
-TEST_CASE("pipe cutter: 70 errors with the seed's aliases and Table 2 ranges") {
+TEST_CASE("pipe cutter: 70 errors with Jiang et al. 2021's aliases and Table 2 ranges") {
   const Description d = load_machine_file(test::machine_path("pipe_cutter"));
   REQUIRE(d.errors.size() == 70);
   REQUIRE(d.axes().size() == 5);  // X, Y231, A04, Y451, Z453; A12, Y232, Y452, Z454 are linked
@@ -240,7 +240,7 @@ TEST_CASE("pipe cutter: description machinery equals the independent seed constr
   }
 }
 
-TEST_CASE("pipe cutter: the generated header is the seed construction to O(s^2)") {
+TEST_CASE("pipe cutter: the generated header is Jiang et al. 2021's construction to O(s^2)") {
   const Description d = load_machine_file(test::machine_path("pipe_cutter"));
   std::mt19937 rng(9);
   for (int trial = 0; trial < 3; ++trial) {
@@ -274,7 +274,7 @@ TEST_CASE("pipe cutter: the generated header is the seed construction to O(s^2)"
   }
 }
 
-TEST_CASE("pipe cutter: closed forms of the seed's Ex, Ey, Ez at A12 = A04 = 0") {
+TEST_CASE("pipe cutter: closed forms of Jiang et al. 2021's Ex, Ey, Ez at A12 = A04 = 0") {
   const Description d = load_machine_file(test::machine_path("pipe_cutter"));
   const gen::SymbolicModel m = gen::build_model(d, 1);
   // At the study's pose the working point's deviation, with D = L04 - L23 - L01 - X:

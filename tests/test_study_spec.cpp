@@ -195,7 +195,7 @@ TEST_CASE("study units: quantities") {
 
 // ---- Poses ------------------------------------------------------------------------------------
 
-TEST_CASE("study poses: the seed's grid on the gantry grinder") {
+TEST_CASE("study poses: Wang & Yuan 2021's grid on the gantry grinder") {
   const Description& d = grinder();
   const PoseSet p = parse_poses(d, {}, {"X=0,Y=-1500:1500:5,Z=600:1400:5"});
   REQUIRE(p.axes == std::vector<std::string>{"X", "Z", "Y"});  // Description::axes() order

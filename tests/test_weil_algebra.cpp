@@ -33,7 +33,8 @@ TEST_CASE("D^r_k: products above the order vanish, the rest is the binomial expa
   CHECK(d.terms().at({0}).is_equal(5));
 }
 
-TEST_CASE("relations: the seed's algebra (40), squares vanish but cross products are kept") {
+TEST_CASE(
+    "relations: Hrdina & Vasik 2014's algebra (40), squares vanish but cross products are kept") {
   const Algebra w(2, {{0, 0}, {1, 1}}, {});
   const Poly s = Poly::error(0) + Poly::error(1);
   const Poly sq = s.mul(s, w);  // (e1 + e2)² = 2 e1 e2 when e1² = e2² = 0

@@ -168,7 +168,7 @@ std::vector<std::vector<double>> seed_poses(const Description& desc) {
       const auto it = by_name.find(j.coordinate);
       if (it == by_name.end())
         throw std::runtime_error("the pipe cutter has an axis " + j.coordinate +
-                                 " that the seed's poses do not set");
+                                 " that Jiang et al. 2021's poses do not set");
       if (j.max > j.min && (it->second < j.min || it->second > j.max))
         throw std::runtime_error("pose value " + j.coordinate + " = " + std::to_string(it->second) +
                                  " outside the axis range");
@@ -176,7 +176,7 @@ std::vector<std::vector<double>> seed_poses(const Description& desc) {
       ++used;
     }
     if (used != by_name.size())
-      throw std::runtime_error("the pipe cutter lacks an axis of the seed's poses");
+      throw std::runtime_error("the pipe cutter lacks an axis of Jiang et al. 2021's poses");
     poses.push_back(pose);
   }
   return poses;

@@ -42,7 +42,8 @@ int verb_allocate(const Args& args) {
       "errors chosen per output that misses its targets")(
       "rank", po::value<std::string>(&rank)->default_value("scaled"),
       "how --choose ranks the errors: scaled (mean |dR/dsigma_i| sigma_i, unit-free) | raw\n"
-      "(mean |dR/dsigma_i| per base unit, mm or rad: the seed's ranking, which favours the\n"
+      "(mean |dR/dsigma_i| per base unit, mm or rad: Wang & Yuan 2021's ranking, which favours "
+      "the\n"
       "angular errors because a rad is 1000 mm/m)")(
       "errors", po::value<std::string>(&errors_text),
       "explicit comma-separated choice of the errors to tighten (overrides --choose)")(

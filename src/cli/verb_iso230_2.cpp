@@ -40,7 +40,8 @@ int verb_iso230_2(const Args& args) {
       "dc_urad for A, B, C)")("reference-position", ranged(&reference_position, NumberRange{}),
                               "drift elimination: the reference target (mm; default the lowest)")(
       "reference-cycle", ranged(&reference_cycle, NumberRange::whole_numbers(-1e15, 1e15)),
-      "drift elimination: the reference cycle id (default the lowest; the seed suggests one "
+      "drift elimination: the reference cycle id (default the lowest; Stejskal et al. 2017 suggest "
+      "one "
       "measured after at least 2 h)")("alpha",
                                       ranged(&alpha, NumberRange::open(0, 1))->default_value(alpha),
                                       "family-wise false-positive rate of the anomaly test")(

@@ -177,16 +177,16 @@ std::string pdge_fit_text(const PdgeFitStudyOptions& o, const PdgeFitStudyResult
            << (f.basis.kind == BasisKind::Fourier && f.basis.order > 0
                    ? format_fixed(f.basis.period(), 2) + (fr.period_at_bound ? "!" : "")
                    : std::string("-"))
-           << std::setw(12) << format_fixed(f.metrics.e_max, 3) << std::setw(9) << format_fixed(f.metrics.r2, 4)
-           << std::setw(13) << fmt_g(f.metrics.sse, 5) << std::setw(11) << format_fixed(f.metrics.rmse, 3)
-           << std::setw(14) << format_fixed(fr.cv.rmse, 3) << (k == best ? "  <- least CV error" : "")
-           << "\n";
+           << std::setw(12) << format_fixed(f.metrics.e_max, 3) << std::setw(9)
+           << format_fixed(f.metrics.r2, 4) << std::setw(13) << fmt_g(f.metrics.sse, 5)
+           << std::setw(11) << format_fixed(f.metrics.rmse, 3) << std::setw(14)
+           << format_fixed(fr.cv.rmse, 3) << (k == best ? "  <- least CV error" : "") << "\n";
       os << line.str();
       if (curves) {
         for (const CvCurvePoint& c : fr.curve) {
           os << "      order " << std::setw(2) << c.order << ": train RMSE " << std::setw(8)
-             << format_fixed(c.train_rmse, 3) << "  CV RMSE " << std::setw(9) << format_fixed(c.cv.rmse, 3)
-             << " (MSE se " << fmt_g(c.cv.mse_se, 3) << ")";
+             << format_fixed(c.train_rmse, 3) << "  CV RMSE " << std::setw(9)
+             << format_fixed(c.cv.rmse, 3) << " (MSE se " << fmt_g(c.cv.mse_se, 3) << ")";
           if (std::isfinite(c.period_mm) && c.order > 0)
             os << "  L " << format_fixed(c.period_mm, 2) << " mm";
           if (!c.feasible) os << "  not feasible: " << c.reason;
@@ -201,7 +201,7 @@ std::string pdge_fit_text(const PdgeFitStudyOptions& o, const PdgeFitStudyResult
     for (std::size_t k = 0; k < results[i].size(); ++k)
       any_at_bound = any_at_bound || (failures[i][k].empty() && results[i][k].period_at_bound);
   os << "\n* order chosen by cross-validation (" << o.rule
-     << " rule). Metrics as the seed's Table 4: e_max = max |residual|, R2, SSE, RMSE =\n"
+     << " rule). Metrics as Zhang & Chen 2021, Table 4: e_max = max |residual|, R2, SSE, RMSE =\n"
         "sqrt(SSE/n), on the fitted data; CV_RMSE = held-out error.\n";
   if (any_at_bound)
     os << "! searched period at an end of its range [2*order*spacing, 2*travel]: the series\n"

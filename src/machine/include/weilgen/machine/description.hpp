@@ -39,8 +39,8 @@ struct Offset {
 };
 
 // A moving joint, J(q) in its parent's frame. Given either in axis form (type, axis, optional
-// `through`) or as a twist ξ = (ω, v) with J(q) = exp(ξ^ q) (the seed's POE form): ω = 0 is a
-// prismatic joint along v, |ω| = 1 with ω·v = 0 a revolute joint about ω through ω × v. Both
+// `through`) or as a twist ξ = (ω, v) with J(q) = exp(ξ^ q) (Jiang et al. 2021's POE form): ω = 0
+// is a prismatic joint along v, |ω| = 1 with ω·v = 0 a revolute joint about ω through ω × v. Both
 // forms fill the same fields; `twist` keeps the text as written for reports.
 struct Joint {
   JointType type = JointType::Fixed;
@@ -147,7 +147,7 @@ struct PointSpec {
 };
 
 // A point on a chain whose deviation P(e) − P(0) (mm, base frame) derived quantities use as
-// `name.x`, `name.y`, `name.z` (the seed's E_0N of each jaw tip).
+// `name.x`, `name.y`, `name.z` (Jiang et al. 2021's E_0N of each jaw tip).
 struct ChainPoint {
   std::string name;
   PointSpec at;
@@ -218,7 +218,7 @@ struct Description {
   std::string title;              // human title
   std::string source_file;        // path the description was read from
   std::uint64_t source_hash = 0;  // FNV-1a of the machine file's text (model_key.hpp)
-  std::string notes;              // free text (corrections to the seed, conventions)
+  std::string notes;              // free text (corrections to the source paper, conventions)
   Algebra algebra;
   std::vector<Parameter> parameters;
   std::vector<std::string> groups;  // builtin_groups() plus the file's `groups:`
