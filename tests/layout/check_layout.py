@@ -40,9 +40,6 @@ ALLOWED = {
 # the entry.
 MAX_FUNCTION_LINES = 150
 LONG_FUNCTIONS = {
-    ("src/measure/iso230_2_uncertainty.cpp", "Iso230_2Uncertainty::run"):
-        "the ISO 230-9 budget's contributions are built in sequence over shared sums; to split by "
-        "figure (E, M, A, B, R) and the Monte Carlo check",
     ("src/measure/instrument_import.cpp", "parse_carto"):
         "the CARTO header, column roles, units and rows in one pass; to split into header, "
         "columns and rows",
