@@ -47,8 +47,6 @@ LONG_FUNCTIONS = {
         "every cause's fit and ranking in sequence; to split one step per cause family",
     ("src/report/iso230_2_html.cpp", "iso230_2_html"):
         "the report's sections written in order; to split one function per section",
-    ("src/measure/iso230_2_drift.cpp", "DriftElimination::run"):
-        "differences, chart, spread and anomaly test per direction; to split by step",
     ("src/codegen/emit_report.cpp", "emit_report_markdown"):
         "the generated report's sections in order; to split one function per section",
     ("src/report/iso230_2_document.cpp", "iso230_2_text"):
