@@ -45,8 +45,6 @@ LONG_FUNCTIONS = {
         "columns and rows",
     ("src/measure/ballbar_diagnosis.cpp", "BallbarDiagnosis::run"):
         "every cause's fit and ranking in sequence; to split one step per cause family",
-    ("src/report/iso230_2_html.cpp", "iso230_2_html"):
-        "the report's sections written in order; to split one function per section",
     ("src/codegen/emit_report.cpp", "emit_report_markdown"):
         "the generated report's sections in order; to split one function per section",
     ("src/report/iso230_2_document.cpp", "iso230_2_text"):
