@@ -40,8 +40,6 @@ ALLOWED = {
 # the entry.
 MAX_FUNCTION_LINES = 150
 LONG_FUNCTIONS = {
-    ("src/report/iso230_2_document.cpp", "iso230_2_text"):
-        "the text report's tables in order; to split one function per table",
     ("src/analysis/gap/localise.cpp", "localise"):
         "one loop over the localisation coordinates with their binning rules; to split per kind",
     ("src/uq/sobol_bootstrap.cpp", "bootstrap_pass"):
