@@ -44,8 +44,6 @@ LONG_FUNCTIONS = {
         "one loop over the localisation coordinates with their binning rules; to split per kind",
     ("src/uq/sobol_bootstrap.cpp", "bootstrap_pass"):
         "one pass over the blocks accumulating every resample's sums (a hot loop kept together)",
-    ("src/analysis/gap/effect_thermal.cpp", "add_thermal"):
-        "the thermal-drift candidates (time, sensors, axis) built together; to split per candidate",
 }
 SKIP_DECLARATION = re.compile(r"^(namespace|struct|class|enum|union|extern|template|using|typedef|"
                               r"static_assert|#|//|/\*|\*|\}|\{)")
