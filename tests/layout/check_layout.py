@@ -40,8 +40,6 @@ ALLOWED = {
 # the entry.
 MAX_FUNCTION_LINES = 150
 LONG_FUNCTIONS = {
-    ("src/analysis/gap/localise.cpp", "localise"):
-        "one loop over the localisation coordinates with their binning rules; to split per kind",
     ("src/uq/sobol_bootstrap.cpp", "bootstrap_pass"):
         "one pass over the blocks accumulating every resample's sums (a hot loop kept together)",
 }
