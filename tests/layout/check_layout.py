@@ -11,9 +11,8 @@
     included only from their own folder: never from a public header (include/weilgen/...) nor
     from tests/, bench/, fuzz/ or examples/;
   - no function (or method defined in its class) in src/ is longer than 150 lines, except the
-    named ones of LONG_FUNCTIONS, each
-    with its reason (an exception that is no longer needed is reported too, so the list only
-    shrinks);
+    named ones of LONG_FUNCTIONS, each with its reason (an exception that is no longer needed is
+    reported too, so the list only shrinks);
   - no doctest case name in tests/*.cpp contains ';' (CMake splits the name at it, and CTest
     then runs no test of that case).
 
