@@ -158,7 +158,7 @@ const std::vector<MachineLayouts>& suite_machines() {
 // --self-check and documented, not scored again and again).
 bool in_suite(const std::string& machine, const std::string& layout, const std::string& effect) {
   (void)machine;
-  const bool rtest = layout.rfind("rtest", 0) == 0;
+  const bool rtest = Layout::parse(layout).rtest();
   if (effect == "periodic" || effect == "pdge_shape")
     return layout != "sparse" && layout != "small";
   if (effect == "higher_order") return layout == "grid" || layout == "rtest";

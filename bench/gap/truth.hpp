@@ -31,6 +31,30 @@ const std::vector<std::string>& all_effects();
 // grid, sparse, small, line, ballbar, ballbar_yz, rtest, rtest_small.
 const std::vector<std::string>& layout_names();
 
+// The effects the generator can withhold (one row each in Synthesiser::effect_table()).
+enum class EffectKind {
+  ThermalDrift,
+  Reversal,
+  Periodic,
+  PdgeShape,
+  HigherOrder,
+  MissingError,
+  ToolOffset,
+  Setup,
+  Step
+};
+
+// A measurement layout (truth_layout.cpp), parsed once from its name.
+struct Layout {
+  enum class Kind { Grid, Sparse, Small, Line, Ballbar, BallbarYz, Rtest, RtestSmall };
+  Kind kind = Kind::Grid;
+  // Throws std::runtime_error on a name not in layout_names().
+  static Layout parse(const std::string& name);
+  bool line() const { return kind == Kind::Line; }
+  bool ballbar() const { return kind == Kind::Ballbar || kind == Kind::BallbarYz; }
+  bool rtest() const { return kind == Kind::Rtest || kind == Kind::RtestSmall; }
+};
+
 struct ScenarioSpec {
   std::string machine = "vmc_3axis";  // truth machine: shipped name or path
   // A library effect, "step", "none", or two library effects joined by '+' (both withheld, each
@@ -82,6 +106,14 @@ void copy_to(std::vector<T>& dst, const std::vector<T>& src) {
   dst.resize(src.size());
   for (std::size_t i = 0; i < src.size(); ++i) dst[i] = src[i];
 }
+
+// The largest element (0 when empty), and a number printed with a printf format.
+double max_of(const std::vector<double>& v);
+std::string fmt(const char* f, double v);
+// Central-difference Jacobian (3 × errors, mm per base unit) of the tool position of `chain`
+// at `axes`, step h (mm, rad).
+Eigen::MatrixXd position_jacobian(const NumericChain& chain, const std::vector<double>& axes,
+                                  std::size_t n, double h);
 
 // A 64-bit seed from text (FNV-1a): stable scenario seeds from scenario ids.
 std::uint64_t seed_from(const std::string& text);
@@ -156,6 +188,7 @@ class Synthesiser {
   };
   // One withheld effect and its realisation.
   struct Effect {
+    EffectKind kind = EffectKind::Step;
     std::string name;
     int axis = -1, error = -1, dim = -1;  // the axis, error and measured direction it acts on
     double period = 0, phase = 0, centre = 0, width = 0;  // periodic, pdge_shape (axis unit)
@@ -186,7 +219,55 @@ class Synthesiser {
   void add_pass(const std::vector<int>& sequence, int cycle, double dwell_s);
   std::vector<int> linear_axes() const;  // indices of linear axes with a travel
 
+ public:
+  // Effects (truth_effects.cpp): each effect's placement on the layout (its axis, error,
+  // direction, shape; the draws from the effect's stream) and its truth.json parameters and
+  // localisation, one row per effect in effect_table().
+  struct Placement;
+  struct Labels;
+  using PlaceFn = void (Synthesiser::*)(Effect&, Rng&, const Placement&) const;
+  using DescribeFn = void (Synthesiser::*)(const Effect&, const Labels&, nlohmann::json& params,
+                                           nlohmann::json& localise) const;
+  struct EffectDef {
+    EffectKind kind;
+    const char* name;
+    bool library;              // a candidate of the diagnosis library (else: outside it, "step")
+    bool additive;             // may be withheld together with another additive effect
+    double nominal_amplitude;  // the scaling's start (µm, µrad, ppm, mm or a factor)
+    PlaceFn place;             // nullptr: nothing to place
+    DescribeFn describe;
+  };
+  static const std::vector<EffectDef>& effect_table();
+  static const EffectDef& effect_def(EffectKind kind);
+  static const EffectDef* find_effect(const std::string& name);
+
+ private:
   void build_effect(Effect& e, Rng& rng);
+  int pick_error(int axis, Rng& rng, const Placement& at) const;
+  void place_reversal(Effect& e, Rng& rng, const Placement& at) const;
+  void place_shape(Effect& e, Rng& rng, const Placement& at) const;  // periodic, pdge_shape
+  void place_thermal(Effect& e, Rng& rng, const Placement& at) const;
+  void place_step(Effect& e, Rng& rng, const Placement& at) const;
+  void place_tool_offset(Effect& e, Rng& rng, const Placement& at) const;
+  void describe_reversal(const Effect& f, const Labels& n, nlohmann::json& params,
+                         nlohmann::json& loc) const;
+  void describe_periodic(const Effect& f, const Labels& n, nlohmann::json& params,
+                         nlohmann::json& loc) const;
+  void describe_pdge_shape(const Effect& f, const Labels& n, nlohmann::json& params,
+                           nlohmann::json& loc) const;
+  void describe_thermal(const Effect& f, const Labels& n, nlohmann::json& params,
+                        nlohmann::json& loc) const;
+  void describe_step(const Effect& f, const Labels& n, nlohmann::json& params,
+                     nlohmann::json& loc) const;
+  void describe_higher_order(const Effect& f, const Labels& n, nlohmann::json& params,
+                             nlohmann::json& loc) const;
+  void describe_missing_error(const Effect& f, const Labels& n, nlohmann::json& params,
+                              nlohmann::json& loc) const;
+  void describe_tool_offset(const Effect& f, const Labels& n, nlohmann::json& params,
+                            nlohmann::json& loc) const;
+  void describe_setup(const Effect& f, const Labels& n, nlohmann::json& params,
+                      nlohmann::json& loc) const;
+  std::string output_name(std::size_t column) const;  // dx, dy, dz or dr
   void build_regressors();
   void scale_effects();
   void draw_noise();
@@ -218,6 +299,7 @@ class Synthesiser {
   std::size_t dominant_column(const Effect& e) const;
 
   ScenarioSpec spec_;
+  Layout layout_;
   Description truth_desc_, model_desc_;
   std::string model_machine_;
   std::unique_ptr<NumericChain> truth_chain_, model_chain_;

@@ -11,6 +11,39 @@
 
 namespace weilgen::gapbench {
 
+namespace {
+
+struct LayoutName {
+  const char* name;
+  Layout::Kind kind;
+};
+
+const std::vector<LayoutName>& layout_table() {
+  static const std::vector<LayoutName> table = {
+      {"grid", Layout::Kind::Grid},       {"sparse", Layout::Kind::Sparse},
+      {"small", Layout::Kind::Small},     {"line", Layout::Kind::Line},
+      {"ballbar", Layout::Kind::Ballbar}, {"ballbar_yz", Layout::Kind::BallbarYz},
+      {"rtest", Layout::Kind::Rtest},     {"rtest_small", Layout::Kind::RtestSmall}};
+  return table;
+}
+
+}  // namespace
+
+const std::vector<std::string>& layout_names() {
+  static const std::vector<std::string> v = [] {
+    std::vector<std::string> names;
+    for (const LayoutName& l : layout_table()) names.push_back(l.name);
+    return names;
+  }();
+  return v;
+}
+
+Layout Layout::parse(const std::string& name) {
+  for (const LayoutName& l : layout_table())
+    if (name == l.name) return Layout{l.kind};
+  throw fail("unknown layout '" + name + "'");
+}
+
 std::vector<int> Synthesiser::linear_axes() const {
   std::vector<int> linear;
   for (std::size_t k = 0; k < axes_.size(); ++k)
@@ -42,23 +75,29 @@ void Synthesiser::add_pass(const std::vector<int>& sequence, int cycle, double d
 }
 
 void Synthesiser::build_layout(Rng& rng) {
-  const std::string& l = spec_.layout;
-  if (l == "grid") {
-    grid_layout(5, 11, 10, 3, 8);
-  } else if (l == "sparse") {
-    grid_layout(4, 6, 5, 2, 30);
-  } else if (l == "small") {
-    small_layout();
-  } else if (l == "line") {
-    line_layout(rng);
-  } else if (l == "ballbar") {
-    ballbar_layout(0, 1);
-  } else if (l == "ballbar_yz") {
-    ballbar_layout(1, 2);
-  } else if (l == "rtest" || l == "rtest_small") {
-    rtest_layout(l == "rtest_small");
-  } else {
-    throw fail("unknown layout '" + l + "'");
+  switch (layout_.kind) {
+    case Layout::Kind::Grid:
+      grid_layout(5, 11, 10, 3, 8);
+      break;
+    case Layout::Kind::Sparse:
+      grid_layout(4, 6, 5, 2, 30);
+      break;
+    case Layout::Kind::Small:
+      small_layout();
+      break;
+    case Layout::Kind::Line:
+      line_layout(rng);
+      break;
+    case Layout::Kind::Ballbar:
+      ballbar_layout(0, 1);
+      break;
+    case Layout::Kind::BallbarYz:
+      ballbar_layout(1, 2);
+      break;
+    case Layout::Kind::Rtest:
+    case Layout::Kind::RtestSmall:
+      rtest_layout(layout_.kind == Layout::Kind::RtestSmall);
+      break;
   }
   finish_layout();
 }
@@ -393,9 +432,8 @@ double Synthesiser::drift(double t_s) const {
 }
 
 double Synthesiser::axis_step(int axis) const {
-  if (spec_.layout == "line") return (axes_[axis].max - axes_[axis].min) / 100;
-  if (spec_.layout == "ballbar" || spec_.layout == "ballbar_yz")
-    return radius_mm_ * 2 * kPi / 180;  // 2 deg of arc
+  if (layout_.line()) return (axes_[axis].max - axes_[axis].min) / 100;
+  if (layout_.ballbar()) return radius_mm_ * 2 * kPi / 180;  // 2 deg of arc
   return grid_step_[static_cast<std::size_t>(axis)];
 }
 

@@ -13,8 +13,8 @@
   - no function (or method defined in its class) in src/ is longer than 150 lines, except the
     named ones of LONG_FUNCTIONS, each with its reason (an exception that is no longer needed is
     reported too, so the list only shrinks);
-  - no doctest case name in tests/*.cpp contains ';' (CMake splits the name at it, and CTest
-    then runs no test of that case).
+  - no doctest case name in tests/*.cpp or tests/gap/*.cpp contains ';' (CMake splits the name at
+    it, and CTest then runs no test of that case).
 
 Usage: check_layout.py SOURCE_DIR. Prints each violation as file:line: message; exit 1 if any.
 """
@@ -51,7 +51,7 @@ TEST_CASE = re.compile(r'^\s*TEST_CASE\("((?:[^"\\]|\\.)*)"')
 
 # Tests that check a layer's internals directly, each with its reason.
 WHITE_BOX_TESTS = {
-    "tests/test_gap_engine.cpp": "the gap diagnosis' least-squares engine against dense least "
+    "tests/gap/engine.cpp": "the gap diagnosis' least-squares engine against dense least "
                                  "squares, below the public diagnosis",
 }
 
@@ -227,9 +227,10 @@ def main(root):
         if lib in text:
             problems.append(f"src/codegen/CMakeLists.txt: links {lib} (codegen uses GiNaC only)")
     tests = os.path.join(root, "tests")
-    for name in sorted(os.listdir(tests)):
-        if not name.endswith(".cpp"):
-            continue
+    test_files = sorted(n for n in os.listdir(tests) if n.endswith(".cpp"))
+    test_files += sorted("gap/" + n for n in os.listdir(os.path.join(tests, "gap"))
+                         if n.endswith(".cpp"))
+    for name in test_files:
         with open(os.path.join(tests, name), encoding="utf-8") as fh:
             for number, line in enumerate(fh, 1):
                 m = TEST_CASE.match(line)

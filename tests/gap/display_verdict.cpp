@@ -1,151 +1,14 @@
-// Gap diagnosis, issue 14: bad input (angles in radians, covariates with gaps), the display
-// (rejected candidates, shapes the data cannot tell apart, plots along every coordinate that
-// varies) and where the residual lies on a rotary machine and in a diagonal run.
+// Gap diagnosis, the display and the verdict: rejected candidates and indistinct shapes, plots
+// along every coordinate that varies, where the residual lies on a rotary machine and in a
+// diagonal run, and the verdict without a significant baseline gap.
 #include <doctest/doctest.h>
 
-#include <algorithm>
-#include <cmath>
-#include <random>
-#include <sstream>
-
-#include "test_support.hpp"
-#include "weilgen/analysis/gap.hpp"
-#include "weilgen/model/numeric_chain.hpp"
+#include "gap/fixtures.hpp"
+#include "weilgen/base/constants.hpp"
 #include "weilgen/report/gap_document.hpp"
 
 using namespace weilgen;
-
-namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const std::exception& e) {
-    return e.what();
-  }
-  return "no error";
-}
-
-// five_axis_ac rows: X, Y, Z fixed, A over {-30, 0, 30} deg, C over `c` (written as given).
-std::string five_axis_rows(const std::vector<std::string>& c) {
-  std::string s = "X,Y,Z,A,C,t_s,dx_um,rpm\n";
-  int t = 0;
-  for (const char* a : {"-30", "0", "30"})
-    for (const std::string& ci : c) {
-      s += std::string("10,0,-100,") + a + "," + ci + "," + std::to_string(60 * t) + "," +
-           std::to_string(0.1 * t) + "," + std::to_string(1000 + 10 * t) + "\n";
-      ++t;
-    }
-  return s;
-}
-
-MeasurementTable read_for(const std::string& machine, const std::string& csv) {
-  return parse_measurements(
-      csv, "r.csv", machine_read_options(test::builtin_model(machine)->description(), false));
-}
-
-}  // namespace
-
-TEST_CASE("gap input: a rotary column in radians is refused when it reads as whole degrees") {
-  // C at 0, 30, ..., 330 deg written in radians (6 decimals), five_axis_ac's C in deg over ±360.
-  std::vector<std::string> rad;
-  for (int k = 0; k < 12; ++k) {
-    std::ostringstream v;
-    v.precision(6);
-    v << std::fixed << k * 30 * kPi / 180;
-    rad.push_back(v.str());
-  }
-  // The largest value (5.759587 rad = 330 deg) is on line 13 (the first A block), column 15.
-  CHECK(error_of([&] { read_for("five_axis_ac", five_axis_rows(rad)); }) ==
-        "r.csv:13:15: column 'C' looks like radians: every value lies within ±2π (0 .. 5.75959) "
-        "while C is in deg over [-360, 360] deg, and read as radians they are whole degrees "
-        "(5.75959 rad = 330 deg); write it in degrees (times 180/π)");
-  // The reader is the one home: identify and gap read the data through it (CLI: hostile_cli).
-  // The same values in degrees are read without a word.
-  std::vector<std::string> deg;
-  for (int k = 0; k < 12; ++k) deg.push_back(std::to_string(30 * k));
-  const MeasurementTable ok = read_for("five_axis_ac", five_axis_rows(deg));
-  CHECK(ok.warnings.empty());
-}
-
-TEST_CASE("gap input: a short sweep within ±2π deg is a warning, not an error") {
-  // 0, 0.5, ..., 5.5 deg: possible in degrees (a short sweep) and in radians (0 .. 315 deg);
-  // read as radians they are not whole degrees, so the range alone speaks: a located warning.
-  std::vector<std::string> c;
-  for (int k = 0; k < 12; ++k) c.push_back(std::to_string(0.5 * k));
-  const MeasurementTable t = read_for("five_axis_ac", five_axis_rows(c));
-  REQUIRE(t.warnings.size() == 1);
-  CHECK(t.warnings[0] ==
-        "r.csv:13:15: warning: column 'C' looks like radians: every value lies within ±2π (0 .. "
-        "5.5) while C is in deg over [-360, 360] deg, so as degrees the data turn C by only 5.5 "
-        "deg; if they are radians, write them in degrees");
-  // Whole numbers as written (0, 1, ..., 5 deg) are never an error, whatever they read as.
-  c.clear();
-  for (int k = 0; k < 12; ++k) c.push_back(std::to_string(k % 6));
-  CHECK(read_for("five_axis_ac", five_axis_rows(c)).warnings.size() == 1);
-  // A value beyond what radians within the travel allow (A = 2.5 rad = 143 deg > 110 deg): no
-  // word about radians.
-  std::string a = "X,Y,Z,A,C,dx_um\n";
-  for (int k = 0; k < 12; ++k) a += "10,0,-100," + std::to_string(0.25 * k) + ",0,1\n";
-  CHECK(read_for("five_axis_ac", a).warnings.empty());
-  // Fewer than 3 distinct values, or a machine axis in radians: no check.
-  std::string two = "X,Y,Z,A,C,dx_um\n";
-  for (int k = 0; k < 12; ++k)
-    two += "10,0,-100,0," + std::string(k % 2 ? "1.570796" : "0") + ",1\n";
-  CHECK(read_for("five_axis_ac", two).warnings.empty());
-}
-
-TEST_CASE("gap input: a ballbar angle in radians is refused") {
-  std::string s = "# plane: XY\n# radius: 150 mm\nangle_deg,dr_um\n";
-  for (int k = 0; k < 36; ++k)
-    s += std::to_string(k * 10 * kPi / 180) + "," + std::to_string(0.1 * k) + "\n";
-  const std::string e = error_of([&] { parse_measurements(s, "b.csv"); });
-  CHECK(e.rfind("b.csv:39:1: column 'angle_deg' looks like radians", 0) == 0);
-  CHECK(e.find("(6.10865 rad = 350 deg)") != std::string::npos);
-}
-
-TEST_CASE("gap input: a covariate with gaps names the file, the first empty cell and every row") {
-  const Description& desc = test::builtin_model("vmc_3axis")->description();
-  auto gap_error = [&](const std::string& csv) {
-    return error_of([&] { gap_data(parse_measurements(csv, "b.csv"), desc); });
-  };
-  auto rows = [](const std::string& column, const std::vector<int>& empty, int n) {
-    std::string s = "X,Y,Z," + column + ",dx_um\n";
-    for (int i = 0; i < n; ++i) {
-      const bool gap = std::find(empty.begin(), empty.end(), i) != empty.end();
-      s += std::to_string(i * 10) + ",0,0," + (gap ? "" : std::to_string(100 + 7 * i)) + ",1\n";
-    }
-    return s;
-  };
-  CHECK(gap_error(rows("rpm", {3}, 12)) ==
-        "b.csv:5:8: column 'rpm' is empty in 1 row where a deviation is measured (line 5): the "
-        "diagnosis needs it in every row; fill or drop those rows");
-  // Beyond ten rows, the count of the others.
-  std::vector<int> many;
-  for (int i = 2; i < 16; ++i) many.push_back(i);
-  CHECK(gap_error(rows("T_table", many, 30)) ==
-        "b.csv:4:8: column 'T_table' is empty in 14 rows where a deviation is measured (lines 4, "
-        "5, 6, 7, 8, 9, 10, 11, 12, 13 and 4 more): the diagnosis needs it in every row; fill or "
-        "drop those rows");
-  CHECK(gap_error(rows("t_s", {0, 11}, 12)) ==
-        "b.csv:2:7: column 't_s' is empty in 2 rows where a deviation is measured (lines 2, 13): "
-        "the diagnosis needs it in every row; fill or drop those rows");
-  // A cycle or a direction with gaps too (neither needs to vary).
-  CHECK(gap_error(rows("cycle", {5}, 12)) ==
-        "b.csv:7:8: column 'cycle' is empty in 1 row where a deviation is measured (line 7): the "
-        "diagnosis needs it in every row; fill or drop those rows");
-  std::string dir = "X,Y,Z,dir_X,dx_um\n";
-  for (int i = 0; i < 12; ++i)
-    dir += std::to_string(i * 10) + ",0,0," + (i == 8 ? "" : "1") + ",1\n";
-  CHECK(gap_error(dir) ==
-        "b.csv:10:8: column 'dir_X' is empty in 1 row where a deviation is measured (line 10): "
-        "the diagnosis needs it in every row; fill or drop those rows");
-  // A row that measures nothing may leave the covariate empty.
-  std::string unmeasured = rows("rpm", {}, 12) + "5,0,0,,\n";
-  CHECK_NOTHROW(gap_data(parse_measurements(unmeasured, "b.csv"), desc));
-}
+using namespace weilgen::gap_test;
 
 namespace {
 
@@ -272,15 +135,6 @@ std::string diagonal(std::uint32_t seed, int cycles,
       t += 60;
     }
   return csv.str();
-}
-
-GapResult diagnose(const std::string& csv, const std::string& machine, const std::string& holdout) {
-  const auto model = test::builtin_model(machine);
-  PdgeBasisChoice c;
-  c.all = "poly:2";
-  const ErrorParameterisation p(model->description(), c, model->parameters());
-  const GapData d = gap_data(parse_measurements(csv, "g.csv"), model->description());
-  return GapDiagnosis().run(*model, p, d, *parse_holdout(holdout), "test");
 }
 
 }  // namespace
