@@ -112,19 +112,36 @@ CNames c_names(const SymbolicModel& m) {
   return c;
 }
 
-std::string instantiate_template(std::string text, const std::string& lower,
+namespace {
+
+const std::string kTemplateMarker = "---- weilgen template: ";
+
+// The positions of a block's begin line's first character and of the character after its end
+// line's newline.
+std::pair<std::size_t, std::size_t> block_span(const std::string& text, const std::string& block) {
+  const auto b = text.find(kTemplateMarker + block + " begin ----");
+  const auto e = text.find(kTemplateMarker + block + " end ----");
+  if (b == std::string::npos || e == std::string::npos || e < b)
+    throw std::logic_error("template: no block '" + block + "'");
+  const auto from = text.rfind('\n', b) == std::string::npos ? 0 : text.rfind('\n', b) + 1;
+  const auto to = text.find('\n', e) == std::string::npos ? text.size() : text.find('\n', e) + 1;
+  return {from, to};
+}
+
+}  // namespace
+
+std::string template_block(const std::string& text, const std::string& block) {
+  const auto [from, to] = block_span(text, block);
+  const auto inner = text.find('\n', from) + 1;
+  const auto end_line =
+      text.rfind('\n', to - 2) == std::string::npos ? 0 : text.rfind('\n', to - 2) + 1;
+  return text.substr(inner, end_line - inner);
+}
+
+std::string instantiate_template(const std::string& text, const std::string& lower,
                                  const std::string& upper_name,
                                  const std::vector<std::pair<std::string, std::string>>& blocks) {
-  for (const auto& [block, replacement] : blocks) {
-    const std::string begin = "---- weilgen template: " + block + " begin ----";
-    const std::string end = "---- weilgen template: " + block + " end ----";
-    const auto b = text.find(begin), e = text.find(end);
-    if (b == std::string::npos || e == std::string::npos || e < b)
-      throw std::logic_error("template: no block '" + block + "'");
-    const auto from = text.rfind('\n', b) == std::string::npos ? 0 : text.rfind('\n', b) + 1;
-    const auto to = text.find('\n', e) == std::string::npos ? text.size() : text.find('\n', e) + 1;
-    text.replace(from, to - from, replacement);
-  }
+  // The stand-in names first: a block's text is final (a model's own names may hold "standin").
   std::string out;
   for (std::size_t i = 0; i < text.size();) {
     const bool low = text.compare(i, 7, "standin") == 0, up = text.compare(i, 7, "STANDIN") == 0;
@@ -137,6 +154,10 @@ std::string instantiate_template(std::string text, const std::string& lower,
                              text.substr(i > 10 ? i - 10 : 0, 30));
     out += low ? lower : upper_name;
     i += 7;
+  }
+  for (const auto& [block, replacement] : blocks) {
+    const auto [from, to] = block_span(out, block);
+    out.replace(from, to - from, replacement);
   }
   return out;
 }

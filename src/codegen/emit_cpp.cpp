@@ -21,6 +21,10 @@ namespace weilgen::gen {
 
 using GiNaC::ex;
 
+// The text of templates/model.hpp after its marker line, embedded at build time
+// (src/codegen/CMakeLists.txt).
+extern const char* const kModelTemplate;
+
 namespace {
 
 std::string string_literal(const std::string& s) {
@@ -603,156 +607,167 @@ std::string doc_list(const std::vector<std::string>& names) {
   return s;
 }
 
-}  // namespace
+// The generated functions' bodies with their operation counts, before the template places them.
+struct ModelCode {
+  std::vector<Monomial> higher;  // monomials of degree >= 2 with a non-zero coefficient
+  FunctionCode coefficients, deviation, deviation_and_coefficients, higher_order, nominal_pose,
+      nominal_jacobian;
+  HigherTable table;  // the shared coefficient polynomials (only with `higher`)
+};
 
-std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_label,
-                            std::size_t max_nested_higher_terms, const SplitLimits& split) {
-  const Description& d = m.desc;
-  const InputTable inputs = inputs_of(m);
-  const std::size_t ne = m.errors.size();
-  const std::vector<Monomial> higher = m.higher_monomials();
-
-  // Coefficients: ∂output/∂error at zero error, row-major [output][error].
-  std::vector<ex> cpos, crot;
+// Coefficients: ∂output/∂error at zero error, row-major [output][error].
+FunctionCode coefficients_function(const SymbolicModel& m, const InputTable& inputs) {
+  std::vector<ex> pos, rot;
   for (int o = 0; o < 6; ++o)
-    for (std::size_t i = 0; i < ne; ++i)
-      (o < 3 ? cpos : crot).push_back(m.coefficient(o, {static_cast<std::uint16_t>(i)}));
-  const FunctionCode coef =
-      function_body(inputs, {{"position_coeff", cpos}, {"orientation_coeff", crot}});
+    for (std::size_t i = 0; i < m.errors.size(); ++i)
+      (o < 3 ? pos : rot).push_back(m.coefficient(o, {static_cast<std::uint16_t>(i)}));
+  return function_body(inputs, {{"position_coeff", pos}, {"orientation_coeff", rot}});
+}
 
-  FunctionCode dev, dev_coef, high;
-  HigherTable table;
-  if (higher.empty()) {
-    // Deviation: the full algebra element of each output.
-    Coefficients coefs;
-    std::vector<ex> pos, rot;
-    for (int o = 0; o < 6; ++o) (o < 3 ? pos : rot).push_back(coefs.output(m.outputs[o], m.errors));
-    dev = function_body(inputs, {{"position", pos}, {"orientation", rot}}, &coefs);
+// Deviation and DeviationAndCoefficients of a model without terms of degree >= 2: the full
+// algebra element of each output, its coefficients named once.
+void first_order_functions(const SymbolicModel& m, const InputTable& inputs, ModelCode& code) {
+  Coefficients coefs;
+  std::vector<ex> pos, rot;
+  for (int o = 0; o < 6; ++o) (o < 3 ? pos : rot).push_back(coefs.output(m.outputs[o], m.errors));
+  code.deviation = function_body(inputs, {{"position", pos}, {"orientation", rot}}, &coefs);
+  // Both at once: one CSE over the deviation and the coefficients, so that the sin/cos of the
+  // axes and the nominal terms they share are computed once. A coefficient that is a named
+  // coefficient of Deviation is written as factor·_coefN (the same canonical sign), so that the
+  // two are not computed twice under different signs.
+  Coefficients shared = coefs;
+  std::vector<ex> spos, srot;
+  shared.first_order(m, spos, srot);
+  code.deviation_and_coefficients = function_body(inputs,
+                                                  {{"position", pos},
+                                                   {"orientation", rot},
+                                                   {"position_coeff", spos},
+                                                   {"orientation_coeff", srot}},
+                                                  &shared);
+}
 
-    // Both at once: one CSE over the deviation and the coefficients, so that the sin/cos of the
-    // axes and the nominal terms they share are computed once. A coefficient that is a named
-    // coefficient of Deviation is written as factor·_coefN (the same canonical sign), so that
-    // the two are not computed twice under different signs.
-    Coefficients shared = coefs;
-    std::vector<ex> spos, srot;
-    shared.first_order(m, spos, srot);
-    dev_coef = function_body(inputs,
-                             {{"position", pos},
-                              {"orientation", rot},
-                              {"position_coeff", spos},
-                              {"orientation_coeff", srot}},
-                             &shared);
-  } else {
-    table = higher_table(m, higher, inputs, max_nested_higher_terms, split);
-    dev = table.deviation;
-    dev_coef = table.deviation_and_coefficients;
-    high = table.higher_order;
-  }
-  // Nominal kinematics: the pose at zero errors and its Jacobian in the axes' units (a revolute
-  // column per deg is the per-rad derivative times to_base).
-  std::vector<ex> npos, nrot;
+// The pose at zero errors.
+FunctionCode nominal_pose_function(const SymbolicModel& m, const InputTable& inputs) {
+  std::vector<ex> pos, rot;
   for (int i = 0; i < 3; ++i) {
-    npos.push_back(m.nominal[i][3]);
-    for (int j = 0; j < 3; ++j) nrot.push_back(m.nominal[i][j]);
+    pos.push_back(m.nominal[i][3]);
+    for (int j = 0; j < 3; ++j) rot.push_back(m.nominal[i][j]);
   }
-  const FunctionCode pose = function_body(inputs, {{"position", npos}, {"rotation", nrot}});
-  // A unit factor is a named constant, `_to_baseN * (...)`, not multiplied into every term.
-  InputTable jinputs = inputs;
+  return function_body(inputs, {{"position", pos}, {"rotation", rot}});
+}
+
+// The nominal pose's Jacobian in the axes' units: a revolute column per deg is the per-rad
+// derivative times to_base, a named constant `_to_baseN * (...)` rather than multiplied into
+// every term.
+FunctionCode nominal_jacobian_function(const SymbolicModel& m, const InputTable& inputs) {
+  InputTable with_units = inputs;
   std::map<double, GiNaC::symbol> unit_factor;
   std::vector<ex> jac(m.nominal_jacobian.size());
   const std::size_t na = m.axes.size();
   for (std::size_t k = 0; k < jac.size(); ++k) {
-    const double to_base = d.bodies[m.axes[k % na].body].joint.to_base;
+    const double to_base = m.desc.bodies[m.axes[k % na].body].joint.to_base;
     jac[k] = m.nominal_jacobian[k];
     if (to_base == 1.0 || jac[k].is_zero()) continue;
     auto it = unit_factor.find(to_base);
     if (it == unit_factor.end()) {
       const std::string code = "_to_base" + std::to_string(unit_factor.size());
       it = unit_factor.emplace(to_base, GiNaC::symbol(code)).first;
-      jinputs.code_name[code] = code;
-      jinputs.definition[code] = "Scalar(" + format_literal(to_base) + ")";
-      jinputs.order.push_back(code);
+      with_units.code_name[code] = code;
+      with_units.definition[code] = "Scalar(" + format_literal(to_base) + ")";
+      with_units.order.push_back(code);
     }
     jac[k] = it->second * jac[k];
   }
-  const FunctionCode jacobian = function_body(jinputs, {{"jacobian", jac}});
+  return function_body(with_units, {{"jacobian", jac}});
+}
 
-  std::vector<std::string> axis_names, error_names, param_names;
-  for (const auto& a : m.axes) axis_names.push_back(d.bodies[a.body].joint.coordinate);
-  for (const auto& e : d.errors) error_names.push_back(e.name);
-  for (const auto& p : d.parameters) param_names.push_back(p.name);
+ModelCode model_code(const SymbolicModel& m, std::size_t max_nested_higher_terms,
+                     const SplitLimits& split) {
+  const InputTable inputs = inputs_of(m);
+  ModelCode code;
+  code.higher = m.higher_monomials();
+  code.coefficients = coefficients_function(m, inputs);
+  if (code.higher.empty()) {
+    first_order_functions(m, inputs, code);
+  } else {
+    code.table = higher_table(m, code.higher, inputs, max_nested_higher_terms, split);
+    code.deviation = code.table.deviation;
+    code.deviation_and_coefficients = code.table.deviation_and_coefficients;
+    code.higher_order = code.table.higher_order;
+  }
+  code.nominal_pose = nominal_pose_function(m, inputs);
+  code.nominal_jacobian = nominal_jacobian_function(m, inputs);
+  return code;
+}
 
+// The banner's lines that name the source, the machine and the algebra.
+std::string banner_block(const SymbolicModel& m, const std::string& source_label) {
+  const Description& d = m.desc;
   std::ostringstream os;
   os << "// GENERATED by weilgen " << kVersion << " from " << source_label
      << ". Do not edit: edit the machine file and run `weilgen generate`.\n";
   os << "// Machine: " << d.name << (d.title.empty() ? "" : " — " + d.title) << "\n";
-  os << "// Algebra: R[e_1..e_" << ne << "] / I, I = <all monomials of degree " << m.order + 1
-     << ">";
+  os << "// Algebra: R[e_1..e_" << m.errors.size() << "] / I, I = <all monomials of degree "
+     << m.order + 1 << ">";
   if (!m.relations.empty()) os << " + <" << m.relations.size() << " relation monomials>";
   os << " (order " << m.order << (m.order == 1 ? ", dual numbers" : "") << ")\n";
-  os << "// Units: axes as in kAxes (mm, deg), errors in base units (mm, rad), parameters in "
-        "mm/deg;\n"
-     << "//        position outputs dx, dy, dz in mm, orientation outputs da, db, dc in rad.\n";
-  os << "// Operation counts (after common-subexpression elimination):\n";
-  if (!higher.empty())
-    os << "//   MonomialCoefficients: " << table.monomial.ops.str() << ", " << table.monomial.temps
-       << " temporaries (" << table.count
+  return os.str();
+}
+
+std::string operation_counts_block(const SymbolicModel& m, const ModelCode& c) {
+  const bool higher = !c.higher.empty();
+  std::ostringstream os;
+  if (higher)
+    os << "//   MonomialCoefficients: " << c.table.monomial.ops.str() << ", "
+       << c.table.monomial.temps << " temporaries (" << c.table.count
        << " coefficients; included in each function below that uses them)\n";
-  os << "//   Deviation:    " << dev.ops.str() << ", " << dev.temps << " temporaries\n";
-  os << "//   Coefficients: " << coef.ops.str() << ", " << coef.temps << " temporaries\n";
-  os << "//   DeviationAndCoefficients: " << dev_coef.ops.str() << ", " << dev_coef.temps
+  os << "//   Deviation:    " << c.deviation.ops.str() << ", " << c.deviation.temps
      << " temporaries\n";
-  if (!higher.empty())
-    os << "//   HigherOrder:  " << high.ops.str() << ", " << high.temps << " temporaries\n";
-  os << "//   NominalPose:  " << pose.ops.str() << ", " << pose.temps << " temporaries\n";
-  os << "//   NominalJacobian: " << jacobian.ops.str() << ", " << jacobian.temps
+  os << "//   Coefficients: " << c.coefficients.ops.str() << ", " << c.coefficients.temps
+     << " temporaries\n";
+  os << "//   DeviationAndCoefficients: " << c.deviation_and_coefficients.ops.str() << ", "
+     << c.deviation_and_coefficients.temps << " temporaries\n";
+  if (higher)
+    os << "//   HigherOrder:  " << c.higher_order.ops.str() << ", " << c.higher_order.temps
+       << " temporaries\n";
+  os << "//   NominalPose:  " << c.nominal_pose.ops.str() << ", " << c.nominal_pose.temps
+     << " temporaries\n";
+  os << "//   NominalJacobian: " << c.nominal_jacobian.ops.str() << ", " << c.nominal_jacobian.temps
      << " temporaries\n";
   os << "//   Compensate:   per iteration errors_at + Deviation + NominalPose + "
-     << (m.axes_turn_output() ? 6 : 3) << "x" << na
+     << (m.axes_turn_output() ? 6 : 3) << "x" << m.axes.size()
      << " least-squares step; once per call NominalJacobian + NominalPose + Cholesky\n";
-  os << "#pragma once\n\n#include <array>\n#include <cmath>\n#include <cstddef>\n"
-     << (higher.empty() ? "" : "#include <cstdint>\n") << "\n";
-  os << "namespace weilgen_models {\nnamespace " << d.name << " {\n\n";
+  return os.str();
+}
 
-  os << "inline constexpr const char* kMachineName = " << string_literal(d.name) << ";\n";
-  os << "inline constexpr int kOrder = " << m.order << ";\n";
-  os << "// Machine-file text, order and weilgen version: identifies the model "
-        "(weilgen/machine/model_key.hpp).\n";
+// The model's counts, from kModelKey to kMaxHigherDegree.
+std::string counts_block(const SymbolicModel& m, const std::vector<Monomial>& higher) {
+  std::ostringstream os;
   os << "inline constexpr const char* kModelKey = "
-     << string_literal(model_key(d.source_hash, m.order)) << ";\n";
+     << string_literal(model_key(m.desc.source_hash, m.order)) << ";\n";
   os << "inline constexpr std::size_t kNumAxes = " << m.axes.size() << ";\n";
-  os << "inline constexpr std::size_t kNumErrors = " << ne << ";\n";
-  os << "inline constexpr std::size_t kNumParams = " << d.parameters.size() << ";\n";
+  os << "inline constexpr std::size_t kNumErrors = " << m.errors.size() << ";\n";
+  os << "inline constexpr std::size_t kNumParams = " << m.desc.parameters.size() << ";\n";
   os << "inline constexpr std::size_t kNumOutputs = " << kNumDeviationOutputs << ";\n";
   os << "inline constexpr std::size_t kNumHigherTerms = " << higher.size() << ";\n";
   os << "inline constexpr std::size_t kMaxHigherDegree = "
-     << (higher.empty() ? 0 : higher.back().size()) << ";\n\n";
+     << (higher.empty() ? 0 : higher.back().size()) << ";\n";
+  return os.str();
+}
 
-  os << "enum class DistributionKind { kNone, kNormal, kUniform, kTruncatedNormal };\n\n";
-  os << "struct AxisInfo {\n  const char* name;\n  const char* unit;\n  bool revolute;\n"
-        "  double min;\n  double max;\n  double to_base;  // unit -> mm or rad\n};\n\n";
-  os << "struct ErrorInfo {\n  const char* name;\n  const char* iso;      // ISO 230-1 name or "
-        "\"\"\n"
-        "  const char* aliases;  // space-separated; a leading '-' marks a negated alias\n"
-        "  const char* group;\n  const char* unit;     // unit of the distribution values\n"
-        "  double to_base;       // unit -> mm or rad (the unit of Deviation's errors)\n"
-        "  bool position_dependent;  // PDGE (true) or PIGE (false)\n"
-        "  const char* body;\n  const char* placement;  // after | before | axis\n"
-        "  bool rotation;\n  DistributionKind distribution;\n"
-        "  double a, b;    // normal: mean, sigma; uniform: lo, hi (in unit)\n"
-        "  double lo, hi;  // truncated normal bounds (in unit)\n};\n\n";
-  os << "struct ParamInfo {\n  const char* name;\n  const char* unit;\n  double "
-        "default_value;\n};\n\n";
-
-  os << "inline constexpr std::array<AxisInfo, kNumAxes> kAxes = {{\n";
+std::string axis_rows(const SymbolicModel& m) {
+  std::ostringstream os;
   for (const auto& a : m.axes) {
-    const Joint& j = d.bodies[a.body].joint;
+    const Joint& j = m.desc.bodies[a.body].joint;
     os << "    {" << string_literal(j.coordinate) << ", " << string_literal(j.unit) << ", "
        << (a.revolute ? "true" : "false") << ", " << format_literal(j.min) << ", "
        << format_literal(j.max) << ", " << format_literal(j.to_base) << "},\n";
   }
-  os << "}};\n\n";
-  os << "inline constexpr std::array<ErrorInfo, kNumErrors> kErrors = {{\n";
+  return os.str();
+}
+
+std::string error_rows(const Description& d) {
+  std::ostringstream os;
   for (const auto& e : d.errors) {
     std::string aliases;
     for (const auto& al : e.aliases)
@@ -768,162 +783,134 @@ std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_la
        << format_literal(e.distribution.b) << ", " << format_literal(e.distribution.lo) << ", "
        << format_literal(e.distribution.hi) << "},\n";
   }
-  os << "}};\n\n";
-  os << "inline constexpr std::array<ParamInfo, kNumParams> kParams = {{\n";
+  return os.str();
+}
+
+std::string param_rows(const Description& d) {
+  std::ostringstream os;
   const auto defaults = d.parameter_defaults();
   for (const auto& p : d.parameters)
     os << "    {" << string_literal(p.name) << ", " << string_literal(p.unit) << ", "
        << format_literal(defaults.at(p.name)) << "},\n";
-  os << "}};\n\n";
+  return os.str();
+}
+
+std::string outputs_block() {
   std::string names, units;
   for (std::size_t o = 0; o < kNumDeviationOutputs; ++o) {
     names += std::string(o ? ", " : "") + string_literal(output_name(o));
     units += std::string(o ? ", " : "") + string_literal(output_unit(o));
   }
-  os << "inline constexpr std::array<const char*, kNumOutputs> kOutputs = {{" << names << "}};\n";
-  os << "inline constexpr std::array<const char*, kNumOutputs> kOutputUnits = {{" << units
-     << "}};\n\n";
-  os << emit_index_constants(m);
-  os << "// Monomials of degree >= 2 with a non-zero coefficient: error indices, padded with -1.\n";
+  return "inline constexpr std::array<const char*, kNumOutputs> kOutputs = {{" + names + "}};\n" +
+         "inline constexpr std::array<const char*, kNumOutputs> kOutputUnits = {{" + units +
+         "}};\n";
+}
+
+// kHigherTerms' declaration and rows (several monomials per line: tens of thousands at order 3).
+std::string higher_terms_block(const std::vector<Monomial>& higher) {
   const std::size_t width = higher.empty() ? 1 : higher.back().size();
-  os << "inline constexpr std::array<std::array<int, " << width
-     << ">, kNumHigherTerms> kHigherTerms = {{\n";
-  std::vector<std::string> rows;  // several monomials per line: tens of thousands at order 3
+  std::vector<std::string> rows;
   for (const auto& mono : higher) {
     std::string item = "{{";
     for (std::size_t i = 0; i < width; ++i)
       item += (i ? "," : "") + (i < mono.size() ? std::to_string(mono[i]) : std::string("-1"));
     rows.push_back(item + "}},");
   }
-  os << packed_lines(rows);
-  os << "}};\n\n";
-  if (!higher.empty()) {
-    os << "// Coefficient polynomials shared by DeviationAndCoefficients, Deviation and "
-          "HigherOrder.\n"
-       << "inline constexpr std::size_t kNumMonomialCoefficients = " << table.count << ";\n";
-    os << table.tables;
-  }
+  return "inline constexpr std::array<std::array<int, " + std::to_string(width) +
+         ">, kNumHigherTerms> kHigherTerms = {{\n" + packed_lines(rows);
+}
 
-  const std::string in_doc = "//   axes:   " + doc_list(axis_names) +
-                             "\n//   errors: " + doc_list(error_names) +
-                             "\n//   params: " + doc_list(param_names) + "\n";
-  std::ostringstream dev_text, coef_text, dev_coef_text;
-  dev_text
-      << (d.output ? "// Deviation of the output point (" +
-                         (d.output->description.empty() ? std::string("the output transform")
-                                                        : d.output->description) +
-                         "):\n"
-                   : std::string("// Deviation of the tool point relative to the workpiece, in the "
-                                 "workpiece frame:\n"))
-      << "// position = (dx, dy, dz) in mm, orientation = (da, db, dc) in rad. Null outputs are\n"
-         "// skipped. Exact in the algebra of order kOrder.\n"
-      << in_doc;
-  dev_text
-      << "template <typename Scalar>\nvoid Deviation([[maybe_unused]] const std::array<Scalar, "
-         "kNumAxes>& axes,\n"
-         "               [[maybe_unused]] const std::array<Scalar, kNumErrors>& errors,\n"
-         "               [[maybe_unused]] const std::array<Scalar, kNumParams>& params,\n"
-         "               std::array<Scalar, 3>* const position,\n"
-         "               std::array<Scalar, 3>* const orientation = nullptr) {\n"
-         "  using std::cos;\n  using std::sin;\n  using std::sqrt;\n"
-      << dev.body << "}\n";
-  coef_text
-      << "\n// First-order coefficients d(output)/d(error) at zero error, row-major "
-         "[output][error]:\n"
-         "// position_coeff rows dx, dy, dz (mm per base unit of the error), orientation_coeff "
-         "rows\n"
-         "// da, db, dc (rad per base unit).\n";
-  coef_text
-      << "template <typename Scalar>\nvoid Coefficients([[maybe_unused]] const std::array<Scalar, "
-         "kNumAxes>& axes,\n"
-         "                  [[maybe_unused]] const std::array<Scalar, kNumParams>& params,\n"
-         "                  std::array<Scalar, 3 * kNumErrors>* const position_coeff,\n"
-         "                  std::array<Scalar, 3 * kNumErrors>* const orientation_coeff = nullptr) "
-         "{\n"
-         "  using std::cos;\n  using std::sin;\n  using std::sqrt;\n"
-      << coef.body << "}\n";
-  dev_coef_text
-      << "\n// Deviation and Coefficients at one pose in one call, sharing the sin/cos of the axes "
-         "and\n"
-         "// the terms common to both (one common-subexpression pass over both). The same outputs\n"
-         "// as the two functions, equal to rounding; null outputs are skipped.\n";
-  dev_coef_text
-      << "template <typename Scalar>\nvoid DeviationAndCoefficients(\n"
-         "    [[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,\n"
-         "    [[maybe_unused]] const std::array<Scalar, kNumErrors>& errors,\n"
-         "    [[maybe_unused]] const std::array<Scalar, kNumParams>& params,\n"
-         "    std::array<Scalar, 3>* const position, std::array<Scalar, 3>* const orientation,\n"
-         "    std::array<Scalar, 3 * kNumErrors>* const position_coeff,\n"
-         "    std::array<Scalar, 3 * kNumErrors>* const orientation_coeff = nullptr) {\n"
-         "  using std::cos;\n  using std::sin;\n  using std::sqrt;\n"
-      << dev_coef.body << "}\n";
-  if (higher.empty()) {
-    os << dev_text.str() << coef_text.str() << dev_coef_text.str();
+// A block of the template that keeps its own text (without its marker lines).
+std::pair<std::string, std::string> kept(const std::string& block) {
+  return {block, template_block(kModelTemplate, block)};
+}
+
+// One function section of the template with its body.
+std::string function_text(const std::string& section, const FunctionCode& code,
+                          const std::vector<std::pair<std::string, std::string>>& blocks = {}) {
+  auto all = blocks;
+  all.push_back({"body", code.body});
+  return instantiate_template(template_block(kModelTemplate, section), "", "", all);
+}
+
+// The functions in the header's order: without terms of degree >= 2, Deviation, Coefficients
+// and DeviationAndCoefficients; with them, MonomialCoefficients first (the others call it), then
+// DeviationAndCoefficients, which Deviation calls, and HigherOrder.
+std::string functions_block(const SymbolicModel& m, const ModelCode& c) {
+  const Description& d = m.desc;
+  std::vector<std::string> axis_names, error_names, param_names;
+  for (const auto& a : m.axes) axis_names.push_back(d.bodies[a.body].joint.coordinate);
+  for (const auto& e : d.errors) error_names.push_back(e.name);
+  for (const auto& p : d.parameters) param_names.push_back(p.name);
+  std::vector<std::pair<std::string, std::string>> deviation_blocks = {
+      {"inputs", "//   axes:   " + doc_list(axis_names) + "\n//   errors: " +
+                     doc_list(error_names) + "\n//   params: " + doc_list(param_names) + "\n"}};
+  deviation_blocks.push_back(
+      d.output
+          ? std::make_pair(std::string("deviation_subject"),
+                           "// Deviation of the output point (" +
+                               (d.output->description.empty() ? std::string("the output transform")
+                                                              : d.output->description) +
+                               "):\n")
+          : kept("deviation_subject"));
+  const std::string deviation = function_text("deviation", c.deviation, deviation_blocks);
+  const std::string coefficients = function_text("coefficients", c.coefficients);
+  const std::string both =
+      function_text("deviation_and_coefficients", c.deviation_and_coefficients);
+  std::string out;
+  if (c.higher.empty()) {
+    out = deviation + coefficients + both;
   } else {
-    // Deviation calls DeviationAndCoefficients, which comes first.
-    if (table.parts > 0)
-      os << "// MonomialCoefficients in " << table.parts
-         << " parts, each a function of its own (a compiler's time and\n"
-            "// memory grow faster than the length of one function), called in order.\n"
-            "#ifndef WEILGEN_MODELS_NOINLINE\n"
-            "#if defined(__GNUC__) || defined(__clang__)\n"
-            "#define WEILGEN_MODELS_NOINLINE __attribute__((noinline))\n"
-            "#else\n"
-            "#define WEILGEN_MODELS_NOINLINE\n"
-            "#endif\n"
-            "#endif\n\n"
-         << table.monomial_parts;
-    os << "// The coefficient polynomials of the error monomials, each once (every coefficient of "
-          "an\n"
-          "// output's monomial is a numeric factor times one of them or a number).\n"
-          "template <typename Scalar>\n"
-          "void MonomialCoefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,\n"
-          "                          [[maybe_unused]] const std::array<Scalar, kNumParams>& "
-          "params,\n"
-          "                          std::array<Scalar, kNumMonomialCoefficients>* const "
-          "coefficients) {\n"
-          "  using std::cos;\n  using std::sin;\n  using std::sqrt;\n"
-       << table.monomial.body << "}\n"
-       << dev_coef_text.str() << "\n"
-       << dev_text.str() << coef_text.str();
+    if (c.table.parts > 0)
+      out += instantiate_template(
+          template_block(kModelTemplate, "monomial_parts"), "", "",
+          {{"parts_count", "// MonomialCoefficients in " + std::to_string(c.table.parts) +
+                               " parts, each a function of its own (a compiler's time and\n"},
+           {"parts", c.table.monomial_parts}});
+    out += function_text("monomial_coefficients", c.table.monomial) + both + "\n" + deviation +
+           coefficients + function_text("higher_order", c.higher_order);
   }
-  if (!higher.empty()) {
-    os << "\n// Coefficients of the monomials kHigherTerms in each output, row-major\n"
-          "// [output][term]: output = Coefficients·errors + Σ terms[o][k]·Π "
-          "errors[kHigherTerms[k]].\n";
-    os << "template <typename Scalar>\nvoid HigherOrder([[maybe_unused]] const std::array<Scalar, "
-          "kNumAxes>& axes,\n"
-          "                 [[maybe_unused]] const std::array<Scalar, kNumParams>& params,\n"
-          "                 std::array<Scalar, kNumOutputs * kNumHigherTerms>* const terms) {\n"
-          "  using std::cos;\n  using std::sin;\n  using std::sqrt;\n"
-       << high.body << "}\n";
-  }
-  os << "\n// Nominal pose (every error zero) of "
-     << (d.output ? "the output transform" : "the tool frame in the workpiece frame")
-     << ":\n// position of the " << (d.output ? "output" : "tool")
-     << " point in mm, rotation row-major (R[i][j] at 3i+j). Null outputs are skipped.\n";
-  os << "template <typename Scalar>\nvoid NominalPose([[maybe_unused]] const std::array<Scalar, "
-        "kNumAxes>& axes,\n"
-        "                 [[maybe_unused]] const std::array<Scalar, kNumParams>& params,\n"
-        "                 std::array<Scalar, 3>* const position,\n"
-        "                 std::array<Scalar, 9>* const rotation = nullptr) {\n"
-        "  using std::cos;\n  using std::sin;\n  using std::sqrt;\n"
-     << pose.body << "}\n";
-  os << "\n// Jacobian of the nominal pose with respect to the axes, row-major [output][axis]: "
-        "rows "
-        "dx, dy, dz\n"
-        "// (mm per axis unit: mm/mm, mm/deg) and da, db, dc (rad per axis unit), the rotation "
-        "rate\n"
-        "// vee(dR/dq R^T) as in Deviation's orientation. Columns in kAxes order.\n";
-  os << "template <typename Scalar>\nvoid NominalJacobian([[maybe_unused]] const "
-        "std::array<Scalar, kNumAxes>& axes,\n"
-        "                     [[maybe_unused]] const std::array<Scalar, kNumParams>& params,\n"
-        "                     std::array<Scalar, 6 * kNumAxes>* const jacobian) {\n"
-        "  using std::cos;\n  using std::sin;\n  using std::sqrt;\n"
-     << jacobian.body << "}\n\n";
-  os << compensation_code(m.axes_turn_output());
-  os << "\n}  // namespace " << d.name << "\n}  // namespace weilgen_models\n";
-  return os.str();
+  // The nominal pose names the tool frame or the machine file's output transform.
+  out += function_text("nominal_pose", c.nominal_pose,
+                       {{d.output ? "tool_frame" : "output_transform", ""},
+                        kept(d.output ? "output_transform" : "tool_frame")});
+  return out + function_text("nominal_jacobian", c.nominal_jacobian);
+}
+
+}  // namespace
+
+std::string emit_cpp_header(const SymbolicModel& m, const std::string& source_label,
+                            std::size_t max_nested_higher_terms, const SplitLimits& split) {
+  const Description& d = m.desc;
+  const ModelCode code = model_code(m, max_nested_higher_terms, split);
+  const bool higher = !code.higher.empty();
+  const std::string constants =
+      "inline constexpr const char* kMachineName = " + string_literal(d.name) +
+      ";\ninline constexpr int kOrder = " + std::to_string(m.order) + ";\n";
+  const std::string monomial_tables =
+      higher ? instantiate_template(
+                   template_block(kModelTemplate, "monomial_tables"), "", "",
+                   {{"monomial_count", "inline constexpr std::size_t kNumMonomialCoefficients = " +
+                                           std::to_string(code.table.count) + ";\n" +
+                                           code.table.tables}})
+             : std::string();
+  // The template names the model only by the lower-case stand-in (its namespace).
+  return instantiate_template(
+      kModelTemplate, d.name, d.name,
+      {{"banner", banner_block(m, source_label)},
+       {"operation_counts", operation_counts_block(m, code)},
+       {"higher_includes", higher ? template_block(kModelTemplate, "higher_includes") : ""},
+       {"constants", constants},
+       {"counts", counts_block(m, code.higher)},
+       {"axes", axis_rows(m)},
+       {"errors", error_rows(d)},
+       {"params", param_rows(d)},
+       {"outputs", outputs_block()},
+       {"indices", emit_index_constants(m)},
+       {"higher_terms", higher_terms_block(code.higher)},
+       {"monomial_tables", monomial_tables},
+       {"functions", functions_block(m, code)},
+       {"compensation", compensation_code(m.axes_turn_output())}});
 }
 
 }  // namespace weilgen::gen

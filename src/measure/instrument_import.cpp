@@ -552,20 +552,9 @@ int find_carto_header(const std::vector<Line>& lines, char& delim) {
   return -1;
 }
 
-ImportResult parse_carto(const std::vector<Line>& lines, const std::string& file,
-                         const ImportOptions& o) {
-  char delim = ',';
-  const int h = find_carto_header(lines, delim);
-  if (h < 0)
-    throw InputError(SourceLoc{file, 0, 0}, "CARTO: no header row with a target column (" +
-                                                std::string(kCartoColumns) + ")");
-  const bool decimal_comma = delim != ',';
-  ImportResult res;
-  res.format = InstrumentFormat::Carto;
-  Wide w;
-  w.meta.file = file;
-  w.meta.header_line = lines[h].no;
-  // Metadata before the header: `Key,Value` rows and `# key: value` comments.
+// The metadata before the header row `h`: `Key,Value` rows and `# key: value` comments.
+void carto_metadata(const std::vector<Line>& lines, int h, char delim, const std::string& file,
+                    Wide& w) {
   for (int k = 0; k < h; ++k) {
     const Line& L = lines[k];
     std::string key, value;
@@ -628,7 +617,10 @@ ImportResult parse_carto(const std::vector<Line>& lines, const std::string& file
     w.meta.header_keys["material_compensation"] = "unstated";
     w.meta.header_key_lines["material_compensation"] = 0;
   }
-  // The axis.
+}
+
+// The axis the file names (an 'Axis' line) or --axis; both must agree.
+std::string carto_axis(const ImportOptions& o, const std::string& file, Wide& w) {
   std::string axis = o.axis;
   if (w.meta.header_keys.count("axis")) {
     const std::string a = axis_letter(w.meta.header_keys["axis"]);
@@ -646,18 +638,28 @@ ImportResult parse_carto(const std::vector<Line>& lines, const std::string& file
     throw InputError(SourceLoc{file, w.meta.header_line, 0},
                      "CARTO: the file does not name its axis (no 'Axis' line before the table): "
                      "give it with --axis");
-  const std::string deviation = axis_deviation_column(axis);
-  if (deviation.empty() || axis.size() != 1)
+  if (axis_deviation_column(axis).empty() || axis.size() != 1)
     throw std::invalid_argument("axis " + axis +
                                 ": expected one of X, Y, Z, U, V, W (linear) or A, B, C (rotary)");
-  const bool rotary = axis == "A" || axis == "B" || axis == "C";
   w.meta.header_keys["axis"] = axis;
   if (!w.meta.header_key_lines.count("axis")) w.meta.header_key_lines["axis"] = 0;
+  return axis;
+}
 
-  // The header row.
+// The header row's columns, classified, with the unit conversion of each.
+struct CartoTable {
+  std::vector<CartoColumn> columns;
+  std::vector<Conversion> conversions;
+};
+
+// The header row `h`: each column's quantity and unit; exactly one target column, a direction
+// column and at least one run.
+CartoTable carto_columns(const std::vector<Line>& lines, int h, char delim, const std::string& file,
+                         bool rotary, const ImportOptions& o, Wide& w) {
   const std::vector<Cell> header = split_csv(lines[h].text, delim, file, lines[h].no);
-  std::vector<CartoColumn> cols;
-  std::vector<Conversion> conv;
+  CartoTable t;
+  std::vector<CartoColumn>& cols = t.columns;
+  std::vector<Conversion>& conv = t.conversions;
   std::set<std::string> seen;
   bool has_direction = false, has_run = false;
   int targets = 0;
@@ -744,7 +746,14 @@ ImportResult parse_carto(const std::vector<Line>& lines, const std::string& file
   if (!has_run)
     throw InputError(SourceLoc{file, lines[h].no, 0}, "no run column ('Run 1 (um)', ...)");
 
-  // The tidy columns each source column feeds.
+  return t;
+}
+
+// The tidy column each source column feeds, and the mapping the import reports.
+void carto_tidy_columns(const CartoTable& t, const std::string& axis, ImportResult& res, Wide& w) {
+  const std::vector<CartoColumn>& cols = t.columns;
+  const std::vector<Conversion>& conv = t.conversions;
+  const std::string deviation = axis_deviation_column(axis);
   const std::string sensor_base = "T_material";
   bool several_sensors = false;
   for (const auto& c : cols) several_sensors |= c.q == Quantity::MaterialT && c.sensor > 0;
@@ -800,23 +809,31 @@ ImportResult parse_carto(const std::vector<Line>& lines, const std::string& file
     }
     res.mapping.push_back(m);
   }
-  // Data rows.
+}
+
+// The data rows after the header row `h`, converted to the tidy columns' units.
+void carto_rows(const std::vector<Line>& lines, int h, char delim, const CartoTable& t,
+                const std::string& file, Wide& w) {
+  const std::vector<CartoColumn>& cols = t.columns;
+  const std::vector<Conversion>& conv = t.conversions;
+  const std::size_t header_size = cols.size();
+  const bool decimal_comma = delim != ',';
   for (std::size_t k = static_cast<std::size_t>(h) + 1; k < lines.size(); ++k) {
     const Line& L = lines[k];
     if (blank_or_comment(L.text)) continue;
     const std::vector<Cell> cells = split_csv(L.text, delim, file, L.no);
     std::size_t n = cells.size();
-    while (n > header.size() && cells[n - 1].text.empty()) --n;  // trailing separators
-    if (n != header.size()) {
+    while (n > header_size && cells[n - 1].text.empty()) --n;  // trailing separators
+    if (n != header_size) {
       // A decimal comma in a comma-separated export splits every number in two.
       const std::string hint =
-          delim == ',' && n > header.size()
+          delim == ',' && n > header_size
               ? " (decimal commas in a comma-separated file split every number: export with ';' "
                 "or a tab between the fields, or with a decimal point)"
               : "";
-      throw InputError(SourceLoc{file, L.no, n > header.size() ? cells[header.size()].column : 0},
+      throw InputError(SourceLoc{file, L.no, n > header_size ? cells[header_size].column : 0},
                        std::to_string(n) + " fields, the header (line " +
-                           std::to_string(lines[h].no) + ") has " + std::to_string(header.size()) +
+                           std::to_string(lines[h].no) + ") has " + std::to_string(header_size) +
                            hint);
     }
     std::size_t wc = 0;
@@ -857,6 +874,26 @@ ImportResult parse_carto(const std::vector<Line>& lines, const std::string& file
     }
     w.lines.push_back(L.no);
   }
+}
+
+ImportResult parse_carto(const std::vector<Line>& lines, const std::string& file,
+                         const ImportOptions& o) {
+  char delim = ',';
+  const int h = find_carto_header(lines, delim);
+  if (h < 0)
+    throw InputError(SourceLoc{file, 0, 0}, "CARTO: no header row with a target column (" +
+                                                std::string(kCartoColumns) + ")");
+  ImportResult res;
+  res.format = InstrumentFormat::Carto;
+  Wide w;
+  w.meta.file = file;
+  w.meta.header_line = lines[h].no;
+  carto_metadata(lines, h, delim, file, w);
+  const std::string axis = carto_axis(o, file, w);
+  const bool rotary = axis == "A" || axis == "B" || axis == "C";
+  const CartoTable table = carto_columns(lines, h, delim, file, rotary, o, w);
+  carto_tidy_columns(table, axis, res, w);
+  carto_rows(lines, h, delim, table, file, w);
   if (w.lines.empty())
     throw InputError(SourceLoc{file, lines[h].no, 0}, "no data rows after the header");
   w.read.coordinates = {axis};

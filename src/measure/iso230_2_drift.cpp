@@ -45,36 +45,18 @@ std::pair<double, double> within_slope(
   return {slope, dof > 0 ? std::sqrt(rss / dof / suu) : kNaN};
 }
 
-}  // namespace
-
-void DriftOptions::validate() const {
-  if (!(alpha > 0 && alpha < 1))
-    throw std::invalid_argument("drift elimination: alpha must be in (0, 1)");
-  if (!(coverage > 0))
-    throw std::invalid_argument("drift elimination: the coverage factor must be > 0");
-  if (!(tolerance_mm > 0))
-    throw std::invalid_argument("drift elimination: tolerance_mm must be > 0");
-}
-
-DriftElimination::DriftElimination(DriftOptions options) : options_(std::move(options)) {
-  options_.validate();
-}
-
-DriftResult DriftElimination::run(const IsoRuns& R) const {
+// The reference target (the one nearest --reference-position, else the first) and cycle
+// (--reference-cycle, else the lowest cycle id measured in both directions) into `res`; returns
+// the reference cycle's column in each direction.
+std::array<std::size_t, 2> drift_reference(const IsoRuns& R, const DriftOptions& options,
+                                           DriftResult& res) {
   const std::size_t m = R.targets();
-  if (m < 2)
-    throw InputError(SourceLoc{R.file, 0, 0},
-                     "the drift elimination needs at least 2 targets (adjacent differences)");
-  DriftResult res;
-  res.alpha = options_.alpha;
-
-  // Reference target and cycle.
-  if (options_.reference_position_mm) {
-    const double p = *options_.reference_position_mm;
+  if (options.reference_position_mm) {
+    const double p = *options.reference_position_mm;
     std::size_t best = 0;
     for (std::size_t i = 1; i < m; ++i)
       if (std::abs(R.positions_mm[i] - p) < std::abs(R.positions_mm[best] - p)) best = i;
-    if (!(std::abs(R.positions_mm[best] - p) <= options_.tolerance_mm)) {
+    if (!(std::abs(R.positions_mm[best] - p) <= options.tolerance_mm)) {
       std::string list;
       for (double v : R.positions_mm) list += (list.empty() ? "" : ", ") + format_number(v);
       throw std::invalid_argument("--reference-position " + format_number(p) +
@@ -82,9 +64,8 @@ DriftResult DriftElimination::run(const IsoRuns& R) const {
     }
     res.reference_target = best;
   }
-  const std::size_t r = res.reference_target;
-  if (options_.reference_cycle) {
-    res.reference_cycle = *options_.reference_cycle;
+  if (options.reference_cycle) {
+    res.reference_cycle = *options.reference_cycle;
   } else {  // the lowest cycle id measured in both directions
     std::vector<long> common;
     std::set_intersection(R.cycles[kUp].begin(), R.cycles[kUp].end(), R.cycles[kDown].begin(),
@@ -107,7 +88,13 @@ DriftResult DriftElimination::run(const IsoRuns& R) const {
     j0[d] = static_cast<std::size_t>(it - c.begin());
   }
 
-  // Adjacent differences and the raw F statistics.
+  return j0;
+}
+
+// Adjacent-position differences per direction and each difference's F statistic against the
+// pooled spread of the other differences of the same parity (they share no target with it).
+void adjacent_differences(const IsoRuns& R, DriftResult& res) {
+  const std::size_t m = R.targets();
   for (int d = 0; d < 2; ++d) {
     const std::size_t n = R.cycles[d].size();
     AdjacentDifferences& D = res.differences[d];
@@ -147,9 +134,11 @@ DriftResult DriftElimination::run(const IsoRuns& R) const {
       ++res.tests;
     }
   }
+}
 
-  // Flags (Bonferroni over every test of both directions) and their attribution to targets.
-  const double threshold = res.tests > 0 ? options_.alpha / static_cast<double>(res.tests) : 0;
+// Flags (Bonferroni over every test of both directions) and their attribution to targets.
+void flag_anomalies(std::size_t m, double alpha, DriftResult& res) {
+  const double threshold = res.tests > 0 ? alpha / static_cast<double>(res.tests) : 0;
   for (int d = 0; d < 2; ++d) {
     AdjacentDifferences& D = res.differences[d];
     const int dir = d == kUp ? +1 : -1;
@@ -176,10 +165,15 @@ DriftResult DriftElimination::run(const IsoRuns& R) const {
       if (anomalous) res.anomalous_positions.push_back({dir, i});
     }
   }
+}
 
-  // The rebuilt chart: the reference cycle's value at the reference target, accumulated with the
-  // mean adjacent differences outward; s* of the difference linking each target toward the
-  // reference, divided by sqrt(2) (Stejskal et al. 2017, eq. (9)).
+// The rebuilt chart: the reference cycle's value at the reference target, accumulated with the
+// mean adjacent differences outward; s* of the difference linking each target toward the
+// reference, divided by sqrt(2) (Stejskal et al. 2017, eq. (9)). Returns s* per direction.
+std::array<std::vector<double>, 2> rebuild_chart(const IsoRuns& R,
+                                                 const std::array<std::size_t, 2>& j0,
+                                                 DriftResult& res) {
+  const std::size_t m = R.targets(), r = res.reference_target;
   std::array<std::vector<double>, 2> s_star;
   for (int d = 0; d < 2; ++d) {
     const std::size_t n = R.cycles[d].size();
@@ -208,16 +202,12 @@ DriftResult DriftElimination::run(const IsoRuns& R) const {
         C.shifted[i][j] = R.x[d][i][j] - R.x[d][r][j] + R.x[d][r][j0[d]];
     s_star[d] = C.s;
   }
-  res.figures = iso_figures(res.chart[kUp].value, res.chart[kDown].value, s_star[kUp],
-                            s_star[kDown], options_.coverage, options_.coverage);
-  if (options_.student) {
-    const double ku = student_coverage_factor(R.cycles[kUp].size() - 1, options_.coverage);
-    const double kd = student_coverage_factor(R.cycles[kDown].size() - 1, options_.coverage);
-    res.student = iso_figures(res.chart[kUp].value, res.chart[kDown].value, s_star[kUp],
-                              s_star[kDown], ku, kd);
-  }
+  return s_star;
+}
 
-  // s ratio: pooled s of the differences over the pooled classical s.
+// s ratio: pooled s of the differences over the pooled classical s.
+void spread_ratio(const IsoRuns& R, DriftResult& res) {
+  const std::size_t m = R.targets();
   for (int d = 0; d < 2; ++d) {
     double sd2 = 0, sx2 = 0;
     for (double s : res.differences[d].s) sd2 += s * s;
@@ -228,9 +218,12 @@ DriftResult DriftElimination::run(const IsoRuns& R) const {
     res.s_ratio[d] =
         std::sqrt(sd2 / static_cast<double>(m - 1)) / std::sqrt(sx2 / static_cast<double>(m));
   }
+}
 
-  // Drift per cycle.
-  DriftPerCycle& P = res.per_cycle;
+// Drift per cycle: each cycle's mean offset from the reference cycle, and the drift rate per
+// cycle (and per hour when the readings are timed) as a within-target slope.
+void drift_per_cycle(const IsoRuns& R, const std::array<std::size_t, 2>& j0, DriftPerCycle& P) {
+  const std::size_t m = R.targets();
   for (int d = 0; d < 2; ++d)
     P.cycles.insert(P.cycles.end(), R.cycles[d].begin(), R.cycles[d].end());
   std::sort(P.cycles.begin(), P.cycles.end());
@@ -281,6 +274,45 @@ DriftResult DriftElimination::run(const IsoRuns& R) const {
       }
     for (std::size_t c = 0; c < nc; ++c) P.time_h.push_back(sum[c] / cnt[c] / 3600.0);
   }
+}
+
+}  // namespace
+
+void DriftOptions::validate() const {
+  if (!(alpha > 0 && alpha < 1))
+    throw std::invalid_argument("drift elimination: alpha must be in (0, 1)");
+  if (!(coverage > 0))
+    throw std::invalid_argument("drift elimination: the coverage factor must be > 0");
+  if (!(tolerance_mm > 0))
+    throw std::invalid_argument("drift elimination: tolerance_mm must be > 0");
+}
+
+DriftElimination::DriftElimination(DriftOptions options) : options_(std::move(options)) {
+  options_.validate();
+}
+
+DriftResult DriftElimination::run(const IsoRuns& R) const {
+  const std::size_t m = R.targets();
+  if (m < 2)
+    throw InputError(SourceLoc{R.file, 0, 0},
+                     "the drift elimination needs at least 2 targets (adjacent differences)");
+  DriftResult res;
+  res.alpha = options_.alpha;
+  const std::array<std::size_t, 2> j0 = drift_reference(R, options_, res);
+  adjacent_differences(R, res);
+  flag_anomalies(m, options_.alpha, res);
+  const std::array<std::vector<double>, 2> s_star = rebuild_chart(R, j0, res);
+  res.figures = iso_figures(res.chart[kUp].value, res.chart[kDown].value, s_star[kUp],
+                            s_star[kDown], options_.coverage, options_.coverage);
+  if (options_.student) {
+    const double ku = student_coverage_factor(R.cycles[kUp].size() - 1, options_.coverage);
+    const double kd = student_coverage_factor(R.cycles[kDown].size() - 1, options_.coverage);
+    res.student = iso_figures(res.chart[kUp].value, res.chart[kDown].value, s_star[kUp],
+                              s_star[kDown], ku, kd);
+  }
+
+  spread_ratio(R, res);
+  drift_per_cycle(R, j0, res.per_cycle);
   return res;
 }
 

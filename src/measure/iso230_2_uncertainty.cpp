@@ -125,6 +125,358 @@ double draw(Normal& g, BudgetDistribution d, double u) {
   return g() * u;
 }
 
+// The budget's contributions from its inputs, one method per source (ISO 230-9 annex C): the
+// instrument, the air, the material, the set-up, the environment and the run itself. A
+// contribution of zero standard uncertainty is left out.
+class BudgetContributions {
+ public:
+  BudgetContributions(const std::map<std::string, double>& in, const NormalisationResult& n,
+                      const std::string& unit, double travel, std::vector<std::string>& notes)
+      : in_(in), n_(n), unit_(unit), travel_(travel), notes_(notes) {}
+
+  std::vector<UncertaintyContribution> build(bool linear, bool laser) {
+    instrument();
+    if (linear && laser) {
+      const double dT = air();
+      material();
+      setup(dT);
+    } else if (!linear) {
+      notes_.push_back(
+          "A rotary axis: the budget holds the instrument, the resolution, the environmental "
+          "variation and the run's repeatability.");
+    }
+    environment_and_run();
+    return std::move(C_);
+  }
+
+ private:
+  void add(const std::string& name, const std::string& input, BudgetDistribution d,
+           ContributionKind kind, double u, const std::string& u_unit) {
+    if (!(u > 0)) return;
+    UncertaintyContribution c;
+    c.name = name;
+    c.input = input;
+    c.distribution = d;
+    c.kind = kind;
+    c.u = u;
+    c.unit = u_unit;
+    C_.push_back(c);
+  }
+  // A key the class' defaults do not name counts as 0.
+  double in(const std::string& key) const {
+    const auto it = in_.find(key);
+    return it == in_.end() ? 0.0 : it->second;
+  }
+  std::string scale_unit() const { return unit_ == "um" ? "um/m" : "urad/rad"; }
+
+  void instrument() {
+    add("instrument calibration",
+        format_significant(in("instrument_ppm"), 3) + " " + scale_unit() + " (k = 2)",
+        BudgetDistribution::Normal, ContributionKind::Scale, in("instrument_ppm") / 2,
+        scale_unit());
+    add("instrument, constant part",
+        format_significant(in("instrument_um"), 3) + " " + unit_ + " (k = 2)",
+        BudgetDistribution::Normal, ContributionKind::PerMean, in("instrument_um") / 2, unit_);
+    add("resolution", format_significant(in("resolution_um"), 3) + " " + unit_ + " (full width)",
+        BudgetDistribution::Rectangular, ContributionKind::PerMean, in("resolution_um") / kSqrt12,
+        unit_);
+  }
+
+  // The air: its index's sensitivities at the recorded mean air (20 degC, 101325 Pa, 50 %RH when
+  // none is recorded), ppm per degC, Pa, %. Returns the sensitivity to temperature (ppm/K),
+  // which the dead path uses.
+  double air() {
+    const NormalisationResult& n = n_;
+    const AirConditions air{n.air_temperature_C.empty() ? 20.0 : n.air_temperature_C.mean,
+                            n.air_pressure_Pa.empty() ? 101325.0 : n.air_pressure_Pa.mean,
+                            n.air_humidity_pct.empty() ? 50.0 : n.air_humidity_pct.mean};
+    auto slope = [&](int which, double step) {
+      AirConditions lo = air, hi = air;
+      double* a = which == 0 ? &lo.temperature_C : which == 1 ? &lo.pressure_Pa : &lo.humidity_pct;
+      double* b = which == 0 ? &hi.temperature_C : which == 1 ? &hi.pressure_Pa : &hi.humidity_pct;
+      *a -= step, *b += step;
+      return std::abs(air_refractivity(hi, n.wavelength_nm) -
+                      air_refractivity(lo, n.wavelength_nm)) /
+             (2 * step) * 1e6;
+    };
+    const double dT = slope(0, 0.01), dp = slope(1, 1), dh = slope(2, 0.1);
+    const bool compensated = n.air_applied || n.air == AirCompensation::Instrument;
+    if (compensated) {
+      add("air temperature sensor",
+          format_significant(in("air_temperature_C"), 3) + " degC x " + format_significant(dT, 3) +
+              " um/(m K)",
+          BudgetDistribution::Rectangular, ContributionKind::Scale,
+          in("air_temperature_C") * dT / kSqrt3, scale_unit());
+      add("air pressure sensor",
+          format_significant(in("air_pressure_Pa"), 3) + " Pa x " +
+              format_significant(dp * 1e3, 3) + " um/(m kPa)",
+          BudgetDistribution::Rectangular, ContributionKind::Scale,
+          in("air_pressure_Pa") * dp / kSqrt3, scale_unit());
+      add("air humidity sensor",
+          format_significant(in("air_humidity_pct"), 3) + " %RH x " + format_significant(dh, 3) +
+              " um/(m %RH)",
+          BudgetDistribution::Rectangular, ContributionKind::Scale,
+          in("air_humidity_pct") * dh / kSqrt3, scale_unit());
+      add("Edlen equation", format_significant(in("edlen_ppm"), 3) + " um/m (k = 3)",
+          BudgetDistribution::Normal, ContributionKind::Scale, in("edlen_ppm") / 3, scale_unit());
+    } else {
+      const double index = air_refractivity(air, n.wavelength_nm) * 1e6;
+      add("air refraction not compensated",
+          format_significant(index, 3) + " um/m (the index of the air)",
+          BudgetDistribution::Rectangular, ContributionKind::Scale, index / kSqrt3, scale_unit());
+      notes_.push_back(
+          "The air's refractive index is not compensated: the budget counts the whole index as "
+          "a rectangular uncertainty. Compensate the air instead (--air-compensation).");
+    }
+    return dT;
+  }
+
+  // The material: its temperature sensor and expansion coefficient when normalised to 20 degC,
+  // the whole nominal expansion when not.
+  void material() {
+    const NormalisationResult& n = n_;
+    const double alpha = std::isfinite(n.expansion_ppm_per_K) && n.expansion_ppm_per_K > 0
+                             ? n.expansion_ppm_per_K
+                             : in("nominal_expansion_ppm_per_K");
+    const bool normalised = n.material_applied || n.material_compensation == "instrument";
+    const bool known = !n.material_temperature_C.empty();
+    const double offset = known ? std::abs(n.material_temperature_C.mean - 20) : kNaN;
+    if (normalised) {
+      add("material temperature sensor",
+          format_significant(in("material_temperature_C"), 3) + " degC x " +
+              format_significant(alpha, 3) + " um/(m K)",
+          BudgetDistribution::Rectangular, ContributionKind::Scale,
+          in("material_temperature_C") * alpha / kSqrt3, scale_unit());
+      if (known)
+        add("expansion coefficient",
+            format_significant(100 * in("expansion_relative"), 3) + " % of " +
+                format_significant(alpha, 3) + " um/(m K) x " + format_significant(offset, 3) +
+                " K",
+            BudgetDistribution::Rectangular, ContributionKind::Scale,
+            in("expansion_relative") * alpha * offset / kSqrt3, scale_unit());
+      else
+        notes_.push_back(
+            "No material temperature recorded: the expansion coefficient's uncertainty "
+            "(proportional to T - 20 degC) is not in the budget.");
+    } else if (known) {
+      add("expansion not corrected",
+          format_significant(alpha, 3) + " um/(m K) x " + format_significant(offset, 3) + " K",
+          BudgetDistribution::Rectangular, ContributionKind::Scale, alpha * offset / kSqrt3,
+          scale_unit());
+      notes_.push_back(
+          "Not normalised to 20 degC: the nominal differential expansion is counted as a "
+          "rectangular uncertainty; correcting it (--expansion) removes it.");
+    } else {
+      notes_.push_back(
+          "No material temperature recorded and no normalisation: the expansion to 20 degC is "
+          "not in the budget.");
+    }
+  }
+
+  // Set-up: cosine error over the travel, the dead path (`dT`: the air index' sensitivity to
+  // temperature, ppm/K), the Abbe offset.
+  void setup(double dT) {
+    if (travel_ > 0 && in("misalignment_mm") > 0) {
+      const double phi = in("misalignment_mm") / travel_;
+      add("cosine error (beam misalignment)",
+          format_significant(in("misalignment_mm"), 3) + " mm over " + format_number(travel_) +
+              " mm",
+          BudgetDistribution::OneSided, ContributionKind::Scale, phi * phi / 2 * 1e6 / kSqrt12,
+          scale_unit());
+    }
+    if (in("dead_path_mm") > 0) {
+      const double change = n_.air_refractivity.count > 1
+                                ? n_.air_refractivity.max - n_.air_refractivity.min
+                                : dT * 1e-6 * in("dead_path_air_change_C");
+      add("dead path",
+          format_significant(in("dead_path_mm"), 3) + " mm x " +
+              format_significant(change * 1e6, 3) + " um/m",
+          BudgetDistribution::Rectangular, ContributionKind::PerMean,
+          in("dead_path_mm") * change * 1e3 / 2 / kSqrt3, unit_);
+    }
+    add("Abbe error",
+        format_significant(in("abbe_offset_mm"), 3) + " mm x " +
+            format_significant(in("abbe_angle_urad"), 3) + " urad",
+        BudgetDistribution::Rectangular, ContributionKind::PerTarget,
+        in("abbe_offset_mm") * in("abbe_angle_urad") * 1e-3 / 2 / kSqrt3, unit_);
+  }
+
+  // The environmental variation error and the run's own repeatability (type A, from its s).
+  void environment_and_run() {
+    add("environmental variation (EVE)",
+        format_significant(in("eve_um"), 3) + " " + unit_ + " (range)",
+        BudgetDistribution::Rectangular, ContributionKind::PerMean, in("eve_um") / 2 / kSqrt3,
+        unit_);
+    UncertaintyContribution a;
+    a.name = "repeatability of the run (type A)";
+    a.input = "s_i / sqrt(n) of the means, s_i sqrt(1 - c4^2) of the s";
+    a.kind = ContributionKind::TypeA;
+    C_.push_back(a);
+  }
+
+  const double kSqrt3 = std::sqrt(3.0), kSqrt12 = std::sqrt(12.0);
+  const std::map<std::string, double>& in_;
+  const NormalisationResult& n_;
+  const std::string& unit_;
+  double travel_;
+  std::vector<std::string>& notes_;
+  std::vector<UncertaintyContribution> C_;
+};
+
+// dF/dmean (`dm`) and dF/ds (`ds`) of each figure F, per direction and target.
+struct FigureSensitivities {
+  std::map<std::string, std::array<std::vector<double>, 2>> dm, ds;
+};
+
+// Central differences of the figures in the means and s (the figures are piecewise linear in
+// the means; a step of 1e-6 um stays on one piece unless two extremes tie).
+FigureSensitivities figure_sensitivities(const Point& p0, double k_up, double k_down) {
+  const std::size_t m = p0.mean[kUp].size();
+  const std::vector<std::string>& names = uncertainty_figure_names();
+  const double h = 1e-6;
+  FigureSensitivities S;
+  for (const std::string& f : names)
+    for (int d : {kUp, kDown}) S.dm[f][d].assign(m, 0), S.ds[f][d].assign(m, 0);
+  for (int d : {kUp, kDown})
+    for (std::size_t i = 0; i < m; ++i)
+      for (bool of_s : {false, true}) {
+        Point a = p0, b = p0;
+        (of_s ? a.s : a.mean)[d][i] += h;
+        (of_s ? b.s : b.mean)[d][i] -= h;
+        if (of_s && b.s[d][i] < 0) b.s[d][i] = 0;
+        const double step = of_s ? (a.s[d][i] - b.s[d][i]) : 2 * h;
+        const auto fa = uncertainty_figure_values(figures_at(a, k_up, k_down));
+        const auto fb = uncertainty_figure_values(figures_at(b, k_up, k_down));
+        for (const std::string& f : names) {
+          // A difference of rounding errors only (the figure does not depend on this input) is 0.
+          const double v = (fa.at(f) - fb.at(f)) / step;
+          (of_s ? S.ds : S.dm)[f][d][i] = std::abs(v) < 1e-6 ? 0.0 : v;
+        }
+      }
+  return S;
+}
+
+// Each contribution's sensitivity and standard uncertainty per figure (GUM, linearised):
+// a scale error moves every target by its travel, a per-target error both directions' means
+// together, a per-mean error each mean on its own; type A from the run's s and cycles.
+void propagate_contributions(std::vector<UncertaintyContribution>& C, const FigureSensitivities& S,
+                             const Point& p0, const std::vector<double>& per_scale,
+                             const std::array<std::size_t, 2>& cycles) {
+  const std::size_t m = per_scale.size();
+  for (UncertaintyContribution& c : C)
+    for (const std::string& f : uncertainty_figure_names()) {
+      const auto& dm = S.dm.at(f);
+      const auto& ds = S.ds.at(f);
+      double sens = 0, contribution = 0;
+      switch (c.kind) {
+        case ContributionKind::Scale:
+          for (int d : {kUp, kDown})
+            for (std::size_t i = 0; i < m; ++i) sens += dm[d][i] * per_scale[i];
+          if (std::abs(sens) < 1e-9) sens = 0;
+          contribution = std::abs(sens) * c.u;
+          break;
+        case ContributionKind::PerTarget:
+          for (std::size_t i = 0; i < m; ++i) sens += std::pow(dm[kUp][i] + dm[kDown][i], 2);
+          sens = std::sqrt(sens);
+          contribution = sens * c.u;
+          break;
+        case ContributionKind::PerMean:
+          for (int d : {kUp, kDown})
+            for (std::size_t i = 0; i < m; ++i) sens += dm[d][i] * dm[d][i];
+          sens = std::sqrt(sens);
+          contribution = sens * c.u;
+          break;
+        case ContributionKind::TypeA:
+          sens = kNaN;
+          for (int d : {kUp, kDown}) {
+            const double nd = static_cast<double>(cycles[static_cast<std::size_t>(d)]);
+            const double spread =
+                std::sqrt(1 - std::pow(c4(cycles[static_cast<std::size_t>(d)]), 2));
+            for (std::size_t i = 0; i < m; ++i) {
+              const double s = p0.s[d][i];
+              contribution +=
+                  std::pow(dm[d][i] * s / std::sqrt(nd), 2) + std::pow(ds[d][i] * s * spread, 2);
+            }
+          }
+          contribution = std::sqrt(contribution);
+          break;
+      }
+      c.sensitivity[f] = sens;
+      c.contribution_um[f] = contribution;
+    }
+}
+
+// Monte Carlo (GUM Supplement 1): the same inputs drawn from their distributions, the figures
+// recomputed; each figure's Monte Carlo u and 95 % interval, and whether it confirms the
+// linearised u.
+void monte_carlo_check(UncertaintyResult& r, const Point& p0, double k_up, double k_down,
+                       const std::vector<double>& per_scale,
+                       const std::array<std::size_t, 2>& cycles) {
+  const std::size_t m = per_scale.size();
+  const std::vector<std::string>& names = uncertainty_figure_names();
+  Normal g(r.seed);
+  std::map<std::string, std::vector<double>> samples;
+  for (const std::string& f : names) samples[f].reserve(r.trials);
+  Point p = p0;
+  for (std::size_t t = 0; t < r.trials; ++t) {
+    for (int d : {kUp, kDown}) {
+      const std::size_t nd = cycles[static_cast<std::size_t>(d)];
+      for (std::size_t i = 0; i < m; ++i) {
+        const double s = p0.s[d][i];
+        p.mean[d][i] = p0.mean[d][i] + g() * s / std::sqrt(static_cast<double>(nd));
+        double chi2 = 0;
+        for (std::size_t k = 0; k + 1 < nd; ++k) {
+          const double z = g();
+          chi2 += z * z;
+        }
+        p.s[d][i] = nd > 1 ? s * std::sqrt(chi2 / static_cast<double>(nd - 1)) : s;
+      }
+    }
+    for (const auto& c : r.contributions) {
+      switch (c.kind) {
+        case ContributionKind::Scale: {
+          const double e = draw(g, c.distribution, c.u);
+          for (int d : {kUp, kDown})
+            for (std::size_t i = 0; i < m; ++i) p.mean[d][i] += e * per_scale[i];
+          break;
+        }
+        case ContributionKind::PerTarget:
+          for (std::size_t i = 0; i < m; ++i) {
+            const double e = draw(g, c.distribution, c.u);
+            p.mean[kUp][i] += e;
+            p.mean[kDown][i] += e;
+          }
+          break;
+        case ContributionKind::PerMean:
+          for (int d : {kUp, kDown})
+            for (std::size_t i = 0; i < m; ++i) p.mean[d][i] += draw(g, c.distribution, c.u);
+          break;
+        case ContributionKind::TypeA:
+          break;
+      }
+    }
+    const auto v = uncertainty_figure_values(figures_at(p, k_up, k_down));
+    for (const std::string& f : names) samples[f].push_back(v.at(f));
+  }
+  for (FigureUncertainty& fu : r.figures) {
+    std::vector<double>& x = samples[fu.name];
+    double mean = 0;
+    for (double v : x) mean += v / static_cast<double>(x.size());
+    double ss = 0;
+    for (double v : x) ss += (v - mean) * (v - mean);
+    fu.mc_u = std::sqrt(ss / static_cast<double>(x.size() - 1));
+    std::sort(x.begin(), x.end());
+    const auto at = [&](double q) {
+      return x[std::min(x.size() - 1, static_cast<std::size_t>(q * static_cast<double>(x.size())))];
+    };
+    fu.mc_low = at(0.025);
+    fu.mc_high = at(0.975);
+    // GUM Supplement 1, 8: the linearised u holds when the Monte Carlo's agrees; here within
+    // 5 % (a figure whose extreme switches between targets under the perturbations does not).
+    fu.validated = fu.u > 0 ? std::abs(fu.mc_u / fu.u - 1) <= 0.05 : fu.mc_u < 1e-9;
+  }
+}
+
 }  // namespace
 
 const std::vector<std::string>& uncertainty_classes() {
@@ -294,7 +646,6 @@ UncertaintyResult Iso230_2Uncertainty::run(const IsoRuns& runs, const IsoFigures
   r.trials = static_cast<std::size_t>(in["monte_carlo_trials"]);
   r.seed = static_cast<std::uint64_t>(in["seed"]);
   const bool linear = unit == "um";
-  const bool laser = r.instrument_class != "scale";
   const std::size_t m = runs.targets();
   const std::vector<double>& P = runs.positions_mm;
   const double travel = m ? P.back() - P.front() : 0;
@@ -304,298 +655,27 @@ UncertaintyResult Iso230_2Uncertainty::run(const IsoRuns& runs, const IsoFigures
   for (std::size_t i = 0; i < m; ++i)
     per_scale[i] = (P[i] - n.datum_mm) * (linear ? 1e-3 : kPi / 180);
 
-  std::vector<UncertaintyContribution> C;
-  auto add = [&](const std::string& name, const std::string& input, BudgetDistribution d,
-                 ContributionKind kind, double u, const std::string& u_unit) {
-    if (!(u > 0)) return;
-    UncertaintyContribution c;
-    c.name = name;
-    c.input = input;
-    c.distribution = d;
-    c.kind = kind;
-    c.u = u;
-    c.unit = u_unit;
-    C.push_back(c);
-  };
-  const double sqrt3 = std::sqrt(3.0), sqrt12 = std::sqrt(12.0);
-  const std::string scale_unit = linear ? "um/m" : "urad/rad";
-  add("instrument calibration",
-      format_significant(in["instrument_ppm"], 3) + " " + scale_unit + " (k = 2)",
-      BudgetDistribution::Normal, ContributionKind::Scale, in["instrument_ppm"] / 2, scale_unit);
-  add("instrument, constant part",
-      format_significant(in["instrument_um"], 3) + " " + unit + " (k = 2)",
-      BudgetDistribution::Normal, ContributionKind::PerMean, in["instrument_um"] / 2, unit);
-  add("resolution", format_significant(in["resolution_um"], 3) + " " + unit + " (full width)",
-      BudgetDistribution::Rectangular, ContributionKind::PerMean, in["resolution_um"] / sqrt12,
-      unit);
-  if (linear && laser) {
-    // The air: its index's sensitivities at the recorded mean air (20 degC, 101325 Pa, 50 %RH
-    // when none is recorded), ppm per degC, Pa, %.
-    const AirConditions air{n.air_temperature_C.empty() ? 20.0 : n.air_temperature_C.mean,
-                            n.air_pressure_Pa.empty() ? 101325.0 : n.air_pressure_Pa.mean,
-                            n.air_humidity_pct.empty() ? 50.0 : n.air_humidity_pct.mean};
-    auto slope = [&](int which, double step) {
-      AirConditions lo = air, hi = air;
-      double* a = which == 0 ? &lo.temperature_C : which == 1 ? &lo.pressure_Pa : &lo.humidity_pct;
-      double* b = which == 0 ? &hi.temperature_C : which == 1 ? &hi.pressure_Pa : &hi.humidity_pct;
-      *a -= step, *b += step;
-      return std::abs(air_refractivity(hi, n.wavelength_nm) -
-                      air_refractivity(lo, n.wavelength_nm)) /
-             (2 * step) * 1e6;
-    };
-    const double dT = slope(0, 0.01), dp = slope(1, 1), dh = slope(2, 0.1);
-    const bool compensated = n.air_applied || n.air == AirCompensation::Instrument;
-    if (compensated) {
-      add("air temperature sensor",
-          format_significant(in["air_temperature_C"], 3) + " degC x " + format_significant(dT, 3) +
-              " um/(m K)",
-          BudgetDistribution::Rectangular, ContributionKind::Scale,
-          in["air_temperature_C"] * dT / sqrt3, scale_unit);
-      add("air pressure sensor",
-          format_significant(in["air_pressure_Pa"], 3) + " Pa x " +
-              format_significant(dp * 1e3, 3) + " um/(m kPa)",
-          BudgetDistribution::Rectangular, ContributionKind::Scale,
-          in["air_pressure_Pa"] * dp / sqrt3, scale_unit);
-      add("air humidity sensor",
-          format_significant(in["air_humidity_pct"], 3) + " %RH x " + format_significant(dh, 3) +
-              " um/(m %RH)",
-          BudgetDistribution::Rectangular, ContributionKind::Scale,
-          in["air_humidity_pct"] * dh / sqrt3, scale_unit);
-      add("Edlen equation", format_significant(in["edlen_ppm"], 3) + " um/m (k = 3)",
-          BudgetDistribution::Normal, ContributionKind::Scale, in["edlen_ppm"] / 3, scale_unit);
-    } else {
-      const double index = air_refractivity(air, n.wavelength_nm) * 1e6;
-      add("air refraction not compensated",
-          format_significant(index, 3) + " um/m (the index of the air)",
-          BudgetDistribution::Rectangular, ContributionKind::Scale, index / sqrt3, scale_unit);
-      r.notes.push_back(
-          "The air's refractive index is not compensated: the budget counts the whole index as "
-          "a rectangular uncertainty. Compensate the air instead (--air-compensation).");
-    }
-    // The material.
-    const double alpha = std::isfinite(n.expansion_ppm_per_K) && n.expansion_ppm_per_K > 0
-                             ? n.expansion_ppm_per_K
-                             : in["nominal_expansion_ppm_per_K"];
-    const bool normalised = n.material_applied || n.material_compensation == "instrument";
-    const bool known = !n.material_temperature_C.empty();
-    const double offset = known ? std::abs(n.material_temperature_C.mean - 20) : kNaN;
-    if (normalised) {
-      add("material temperature sensor",
-          format_significant(in["material_temperature_C"], 3) + " degC x " +
-              format_significant(alpha, 3) + " um/(m K)",
-          BudgetDistribution::Rectangular, ContributionKind::Scale,
-          in["material_temperature_C"] * alpha / sqrt3, scale_unit);
-      if (known)
-        add("expansion coefficient",
-            format_significant(100 * in["expansion_relative"], 3) + " % of " +
-                format_significant(alpha, 3) + " um/(m K) x " + format_significant(offset, 3) +
-                " K",
-            BudgetDistribution::Rectangular, ContributionKind::Scale,
-            in["expansion_relative"] * alpha * offset / sqrt3, scale_unit);
-      else
-        r.notes.push_back(
-            "No material temperature recorded: the expansion coefficient's uncertainty "
-            "(proportional to T - 20 degC) is not in the budget.");
-    } else if (known) {
-      add("expansion not corrected",
-          format_significant(alpha, 3) + " um/(m K) x " + format_significant(offset, 3) + " K",
-          BudgetDistribution::Rectangular, ContributionKind::Scale, alpha * offset / sqrt3,
-          scale_unit);
-      r.notes.push_back(
-          "Not normalised to 20 degC: the nominal differential expansion is counted as a "
-          "rectangular uncertainty; correcting it (--expansion) removes it.");
-    } else {
-      r.notes.push_back(
-          "No material temperature recorded and no normalisation: the expansion to 20 degC is "
-          "not in the budget.");
-    }
-    // Set-up: cosine error over the travel, the dead path, the Abbe offset.
-    if (travel > 0 && in["misalignment_mm"] > 0) {
-      const double phi = in["misalignment_mm"] / travel;
-      add("cosine error (beam misalignment)",
-          format_significant(in["misalignment_mm"], 3) + " mm over " + format_number(travel) +
-              " mm",
-          BudgetDistribution::OneSided, ContributionKind::Scale, phi * phi / 2 * 1e6 / sqrt12,
-          scale_unit);
-    }
-    if (in["dead_path_mm"] > 0) {
-      const double change = n.air_refractivity.count > 1
-                                ? n.air_refractivity.max - n.air_refractivity.min
-                                : dT * 1e-6 * in["dead_path_air_change_C"];
-      add("dead path",
-          format_significant(in["dead_path_mm"], 3) + " mm x " +
-              format_significant(change * 1e6, 3) + " um/m",
-          BudgetDistribution::Rectangular, ContributionKind::PerMean,
-          in["dead_path_mm"] * change * 1e3 / 2 / sqrt3, unit);
-    }
-    add("Abbe error",
-        format_significant(in["abbe_offset_mm"], 3) + " mm x " +
-            format_significant(in["abbe_angle_urad"], 3) + " urad",
-        BudgetDistribution::Rectangular, ContributionKind::PerTarget,
-        in["abbe_offset_mm"] * in["abbe_angle_urad"] * 1e-3 / 2 / sqrt3, unit);
-  } else if (!linear) {
-    r.notes.push_back(
-        "A rotary axis: the budget holds the instrument, the resolution, the environmental "
-        "variation and the run's repeatability.");
-  }
-  add("environmental variation (EVE)",
-      format_significant(in["eve_um"], 3) + " " + unit + " (range)",
-      BudgetDistribution::Rectangular, ContributionKind::PerMean, in["eve_um"] / 2 / sqrt3, unit);
-  {
-    UncertaintyContribution a;
-    a.name = "repeatability of the run (type A)";
-    a.input = "s_i / sqrt(n) of the means, s_i sqrt(1 - c4^2) of the s";
-    a.kind = ContributionKind::TypeA;
-    C.push_back(a);
-  }
-
-  // Sensitivities: central differences of the figures in the means and s (the figures are
-  // piecewise linear in the means; a step of 1e-6 um stays on one piece unless two extremes tie).
+  r.contributions = BudgetContributions(in, n, unit, travel, r.notes)
+                        .build(linear, r.instrument_class != "scale");
   Point p0;
   p0.mean = {classical.mean_up, classical.mean_down};
   p0.s = {classical.s_up, classical.s_down};
-  const double k_up = classical.k_up, k_down = classical.k_down;
-  const std::vector<std::string>& names = uncertainty_figure_names();
-  const double h = 1e-6;
-  // d[f][d][i]: dF/dmean, e[f][d][i]: dF/ds.
-  std::map<std::string, std::array<std::vector<double>, 2>> dm, ds;
-  for (const std::string& f : names)
-    for (int d : {kUp, kDown}) dm[f][d].assign(m, 0), ds[f][d].assign(m, 0);
-  for (int d : {kUp, kDown})
-    for (std::size_t i = 0; i < m; ++i)
-      for (bool of_s : {false, true}) {
-        Point a = p0, b = p0;
-        (of_s ? a.s : a.mean)[d][i] += h;
-        (of_s ? b.s : b.mean)[d][i] -= h;
-        if (of_s && b.s[d][i] < 0) b.s[d][i] = 0;
-        const double step = of_s ? (a.s[d][i] - b.s[d][i]) : 2 * h;
-        const auto fa = uncertainty_figure_values(figures_at(a, k_up, k_down));
-        const auto fb = uncertainty_figure_values(figures_at(b, k_up, k_down));
-        for (const std::string& f : names) {
-          // A difference of rounding errors only (the figure does not depend on this input) is 0.
-          const double v = (fa.at(f) - fb.at(f)) / step;
-          (of_s ? ds : dm)[f][d][i] = std::abs(v) < 1e-6 ? 0.0 : v;
-        }
-      }
-  const std::size_t n_up = runs.cycles[kUp].size(), n_down = runs.cycles[kDown].size();
-  const std::array<std::size_t, 2> cycles = {n_up, n_down};
+  const std::array<std::size_t, 2> cycles = {runs.cycles[kUp].size(), runs.cycles[kDown].size()};
+  propagate_contributions(r.contributions,
+                          figure_sensitivities(p0, classical.k_up, classical.k_down), p0, per_scale,
+                          cycles);
   const auto values = uncertainty_figure_values(classical);
-  for (UncertaintyContribution& c : C)
-    for (const std::string& f : names) {
-      double sens = 0, contribution = 0;
-      switch (c.kind) {
-        case ContributionKind::Scale:
-          for (int d : {kUp, kDown})
-            for (std::size_t i = 0; i < m; ++i) sens += dm[f][d][i] * per_scale[i];
-          if (std::abs(sens) < 1e-9) sens = 0;
-          contribution = std::abs(sens) * c.u;
-          break;
-        case ContributionKind::PerTarget:
-          for (std::size_t i = 0; i < m; ++i) sens += std::pow(dm[f][kUp][i] + dm[f][kDown][i], 2);
-          sens = std::sqrt(sens);
-          contribution = sens * c.u;
-          break;
-        case ContributionKind::PerMean:
-          for (int d : {kUp, kDown})
-            for (std::size_t i = 0; i < m; ++i) sens += dm[f][d][i] * dm[f][d][i];
-          sens = std::sqrt(sens);
-          contribution = sens * c.u;
-          break;
-        case ContributionKind::TypeA:
-          sens = kNaN;
-          for (int d : {kUp, kDown}) {
-            const double nd = static_cast<double>(cycles[static_cast<std::size_t>(d)]);
-            const double spread =
-                std::sqrt(1 - std::pow(c4(cycles[static_cast<std::size_t>(d)]), 2));
-            for (std::size_t i = 0; i < m; ++i) {
-              const double s = p0.s[d][i];
-              contribution += std::pow(dm[f][d][i] * s / std::sqrt(nd), 2) +
-                              std::pow(ds[f][d][i] * s * spread, 2);
-            }
-          }
-          contribution = std::sqrt(contribution);
-          break;
-      }
-      c.sensitivity[f] = sens;
-      c.contribution_um[f] = contribution;
-    }
-  for (const std::string& f : names) {
+  for (const std::string& f : uncertainty_figure_names()) {
     FigureUncertainty fu;
     fu.name = f;
     fu.value = values.at(f);
     double u2 = 0;
-    for (const auto& c : C) u2 += c.contribution_um.at(f) * c.contribution_um.at(f);
+    for (const auto& c : r.contributions) u2 += c.contribution_um.at(f) * c.contribution_um.at(f);
     fu.u = std::sqrt(u2);
     fu.U = r.coverage_factor * fu.u;
     r.figures.push_back(fu);
   }
-  r.contributions = C;
-
-  // Monte Carlo: the same inputs drawn from their distributions, the figures recomputed.
-  if (r.trials > 0) {
-    Normal g(r.seed);
-    std::map<std::string, std::vector<double>> samples;
-    for (const std::string& f : names) samples[f].reserve(r.trials);
-    Point p = p0;
-    for (std::size_t t = 0; t < r.trials; ++t) {
-      for (int d : {kUp, kDown}) {
-        const std::size_t nd = cycles[static_cast<std::size_t>(d)];
-        for (std::size_t i = 0; i < m; ++i) {
-          const double s = p0.s[d][i];
-          p.mean[d][i] = p0.mean[d][i] + g() * s / std::sqrt(static_cast<double>(nd));
-          double chi2 = 0;
-          for (std::size_t k = 0; k + 1 < nd; ++k) {
-            const double z = g();
-            chi2 += z * z;
-          }
-          p.s[d][i] = nd > 1 ? s * std::sqrt(chi2 / static_cast<double>(nd - 1)) : s;
-        }
-      }
-      for (const auto& c : C) {
-        switch (c.kind) {
-          case ContributionKind::Scale: {
-            const double e = draw(g, c.distribution, c.u);
-            for (int d : {kUp, kDown})
-              for (std::size_t i = 0; i < m; ++i) p.mean[d][i] += e * per_scale[i];
-            break;
-          }
-          case ContributionKind::PerTarget:
-            for (std::size_t i = 0; i < m; ++i) {
-              const double e = draw(g, c.distribution, c.u);
-              p.mean[kUp][i] += e;
-              p.mean[kDown][i] += e;
-            }
-            break;
-          case ContributionKind::PerMean:
-            for (int d : {kUp, kDown})
-              for (std::size_t i = 0; i < m; ++i) p.mean[d][i] += draw(g, c.distribution, c.u);
-            break;
-          case ContributionKind::TypeA:
-            break;
-        }
-      }
-      const auto v = uncertainty_figure_values(figures_at(p, k_up, k_down));
-      for (const std::string& f : names) samples[f].push_back(v.at(f));
-    }
-    for (FigureUncertainty& fu : r.figures) {
-      std::vector<double>& x = samples[fu.name];
-      double mean = 0;
-      for (double v : x) mean += v / static_cast<double>(x.size());
-      double ss = 0;
-      for (double v : x) ss += (v - mean) * (v - mean);
-      fu.mc_u = std::sqrt(ss / static_cast<double>(x.size() - 1));
-      std::sort(x.begin(), x.end());
-      const auto at = [&](double q) {
-        return x[std::min(x.size() - 1,
-                          static_cast<std::size_t>(q * static_cast<double>(x.size())))];
-      };
-      fu.mc_low = at(0.025);
-      fu.mc_high = at(0.975);
-      // GUM Supplement 1, 8: the linearised u holds when the Monte Carlo's agrees; here within
-      // 5 % (a figure whose extreme switches between targets under the perturbations does not).
-      fu.validated = fu.u > 0 ? std::abs(fu.mc_u / fu.u - 1) <= 0.05 : fu.mc_u < 1e-9;
-    }
-  }
+  if (r.trials > 0) monte_carlo_check(r, p0, classical.k_up, classical.k_down, per_scale, cycles);
   return r;
 }
 

@@ -358,39 +358,15 @@ std::vector<std::string> iso230_2_conformance_statement(const Iso230_2StudyResul
   return out;
 }
 
-std::string iso230_2_text(const std::string& data, const Iso230_2StudyResult& res) {
-  const IsoColumns& cols = res.columns;
-  const IsoRuns& runs = res.runs;
+namespace {
+
+// The axis figures of each evaluation side by side: classical, with the Student-t factor,
+// drift-eliminated and both (only the classical with --iso-only).
+void text_axis_figures(std::ostream& o, const Iso230_2StudyResult& res) {
   const Iso230_2Result& cr = res.classical;
   const std::optional<DriftResult>& drift = res.drift;
-  const std::size_t m = runs.targets();
-  const std::string u = cols.unit;
-  const auto& P = runs.positions_mm;
+  const std::string& u = res.columns.unit;
   const IsoFigures& F = cr.figures;
-  // ---- stdout ----
-  std::ostringstream o;
-  o << "weilgen iso230-2: " << data << ", axis " << cols.axis << " (deviation " << cols.deviation
-    << "), " << m << " target" << (m == 1 ? "" : "s") << ", " << runs.cycles[kUp].size()
-    << " cycles up, " << runs.cycles[kDown].size() << " cycles down\n\n";
-  o << (res.iso_conforming() ? "Conformance\n" : "Conformance: NOT to ISO 230-2\n");
-  for (const auto& line : iso230_2_conformance_statement(res)) o << "  " << line << "\n";
-  o << "\n";
-  o << "Normalisation and air (ISO 230-2:2014, ISO 1)\n";
-  for (const auto& line : iso230_2_normalisation_statement(res)) o << "  " << line << "\n";
-  o << "\n";
-  o << "Per target (" << u << "; ISO 230-2, k = 2)\n";
-  o << std::setw(12) << "target mm" << std::setw(10) << "mean up" << std::setw(10) << "mean dn"
-    << std::setw(9) << "s up" << std::setw(9) << "s dn" << std::setw(9) << "B_i" << std::setw(9)
-    << "R_i up" << std::setw(9) << "R_i dn" << std::setw(9) << "R_i" << std::setw(10) << "mean bi"
-    << "\n";
-  for (std::size_t i = 0; i < m; ++i)
-    o << std::setw(12) << format_number(P[i]) << std::setw(10) << format_fixed(F.mean_up[i], 3)
-      << std::setw(10) << format_fixed(F.mean_down[i], 3) << std::setw(9)
-      << format_fixed(F.s_up[i], 3) << std::setw(9) << format_fixed(F.s_down[i], 3) << std::setw(9)
-      << format_fixed(F.B_i[i], 3) << std::setw(9) << format_fixed(F.R_i_up[i], 3) << std::setw(9)
-      << format_fixed(F.R_i_down[i], 3) << std::setw(9) << format_fixed(F.R_i[i], 3)
-      << std::setw(10) << format_fixed(F.mean_bi[i], 3) << "\n";
-
   struct Row {
     const char* name;
     const char* what;
@@ -427,17 +403,15 @@ std::string iso230_2_text(const std::string& data, const Iso230_2StudyResult& re
     o << std::setw(12)
       << (s ? format_fixed(s->k_up, 2) + "/" + format_fixed(s->k_down, 2) : std::string("-"));
   o << "\n";
-  if (res.uncertainty) {
-    o << "\nMeasurement uncertainty (" << u << "; ISO 230-9 and the GUM; class "
-      << res.uncertainty->instrument_class << ", budget: " << res.uncertainty->source
-      << "; Monte Carlo after GUM Supplement 1)\n";
-    for (const auto& line : iso230_2_uncertainty_text(res)) o << line << "\n";
-  }
-  if (!res.tolerance.empty()) {
-    o << "\nTolerances (" << u << ")\n";
-    for (const auto& line : iso230_2_tolerance_statement(res)) o << line << "\n";
-  }
+}
 
+// The drift elimination's differences, chart, anomaly test and drift per cycle.
+void text_drift_elimination(std::ostream& o, const Iso230_2StudyResult& res) {
+  const IsoColumns& cols = res.columns;
+  const std::optional<DriftResult>& drift = res.drift;
+  const std::size_t m = res.runs.targets();
+  const std::string& u = cols.unit;
+  const auto& P = res.runs.positions_mm;
   if (drift) {
     const DriftResult& D = *drift;
     o << "\nDrift elimination (Stejskal et al. 2017): reference " << cols.axis << "="
@@ -513,6 +487,54 @@ std::string iso230_2_text(const std::string& data, const Iso230_2StudyResult& re
   } else {
     o << "\nDrift elimination: needs at least 2 targets (skipped).\n";
   }
+}
+
+}  // namespace
+
+std::string iso230_2_text(const std::string& data, const Iso230_2StudyResult& res) {
+  const IsoColumns& cols = res.columns;
+  const IsoRuns& runs = res.runs;
+  const std::size_t m = runs.targets();
+  const std::string u = cols.unit;
+  const auto& P = runs.positions_mm;
+  const IsoFigures& F = res.classical.figures;
+  // ---- stdout ----
+  std::ostringstream o;
+  o << "weilgen iso230-2: " << data << ", axis " << cols.axis << " (deviation " << cols.deviation
+    << "), " << m << " target" << (m == 1 ? "" : "s") << ", " << runs.cycles[kUp].size()
+    << " cycles up, " << runs.cycles[kDown].size() << " cycles down\n\n";
+  o << (res.iso_conforming() ? "Conformance\n" : "Conformance: NOT to ISO 230-2\n");
+  for (const auto& line : iso230_2_conformance_statement(res)) o << "  " << line << "\n";
+  o << "\n";
+  o << "Normalisation and air (ISO 230-2:2014, ISO 1)\n";
+  for (const auto& line : iso230_2_normalisation_statement(res)) o << "  " << line << "\n";
+  o << "\n";
+  o << "Per target (" << u << "; ISO 230-2, k = 2)\n";
+  o << std::setw(12) << "target mm" << std::setw(10) << "mean up" << std::setw(10) << "mean dn"
+    << std::setw(9) << "s up" << std::setw(9) << "s dn" << std::setw(9) << "B_i" << std::setw(9)
+    << "R_i up" << std::setw(9) << "R_i dn" << std::setw(9) << "R_i" << std::setw(10) << "mean bi"
+    << "\n";
+  for (std::size_t i = 0; i < m; ++i)
+    o << std::setw(12) << format_number(P[i]) << std::setw(10) << format_fixed(F.mean_up[i], 3)
+      << std::setw(10) << format_fixed(F.mean_down[i], 3) << std::setw(9)
+      << format_fixed(F.s_up[i], 3) << std::setw(9) << format_fixed(F.s_down[i], 3) << std::setw(9)
+      << format_fixed(F.B_i[i], 3) << std::setw(9) << format_fixed(F.R_i_up[i], 3) << std::setw(9)
+      << format_fixed(F.R_i_down[i], 3) << std::setw(9) << format_fixed(F.R_i[i], 3)
+      << std::setw(10) << format_fixed(F.mean_bi[i], 3) << "\n";
+
+  text_axis_figures(o, res);
+  if (res.uncertainty) {
+    o << "\nMeasurement uncertainty (" << u << "; ISO 230-9 and the GUM; class "
+      << res.uncertainty->instrument_class << ", budget: " << res.uncertainty->source
+      << "; Monte Carlo after GUM Supplement 1)\n";
+    for (const auto& line : iso230_2_uncertainty_text(res)) o << line << "\n";
+  }
+  if (!res.tolerance.empty()) {
+    o << "\nTolerances (" << u << ")\n";
+    for (const auto& line : iso230_2_tolerance_statement(res)) o << line << "\n";
+  }
+
+  text_drift_elimination(o, res);
 
   return o.str();
 }

@@ -268,269 +268,327 @@ void uncertainty_section(std::ostream& o, const Iso230_2StudyResult& res) {
   o << "</section>\n";
 }
 
+// The report's page, one method per section in the order they appear. The members are what
+// every section reads: the columns, runs and classical figures, the units and the header keys.
+class Iso230_2Page {
+ public:
+  explicit Iso230_2Page(const Iso230_2StudyResult& result)
+      : res(result),
+        cols(result.columns),
+        runs(result.runs),
+        F(result.classical.figures),
+        u(result.columns.unit),
+        P(result.runs.positions_mm),
+        m(result.runs.positions_mm.size()),
+        pos_unit(result.columns.unit == "urad" ? "deg" : "mm"),
+        machine(key("machine")),
+        D(result.drift ? &*result.drift : nullptr) {}
+
+  std::string write(const std::string& data, const std::string& source_format) {
+    head();
+    heading();
+    identification(data, source_format);
+    environment();
+    results();
+    if (res.uncertainty) uncertainty_section(o, res);
+    targets();
+    drift();
+    signature_and_method();
+    return o.str();
+  }
+
+ private:
+  std::string key(const std::string& k) const {
+    const auto it = res.header_keys.find(k);
+    return it == res.header_keys.end() ? std::string() : it->second;
+  }
+
+  void head() {
+    o << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+      << "<meta name=\"generator\" content=\"weilgen " << kVersion << "\">\n<title>ISO 230-2 "
+      << h(cols.axis) << (machine.empty() ? "" : " \xE2\x80\x93 " + h(machine))
+      << "</title>\n<style>" << report_style() << "</style>\n</head>\n<body>\n<main>\n";
+  }
+
+  // Heading, conformance and warnings.
+  void heading() {
+    o << "<header><h1 data-key=\"title\">Positioning accuracy and repeatability \xE2\x80\x93 "
+      << (res.iso_conforming() ? std::string("ISO 230-2:2014")
+                               : std::string("evaluated after ISO 230-2:2014, not to ISO 230-2"))
+      << "</h1>"
+      << "<p class=\"sub\">Axis " << h(cols.axis)
+      << (machine.empty() ? "" : " \xC2\xB7 " + h(machine))
+      << (key("date").empty() ? "" : " \xC2\xB7 " + h(key("date"))) << "</p></header>\n";
+    if (!res.iso_conforming()) {
+      o << "<section id=\"conformance\" class=\"banner\"><p>Not to ISO 230-2:2014: the run does "
+           "not "
+           "meet the standard's test conditions.</p><ul>\n";
+      for (const ConformanceIssue& i : res.conformance)
+        o << "<li data-check=\"" << h(i.check) << "\">" << h(pretty(i.message)) << "</li>\n";
+      o << "</ul></section>\n";
+    }
+    if (!res.normalisation.warnings.empty()) {
+      o << "<section id=\"warnings\" class=\"warnings\"><ul>\n";
+      for (const std::string& w : res.normalisation.warnings)
+        o << "<li>" << h(pretty(w)) << "</li>\n";
+      o << "</ul></section>\n";
+    }
+  }
+
+  // Test identification: the keys a signed report needs (blank when the file leaves them
+  // empty), the axis, targets, cycles and data file, then any other header key.
+  void identification(const std::string& data, const std::string& source_format) {
+    o << "<section id=\"identification\"><h2>Test identification</h2>\n<table class=\"meta\">\n";
+    // Rows a signed report needs are kept when the file leaves them empty: blank, to fill in.
+    auto meta_row = [&](const std::string& label, const std::string& value, const std::string& k,
+                        bool keep_blank = false) {
+      if (value.empty() && !keep_blank) return;
+      o << "<tr><td>" << label << "</td><td" << (k.empty() ? "" : " data-key=\"" + k + "\"")
+        << (value.empty() ? " class=\"fill\"" : "") << ">" << h(value) << "</td></tr>\n";
+    };
+    const std::tuple<const char*, const char*, bool> known[] = {
+        {"machine", "Machine", true},   {"serial", "Serial number", true},
+        {"title", "Test", false},       {"customer", "Customer", false},
+        {"location", "Location", true}, {"date", "Test date", true},
+        {"operator", "Operator", true}, {"instrument", "Instrument", true}};
+    std::set<std::string> shown;
+    for (const auto& [k, label, blank] : known) {
+      meta_row(label, key(k), k, blank);
+      shown.insert(k);
+    }
+    meta_row("Axis", cols.axis + " (deviation " + cols.deviation + ", " + pretty(u) + ")", "axis");
+    meta_row("Targets",
+             std::to_string(m) + " from " + format_number(P.front()) + " to " +
+                 format_number(P.back()) + " " + pos_unit,
+             "targets");
+    meta_row("Cycles",
+             std::to_string(runs.cycles[kUp].size()) + " forward, " +
+                 std::to_string(runs.cycles[kDown].size()) + " reverse",
+             "cycles");
+    meta_row("Data file", data + " (read as " + source_format + ")", "file");
+    for (const auto& [k, v] : res.header_keys) {
+      static const std::set<std::string> handled = {"axis",
+                                                    "expansion_ppm_per_K",
+                                                    "material_temperature_C",
+                                                    "air_compensation",
+                                                    "air_temperature_C",
+                                                    "air_pressure_Pa",
+                                                    "air_humidity_pct",
+                                                    "laser_wavelength_nm",
+                                                    "air_index_assumed",
+                                                    "datum_mm",
+                                                    "material_compensation",
+                                                    "deviation_unit",
+                                                    "format"};
+      if (!shown.count(k) && !handled.count(k)) meta_row(k, v, k);
+    }
+    o << "</table></section>\n";
+  }
+
+  void environment() {
+    o << "<section id=\"environment\"><h2>Environment, normalisation and compensation</h2>\n";
+    environment_table(o, res.normalisation);
+    o << "<ul class=\"statements\">\n";
+    for (const auto& line : iso230_2_normalisation_statement(res))
+      o << "<li>" << h(pretty(line)) << "</li>\n";
+    o << "</ul></section>\n";
+  }
+
+  // Results: figures and charts, classical beside drift-eliminated, on one deviation scale.
+  void results() {
+    SvgChart classical;
+    classical.id = "chart-classical";
+    classical.title = "Deviation, mean \xC2\xB1 2s (ISO 230-2)";
+    classical.xlabel = "target " + cols.axis + " (" + pos_unit + ")";
+    classical.ylabel = "deviation (" + pretty(u) + ")";
+    classical.x = P;
+    add_cycles(classical, runs.x[kUp], kUpColour, "runs \xE2\x86\x91");
+    add_cycles(classical, runs.x[kDown], kDownColour, "runs \xE2\x86\x93");
+    add_mean_band(classical, F.mean_up, F.s_up, 2, kUpColour, "mean \xE2\x86\x91",
+                  "\xC2\xB1 2s \xE2\x86\x91");
+    add_mean_band(classical, F.mean_down, F.s_down, 2, kDownColour, "mean \xE2\x86\x93",
+                  "\xC2\xB1 2s \xE2\x86\x93");
+    add_tolerance(classical, res.tolerance, u);
+    SvgChart drift_chart;
+    if (D) {
+      drift_chart.id = "chart-drift";
+      drift_chart.title = "Drift eliminated: chart \xC2\xB1 2s* (Stejskal et al.)";
+      drift_chart.xlabel = classical.xlabel;
+      drift_chart.ylabel = classical.ylabel;
+      drift_chart.x = P;
+      add_cycles(drift_chart, D->chart[kUp].shifted, kUpColour, "runs shifted \xE2\x86\x91");
+      add_cycles(drift_chart, D->chart[kDown].shifted, kDownColour, "runs shifted \xE2\x86\x93");
+      add_mean_band(drift_chart, D->chart[kUp].value, D->chart[kUp].s, 2, kUpColour,
+                    "chart \xE2\x86\x91", "\xC2\xB1 2s* \xE2\x86\x91");
+      add_mean_band(drift_chart, D->chart[kDown].value, D->chart[kDown].s, 2, kDownColour,
+                    "chart \xE2\x86\x93", "\xC2\xB1 2s* \xE2\x86\x93");
+      add_tolerance(drift_chart, res.tolerance, u);
+      const auto range = y_range_of({&classical, &drift_chart});
+      classical.y_range = drift_chart.y_range = range;
+    }
+    o << "<section id=\"results\"><h2>Results</h2>\n";
+    if (!res.tolerance.empty()) {
+      const bool pass = res.verdict == Decision::Conforms;
+      bool with_u = false;
+      for (const auto& c : res.tolerance) with_u |= std::isfinite(c.U);
+      o << "<p class=\"verdict\" data-key=\"tolerance_pass\" data-value=\""
+        << (pass ? "true" : "false") << "\">Verdict against the tolerances: <span class=\""
+        << decision_class(res.verdict) << "\">" << decision_text(res.verdict) << "</span> ("
+        << (with_u ? "classical figures, k = 2, with their expanded uncertainty, ISO 14253-1"
+                   : "classical figures, k = 2, without their uncertainty")
+        << (res.verdict_reason.empty() ? std::string() : "; " + h(pretty(res.verdict_reason)))
+        << ")</p>\n";
+    }
+    o << "<div class=\"pair\">\n<div><h3>ISO 230-2 evaluation (k = 2)</h3>\n"
+      << figures_table(F, "classical", u, &res.tolerance) << "<figure>" << svg_chart(classical)
+      << "<figcaption>Every run (thin), the mean unidirectional deviations x\xCC\x84\xE2\x86\x91, "
+         "x\xCC\x84\xE2\x86\x93 and the bands x\xCC\x84 \xC2\xB1 "
+         "2s.</figcaption></figure>\n</div>\n";
+    if (D) {
+      o << "<div><h3>Drift-eliminated evaluation (k = 2)</h3>\n"
+        << figures_table(D->figures, "drift_eliminated", u, nullptr) << "<figure>"
+        << svg_chart(drift_chart) << "<figcaption>Adjacent-position differences accumulated from "
+        << h(cols.axis) << " = " << format_number(P[D->reference_target]) << " " << pos_unit
+        << ", cycle " << D->reference_cycle
+        << "; every run shifted to that reference; s* = s of the differences / \xE2\x88\x9A"
+           "2. "
+           "Thermal drift between cycles is removed; drift within a pass is not.</figcaption>"
+           "</figure>\n</div>\n";
+    } else if (!res.iso_only) {
+      o << "<div><h3>Drift-eliminated evaluation</h3><p>Needs at least 2 targets.</p></div>\n";
+    }
+    o << "</div>\n";
+    if (res.classical.student) {
+      const IsoFigures& S = *res.classical.student;
+      o << "<p>With the Student-t coverage factor for " << runs.cycles[kUp].size()
+        << " cycles (k = " << format_fixed(S.k_up, 2) << " / " << format_fixed(S.k_down, 2)
+        << "): A = <span data-set=\"student\" data-key=\"A_um\">" << format_fixed(S.A, 3)
+        << "</span> " << pretty(u) << ", R = <span data-set=\"student\" data-key=\"R_um\">"
+        << format_fixed(S.R, 3) << "</span> " << pretty(u) << ".</p>\n";
+    }
+    if (!res.tolerance.empty()) {
+      o << "<table class=\"tolerance\"><thead><tr><th>Tolerance</th><th>Value (" << pretty(u)
+        << ")</th><th>U (" << pretty(u) << ")</th><th>Limit (" << pretty(u)
+        << ")</th><th>Result</th></tr></thead><tbody>\n";
+      for (const auto& c : res.tolerance)
+        o << "<tr><td>"
+          << (c.name == "band" ? std::string("every x\xCC\x84 \xC2\xB1 2s within \xC2\xB1 limit")
+                               : h(c.name))
+          << "</td><td class=\"num\" data-set=\"tolerance\" data-key=\"" << h(c.name) << "\">"
+          << format_fixed(c.value, 3) << "</td><td class=\"num\">" << format_fixed(c.U, 3)
+          << "</td><td class=\"num\">" << format_number(c.limit) << "</td><td class=\""
+          << decision_class(c.decision) << "\">" << decision_text(c.decision) << "</td></tr>\n";
+      o << "</tbody></table>\n";
+    }
+    o << "</section>\n";
+  }
+
+  void targets() {
+    o << "<section id=\"targets\"><h2>Per target (" << pretty(u) << ", k = 2)</h2>\n"
+      << "<table class=\"targets\"><thead><tr><th>Target (" << pos_unit
+      << ")</th><th>x\xCC\x84 \xE2\x86\x91</th><th>x\xCC\x84 \xE2\x86\x93</th><th>s "
+         "\xE2\x86\x91</th><th>s \xE2\x86\x93</th><th>B<sub>i</sub></th><th>R<sub>i</sub> "
+         "\xE2\x86\x91</th><th>R<sub>i</sub> "
+         "\xE2\x86\x93</th><th>R<sub>i</sub></th><th>x\xCC\x84<sub>i</sub></th>";
+    if (D)
+      o << "<th>chart \xE2\x86\x91</th><th>s* \xE2\x86\x91</th><th>chart \xE2\x86\x93</th><th>s* "
+           "\xE2\x86\x93</th>";
+    o << "</tr></thead><tbody>\n";
+    for (std::size_t i = 0; i < m; ++i) {
+      auto td = [&](const char* k, double v) {
+        return "<td class=\"num\" data-set=\"classical\" data-key=\"" + std::string(k) +
+               "\" data-index=\"" + std::to_string(i) + "\">" + format_fixed(v, 3) + "</td>";
+      };
+      o << "<tr><td class=\"num\">" << format_number(P[i]) << "</td>"
+        << td("mean_up_um", F.mean_up[i]) << td("mean_down_um", F.mean_down[i])
+        << td("s_up_um", F.s_up[i]) << td("s_down_um", F.s_down[i]) << td("B_i_um", F.B_i[i])
+        << td("R_i_up_um", F.R_i_up[i]) << td("R_i_down_um", F.R_i_down[i])
+        << td("R_i_um", F.R_i[i]) << td("mean_bi_um", F.mean_bi[i]);
+      if (D)
+        o << "<td class=\"num\">" << format_fixed(D->chart[kUp].value[i], 3)
+          << "</td><td class=\"num\">" << format_fixed(D->chart[kUp].s[i], 3)
+          << "</td><td class=\"num\">" << format_fixed(D->chart[kDown].value[i], 3)
+          << "</td><td class=\"num\">" << format_fixed(D->chart[kDown].s[i], 3) << "</td>";
+      o << "</tr>\n";
+    }
+    o << "</tbody></table></section>\n";
+  }
+
+  // Thermal drift: every cycle's offset, the drift rate and the anomaly test.
+  void drift() {
+    if (D) {
+      const DriftPerCycle& C = D->per_cycle;
+      SvgChart cyc;
+      cyc.id = "chart-cycles";
+      cyc.title =
+          "Offset of every cycle (relative to cycle " + std::to_string(D->reference_cycle) + ")";
+      cyc.xlabel = "cycle";
+      cyc.ylabel = "offset (" + pretty(u) + ")";
+      for (long c : C.cycles) cyc.x.push_back(static_cast<double>(c));
+      cyc.series.push_back({"forward \xE2\x86\x91", C.offset_up, kUpColour, 1.6, false, true, 1});
+      cyc.series.push_back(
+          {"reverse \xE2\x86\x93", C.offset_down, kDownColour, 1.6, false, true, 1});
+      cyc.series.push_back({"mean", C.offset, "#333333", 1.2, true, false, 1});
+      cyc.width = 760;
+      cyc.height = 300;
+      o << "<section id=\"drift\"><h2>Thermal drift</h2>\n<figure>" << svg_chart(cyc)
+        << "</figure>\n<p>Drift rate " << format_fixed(C.rate_per_cycle, 4) << " \xC2\xB1 "
+        << format_fixed(C.rate_per_cycle_se, 4) << " " << pretty(u) << " per cycle";
+      if (std::isfinite(C.rate_per_h))
+        o << ", " << format_fixed(C.rate_per_h, 4) << " \xC2\xB1 "
+          << format_fixed(C.rate_per_h_se, 4) << " " << pretty(u) << "/h";
+      o << " (within-group least squares, standard error). Anomaly test (F test of each adjacent "
+           "difference, Bonferroni over "
+        << D->tests << " tests, \xCE\xB1 = " << format_number(D->alpha) << "): ";
+      if (D->anomalous_positions.empty() && D->anomalous_differences.empty()) {
+        o << "no anomalous spread.";
+      } else {
+        std::vector<std::string> items;
+        for (const auto& a : D->anomalous_positions)
+          items.push_back(cols.axis + " = " + format_number(P[a.target]) + " " + pos_unit +
+                          (a.direction > 0 ? " \xE2\x86\x91" : " \xE2\x86\x93"));
+        for (const auto& a : D->anomalous_differences)
+          items.push_back(format_number(P[a.from]) + "\xE2\x80\xA6" + format_number(P[a.to]) + " " +
+                          pos_unit + (a.direction > 0 ? " \xE2\x86\x91" : " \xE2\x86\x93") +
+                          " (p = " + format_significant(a.p_value, 2) + ")");
+        o << "anomalous: ";
+        for (std::size_t i = 0; i < items.size(); ++i) o << (i ? "; " : "") << h(items[i]);
+        o << ".";
+      }
+      o << "</p></section>\n";
+    }
+  }
+
+  void signature_and_method() {
+    o << "<section id=\"signature\"><h2>Approval</h2><div class=\"signature\"><div>Tested by</div>"
+         "<div>Checked by</div><div>Date</div></div></section>\n";
+    o << "<footer>Figures as defined in ISO 230-2:2014, clause 3 (coverage factor k = 2). "
+         "Drift-eliminated evaluation after T. Stejskal et al., Advances in Science and Technology "
+         "Research Journal 11(4), 2017. Normalisation to 20 \xC2\xB0"
+         "C per ISO 1; air refraction by "
+         "the modified Edl\xC3\xA9n equation of Birch &amp; Downs (Metrologia 30, 1993; 31, 1994). "
+         "Report written by weilgen "
+      << kVersion << " (docs/iso230-2.md).</footer>\n</main>\n</body>\n</html>\n";
+  }
+
+  const Iso230_2StudyResult& res;
+  const IsoColumns& cols;
+  const IsoRuns& runs;
+  const IsoFigures& F;
+  const std::string& u;
+  const std::vector<double>& P;
+  const std::size_t m;
+  const std::string pos_unit;
+  const std::string machine;
+  const DriftResult* D;  // null without a drift elimination
+  std::ostringstream o;
+};
+
 }  // namespace
 
 std::string iso230_2_html(const std::string& data, const Iso230_2StudyResult& res,
                           const std::string& source_format) {
-  const IsoColumns& cols = res.columns;
-  const IsoRuns& runs = res.runs;
-  const IsoFigures& F = res.classical.figures;
-  const std::string& u = cols.unit;
-  const auto& P = runs.positions_mm;
-  const std::size_t m = P.size();
-  const bool rotary = cols.unit == "urad";
-  const std::string pos_unit = rotary ? "deg" : "mm";
-  auto key = [&](const std::string& k) {
-    const auto it = res.header_keys.find(k);
-    return it == res.header_keys.end() ? std::string() : it->second;
-  };
-  const std::string machine = key("machine");
-  std::ostringstream o;
-  o << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
-    << "<meta name=\"generator\" content=\"weilgen " << kVersion << "\">\n<title>ISO 230-2 "
-    << h(cols.axis) << (machine.empty() ? "" : " \xE2\x80\x93 " + h(machine)) << "</title>\n<style>"
-    << report_style() << "</style>\n</head>\n<body>\n<main>\n";
-  // ---- Heading, conformance and identification.
-  o << "<header><h1 data-key=\"title\">Positioning accuracy and repeatability \xE2\x80\x93 "
-    << (res.iso_conforming() ? std::string("ISO 230-2:2014")
-                             : std::string("evaluated after ISO 230-2:2014, not to ISO 230-2"))
-    << "</h1>"
-    << "<p class=\"sub\">Axis " << h(cols.axis)
-    << (machine.empty() ? "" : " \xC2\xB7 " + h(machine))
-    << (key("date").empty() ? "" : " \xC2\xB7 " + h(key("date"))) << "</p></header>\n";
-  if (!res.iso_conforming()) {
-    o << "<section id=\"conformance\" class=\"banner\"><p>Not to ISO 230-2:2014: the run does not "
-         "meet the standard's test conditions.</p><ul>\n";
-    for (const ConformanceIssue& i : res.conformance)
-      o << "<li data-check=\"" << h(i.check) << "\">" << h(pretty(i.message)) << "</li>\n";
-    o << "</ul></section>\n";
-  }
-  if (!res.normalisation.warnings.empty()) {
-    o << "<section id=\"warnings\" class=\"warnings\"><ul>\n";
-    for (const std::string& w : res.normalisation.warnings)
-      o << "<li>" << h(pretty(w)) << "</li>\n";
-    o << "</ul></section>\n";
-  }
-  o << "<section id=\"identification\"><h2>Test identification</h2>\n<table class=\"meta\">\n";
-  // Rows a signed report needs are kept when the file leaves them empty: blank, to fill in.
-  auto meta_row = [&](const std::string& label, const std::string& value, const std::string& k,
-                      bool keep_blank = false) {
-    if (value.empty() && !keep_blank) return;
-    o << "<tr><td>" << label << "</td><td" << (k.empty() ? "" : " data-key=\"" + k + "\"")
-      << (value.empty() ? " class=\"fill\"" : "") << ">" << h(value) << "</td></tr>\n";
-  };
-  const std::tuple<const char*, const char*, bool> known[] = {
-      {"machine", "Machine", true},   {"serial", "Serial number", true},
-      {"title", "Test", false},       {"customer", "Customer", false},
-      {"location", "Location", true}, {"date", "Test date", true},
-      {"operator", "Operator", true}, {"instrument", "Instrument", true}};
-  std::set<std::string> shown;
-  for (const auto& [k, label, blank] : known) {
-    meta_row(label, key(k), k, blank);
-    shown.insert(k);
-  }
-  meta_row("Axis", cols.axis + " (deviation " + cols.deviation + ", " + pretty(u) + ")", "axis");
-  meta_row("Targets",
-           std::to_string(m) + " from " + format_number(P.front()) + " to " +
-               format_number(P.back()) + " " + pos_unit,
-           "targets");
-  meta_row("Cycles",
-           std::to_string(runs.cycles[kUp].size()) + " forward, " +
-               std::to_string(runs.cycles[kDown].size()) + " reverse",
-           "cycles");
-  meta_row("Data file", data + " (read as " + source_format + ")", "file");
-  for (const auto& [k, v] : res.header_keys) {
-    static const std::set<std::string> handled = {"axis",
-                                                  "expansion_ppm_per_K",
-                                                  "material_temperature_C",
-                                                  "air_compensation",
-                                                  "air_temperature_C",
-                                                  "air_pressure_Pa",
-                                                  "air_humidity_pct",
-                                                  "laser_wavelength_nm",
-                                                  "air_index_assumed",
-                                                  "datum_mm",
-                                                  "material_compensation",
-                                                  "deviation_unit",
-                                                  "format"};
-    if (!shown.count(k) && !handled.count(k)) meta_row(k, v, k);
-  }
-  o << "</table></section>\n";
-  // ---- Environment.
-  o << "<section id=\"environment\"><h2>Environment, normalisation and compensation</h2>\n";
-  environment_table(o, res.normalisation);
-  o << "<ul class=\"statements\">\n";
-  for (const auto& line : iso230_2_normalisation_statement(res))
-    o << "<li>" << h(pretty(line)) << "</li>\n";
-  o << "</ul></section>\n";
-  // ---- Results: figures and charts, classical beside drift-eliminated.
-  SvgChart classical;
-  classical.id = "chart-classical";
-  classical.title = "Deviation, mean \xC2\xB1 2s (ISO 230-2)";
-  classical.xlabel = "target " + cols.axis + " (" + pos_unit + ")";
-  classical.ylabel = "deviation (" + pretty(u) + ")";
-  classical.x = P;
-  add_cycles(classical, runs.x[kUp], kUpColour, "runs \xE2\x86\x91");
-  add_cycles(classical, runs.x[kDown], kDownColour, "runs \xE2\x86\x93");
-  add_mean_band(classical, F.mean_up, F.s_up, 2, kUpColour, "mean \xE2\x86\x91",
-                "\xC2\xB1 2s \xE2\x86\x91");
-  add_mean_band(classical, F.mean_down, F.s_down, 2, kDownColour, "mean \xE2\x86\x93",
-                "\xC2\xB1 2s \xE2\x86\x93");
-  add_tolerance(classical, res.tolerance, u);
-  SvgChart drift_chart;
-  const DriftResult* D = res.drift ? &*res.drift : nullptr;
-  if (D) {
-    drift_chart.id = "chart-drift";
-    drift_chart.title = "Drift eliminated: chart \xC2\xB1 2s* (Stejskal et al.)";
-    drift_chart.xlabel = classical.xlabel;
-    drift_chart.ylabel = classical.ylabel;
-    drift_chart.x = P;
-    add_cycles(drift_chart, D->chart[kUp].shifted, kUpColour, "runs shifted \xE2\x86\x91");
-    add_cycles(drift_chart, D->chart[kDown].shifted, kDownColour, "runs shifted \xE2\x86\x93");
-    add_mean_band(drift_chart, D->chart[kUp].value, D->chart[kUp].s, 2, kUpColour,
-                  "chart \xE2\x86\x91", "\xC2\xB1 2s* \xE2\x86\x91");
-    add_mean_band(drift_chart, D->chart[kDown].value, D->chart[kDown].s, 2, kDownColour,
-                  "chart \xE2\x86\x93", "\xC2\xB1 2s* \xE2\x86\x93");
-    add_tolerance(drift_chart, res.tolerance, u);
-    const auto range = y_range_of({&classical, &drift_chart});
-    classical.y_range = drift_chart.y_range = range;
-  }
-  o << "<section id=\"results\"><h2>Results</h2>\n";
-  if (!res.tolerance.empty()) {
-    const bool pass = res.verdict == Decision::Conforms;
-    bool with_u = false;
-    for (const auto& c : res.tolerance) with_u |= std::isfinite(c.U);
-    o << "<p class=\"verdict\" data-key=\"tolerance_pass\" data-value=\""
-      << (pass ? "true" : "false") << "\">Verdict against the tolerances: <span class=\""
-      << decision_class(res.verdict) << "\">" << decision_text(res.verdict) << "</span> ("
-      << (with_u ? "classical figures, k = 2, with their expanded uncertainty, ISO 14253-1"
-                 : "classical figures, k = 2, without their uncertainty")
-      << (res.verdict_reason.empty() ? std::string() : "; " + h(pretty(res.verdict_reason)))
-      << ")</p>\n";
-  }
-  o << "<div class=\"pair\">\n<div><h3>ISO 230-2 evaluation (k = 2)</h3>\n"
-    << figures_table(F, "classical", u, &res.tolerance) << "<figure>" << svg_chart(classical)
-    << "<figcaption>Every run (thin), the mean unidirectional deviations x\xCC\x84\xE2\x86\x91, "
-       "x\xCC\x84\xE2\x86\x93 and the bands x\xCC\x84 \xC2\xB1 2s.</figcaption></figure>\n</div>\n";
-  if (D) {
-    o << "<div><h3>Drift-eliminated evaluation (k = 2)</h3>\n"
-      << figures_table(D->figures, "drift_eliminated", u, nullptr) << "<figure>"
-      << svg_chart(drift_chart) << "<figcaption>Adjacent-position differences accumulated from "
-      << h(cols.axis) << " = " << format_number(P[D->reference_target]) << " " << pos_unit
-      << ", cycle " << D->reference_cycle
-      << "; every run shifted to that reference; s* = s of the differences / \xE2\x88\x9A"
-         "2. "
-         "Thermal drift between cycles is removed; drift within a pass is not.</figcaption>"
-         "</figure>\n</div>\n";
-  } else if (!res.iso_only) {
-    o << "<div><h3>Drift-eliminated evaluation</h3><p>Needs at least 2 targets.</p></div>\n";
-  }
-  o << "</div>\n";
-  if (res.classical.student) {
-    const IsoFigures& S = *res.classical.student;
-    o << "<p>With the Student-t coverage factor for " << runs.cycles[kUp].size()
-      << " cycles (k = " << format_fixed(S.k_up, 2) << " / " << format_fixed(S.k_down, 2)
-      << "): A = <span data-set=\"student\" data-key=\"A_um\">" << format_fixed(S.A, 3)
-      << "</span> " << pretty(u) << ", R = <span data-set=\"student\" data-key=\"R_um\">"
-      << format_fixed(S.R, 3) << "</span> " << pretty(u) << ".</p>\n";
-  }
-  if (!res.tolerance.empty()) {
-    o << "<table class=\"tolerance\"><thead><tr><th>Tolerance</th><th>Value (" << pretty(u)
-      << ")</th><th>U (" << pretty(u) << ")</th><th>Limit (" << pretty(u)
-      << ")</th><th>Result</th></tr></thead><tbody>\n";
-    for (const auto& c : res.tolerance)
-      o << "<tr><td>"
-        << (c.name == "band" ? std::string("every x\xCC\x84 \xC2\xB1 2s within \xC2\xB1 limit")
-                             : h(c.name))
-        << "</td><td class=\"num\" data-set=\"tolerance\" data-key=\"" << h(c.name) << "\">"
-        << format_fixed(c.value, 3) << "</td><td class=\"num\">" << format_fixed(c.U, 3)
-        << "</td><td class=\"num\">" << format_number(c.limit) << "</td><td class=\""
-        << decision_class(c.decision) << "\">" << decision_text(c.decision) << "</td></tr>\n";
-    o << "</tbody></table>\n";
-  }
-  o << "</section>\n";
-  if (res.uncertainty) uncertainty_section(o, res);
-  // ---- Per target.
-  o << "<section id=\"targets\"><h2>Per target (" << pretty(u) << ", k = 2)</h2>\n"
-    << "<table class=\"targets\"><thead><tr><th>Target (" << pos_unit
-    << ")</th><th>x\xCC\x84 \xE2\x86\x91</th><th>x\xCC\x84 \xE2\x86\x93</th><th>s "
-       "\xE2\x86\x91</th><th>s \xE2\x86\x93</th><th>B<sub>i</sub></th><th>R<sub>i</sub> "
-       "\xE2\x86\x91</th><th>R<sub>i</sub> "
-       "\xE2\x86\x93</th><th>R<sub>i</sub></th><th>x\xCC\x84<sub>i</sub></th>";
-  if (D)
-    o << "<th>chart \xE2\x86\x91</th><th>s* \xE2\x86\x91</th><th>chart \xE2\x86\x93</th><th>s* "
-         "\xE2\x86\x93</th>";
-  o << "</tr></thead><tbody>\n";
-  for (std::size_t i = 0; i < m; ++i) {
-    auto td = [&](const char* k, double v) {
-      return "<td class=\"num\" data-set=\"classical\" data-key=\"" + std::string(k) +
-             "\" data-index=\"" + std::to_string(i) + "\">" + format_fixed(v, 3) + "</td>";
-    };
-    o << "<tr><td class=\"num\">" << format_number(P[i]) << "</td>"
-      << td("mean_up_um", F.mean_up[i]) << td("mean_down_um", F.mean_down[i])
-      << td("s_up_um", F.s_up[i]) << td("s_down_um", F.s_down[i]) << td("B_i_um", F.B_i[i])
-      << td("R_i_up_um", F.R_i_up[i]) << td("R_i_down_um", F.R_i_down[i]) << td("R_i_um", F.R_i[i])
-      << td("mean_bi_um", F.mean_bi[i]);
-    if (D)
-      o << "<td class=\"num\">" << format_fixed(D->chart[kUp].value[i], 3)
-        << "</td><td class=\"num\">" << format_fixed(D->chart[kUp].s[i], 3)
-        << "</td><td class=\"num\">" << format_fixed(D->chart[kDown].value[i], 3)
-        << "</td><td class=\"num\">" << format_fixed(D->chart[kDown].s[i], 3) << "</td>";
-    o << "</tr>\n";
-  }
-  o << "</tbody></table></section>\n";
-  // ---- Drift.
-  if (D) {
-    const DriftPerCycle& C = D->per_cycle;
-    SvgChart cyc;
-    cyc.id = "chart-cycles";
-    cyc.title =
-        "Offset of every cycle (relative to cycle " + std::to_string(D->reference_cycle) + ")";
-    cyc.xlabel = "cycle";
-    cyc.ylabel = "offset (" + pretty(u) + ")";
-    for (long c : C.cycles) cyc.x.push_back(static_cast<double>(c));
-    cyc.series.push_back({"forward \xE2\x86\x91", C.offset_up, kUpColour, 1.6, false, true, 1});
-    cyc.series.push_back({"reverse \xE2\x86\x93", C.offset_down, kDownColour, 1.6, false, true, 1});
-    cyc.series.push_back({"mean", C.offset, "#333333", 1.2, true, false, 1});
-    cyc.width = 760;
-    cyc.height = 300;
-    o << "<section id=\"drift\"><h2>Thermal drift</h2>\n<figure>" << svg_chart(cyc)
-      << "</figure>\n<p>Drift rate " << format_fixed(C.rate_per_cycle, 4) << " \xC2\xB1 "
-      << format_fixed(C.rate_per_cycle_se, 4) << " " << pretty(u) << " per cycle";
-    if (std::isfinite(C.rate_per_h))
-      o << ", " << format_fixed(C.rate_per_h, 4) << " \xC2\xB1 " << format_fixed(C.rate_per_h_se, 4)
-        << " " << pretty(u) << "/h";
-    o << " (within-group least squares, standard error). Anomaly test (F test of each adjacent "
-         "difference, Bonferroni over "
-      << D->tests << " tests, \xCE\xB1 = " << format_number(D->alpha) << "): ";
-    if (D->anomalous_positions.empty() && D->anomalous_differences.empty()) {
-      o << "no anomalous spread.";
-    } else {
-      std::vector<std::string> items;
-      for (const auto& a : D->anomalous_positions)
-        items.push_back(cols.axis + " = " + format_number(P[a.target]) + " " + pos_unit +
-                        (a.direction > 0 ? " \xE2\x86\x91" : " \xE2\x86\x93"));
-      for (const auto& a : D->anomalous_differences)
-        items.push_back(format_number(P[a.from]) + "\xE2\x80\xA6" + format_number(P[a.to]) + " " +
-                        pos_unit + (a.direction > 0 ? " \xE2\x86\x91" : " \xE2\x86\x93") +
-                        " (p = " + format_significant(a.p_value, 2) + ")");
-      o << "anomalous: ";
-      for (std::size_t i = 0; i < items.size(); ++i) o << (i ? "; " : "") << h(items[i]);
-      o << ".";
-    }
-    o << "</p></section>\n";
-  }
-  // ---- Signature and method.
-  o << "<section id=\"signature\"><h2>Approval</h2><div class=\"signature\"><div>Tested by</div>"
-       "<div>Checked by</div><div>Date</div></div></section>\n";
-  o << "<footer>Figures as defined in ISO 230-2:2014, clause 3 (coverage factor k = 2). "
-       "Drift-eliminated evaluation after T. Stejskal et al., Advances in Science and Technology "
-       "Research Journal 11(4), 2017. Normalisation to 20 \xC2\xB0"
-       "C per ISO 1; air refraction by "
-       "the modified Edl\xC3\xA9n equation of Birch &amp; Downs (Metrologia 30, 1993; 31, 1994). "
-       "Report written by weilgen "
-    << kVersion << " (docs/iso230-2.md).</footer>\n</main>\n</body>\n</html>\n";
-  return o.str();
+  return Iso230_2Page(res).write(data, source_format);
 }
 
 }  // namespace weilgen

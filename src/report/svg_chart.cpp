@@ -96,9 +96,11 @@ std::vector<double> nice_ticks(double lo, double hi, int count) {
   return ticks;
 }
 
-std::string svg_chart(const SvgChart& c) {
+namespace {
+
+// Every x finite, one y per x in each series, one lo and hi per x in each band.
+void check_svg_chart(const SvgChart& c) {
   const std::size_t n = c.x.size();
-  if (n == 0) throw std::invalid_argument("svg chart \"" + c.title + "\": no x values");
   for (double v : c.x)
     if (!std::isfinite(v))
       throw std::invalid_argument("svg chart \"" + c.title + "\": x not finite");
@@ -111,6 +113,37 @@ std::string svg_chart(const SvgChart& c) {
     if (b.lo.size() != n || b.hi.size() != n)
       throw std::invalid_argument("svg chart \"" + c.title + "\": band \"" + b.label +
                                   "\" needs one lo and hi per x");
+}
+
+// The legend's rows below the plot, from the plot's left edge at `top` (px).
+void svg_legend(std::ostream& o, const std::vector<std::vector<const LegendItem*>>& rows,
+                double left, double top) {
+  double ly = top;
+  for (const auto& row : rows) {
+    double lx = left;
+    for (const LegendItem* it : row) {
+      if (it->box)
+        o << "<rect x=\"" << px(lx) << "\" y=\"" << px(ly - 6) << "\" width=\"24\" height=\"10\" "
+          << "fill=\"" << it->colour << "\" fill-opacity=\"" << px(std::max(it->opacity, 0.25))
+          << "\"/>\n";
+      else
+        o << "<line x1=\"" << px(lx) << "\" y1=\"" << px(ly) << "\" x2=\"" << px(lx + 24)
+          << "\" y2=\"" << px(ly) << "\" stroke=\"" << it->colour << "\" stroke-width=\"2\""
+          << (it->dashed ? " stroke-dasharray=\"6 4\"" : "") << "/>\n";
+      o << "<text x=\"" << px(lx + 30) << "\" y=\"" << px(ly + 4) << "\">" << xml_escape(it->label)
+        << "</text>\n";
+      lx += 34 + 6.6 * static_cast<double>(it->label.size());
+    }
+    ly += 18;
+  }
+}
+
+}  // namespace
+
+std::string svg_chart(const SvgChart& c) {
+  const std::size_t n = c.x.size();
+  if (n == 0) throw std::invalid_argument("svg chart \"" + c.title + "\": no x values");
+  check_svg_chart(c);
 
   // Ranges.
   double xlo = *std::min_element(c.x.begin(), c.x.end());
@@ -229,25 +262,7 @@ std::string svg_chart(const SvgChart& c) {
   }
   o << "</g>\n<rect x=\"" << px(left) << "\" y=\"" << px(top) << "\" width=\"" << px(plot_w)
     << "\" height=\"" << px(plot_h) << "\" fill=\"none\" stroke=\"#333333\"/>\n";
-  // Legend.
-  double ly = c.height + 10;
-  for (const auto& row : rows) {
-    double lx = left;
-    for (const LegendItem* it : row) {
-      if (it->box)
-        o << "<rect x=\"" << px(lx) << "\" y=\"" << px(ly - 6) << "\" width=\"24\" height=\"10\" "
-          << "fill=\"" << it->colour << "\" fill-opacity=\"" << px(std::max(it->opacity, 0.25))
-          << "\"/>\n";
-      else
-        o << "<line x1=\"" << px(lx) << "\" y1=\"" << px(ly) << "\" x2=\"" << px(lx + 24)
-          << "\" y2=\"" << px(ly) << "\" stroke=\"" << it->colour << "\" stroke-width=\"2\""
-          << (it->dashed ? " stroke-dasharray=\"6 4\"" : "") << "/>\n";
-      o << "<text x=\"" << px(lx + 30) << "\" y=\"" << px(ly + 4) << "\">" << xml_escape(it->label)
-        << "</text>\n";
-      lx += 34 + 6.6 * static_cast<double>(it->label.size());
-    }
-    ly += 18;
-  }
+  svg_legend(o, rows, left, c.height + 10);
   o << "</svg>\n";
   return o.str();
 }

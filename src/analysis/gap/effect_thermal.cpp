@@ -122,6 +122,76 @@ Columns thermal_columns(const ThermalContext& tc, const Variant& v) {
   return out;
 }
 
+// A fitted thermal variant in words and parameters: its kind (time, heat-up, sensor), frame,
+// drift and scale per axis, and the region it explains.
+void describe_thermal(const ThermalContext& tc, const Variant& v, const VectorXd& coef,
+                      EffectFit& fit) {
+  const GapData& data = *tc.d;
+  const int kind = static_cast<int>(v.hyper[0]);
+  const Frame frame = tc.frames[static_cast<std::size_t>(v.hyper[3])];
+  const Columns cols = thermal_columns(tc, v);
+  const std::string per = kind == 0 ? "_per_h" : kind == 1 ? "" : "_per_K";
+  const std::string per_text = kind == 0 ? "/h" : kind == 1 ? "" : "/K";
+  std::string drift, scale;
+  for (std::size_t k = 0; k < cols.labels.size() && static_cast<Index>(k) < coef.size(); ++k) {
+    const std::string& l = cols.labels[k];
+    const double x = coef[static_cast<Index>(k)];
+    const std::string sx = (x >= 0 ? "+" : "") + format_short(x, 2);
+    if (l.rfind("scale_", 0) == 0) {
+      fit.params[l + "_um_per_m" + per] = x;
+      scale += (scale.empty() ? "" : ", ") + std::string("scale of ") + l.substr(6) + " " + sx +
+               " µm/m" + per_text;
+    } else {
+      const bool tilt = l[0] == 't';
+      fit.params[l + (tilt ? "_urad" : "_um") + per] = x;
+      drift += (drift.empty() ? "" : ", ") + std::string(tilt ? "tilt " : "") + l.back() + " " +
+               sx + (tilt ? " µrad" : " µm") + per_text;
+    }
+  }
+  fit.params[frame == Frame::Tool ? "frame_tool" : "frame_machine"] = 1;
+  std::string what;
+  if (kind == 0) {
+    what = "drift in time";
+  } else if (kind == 1) {
+    fit.params["tau_h"] = v.hyper[1] / 3600;
+    what = "heat-up (tau " + format_short(v.hyper[1] / 3600, 2) + " h)";
+  } else {
+    const std::string& s = tc.sensors[static_cast<std::size_t>(v.hyper[2])];
+    fit.params["sensor_" + s] = 1;
+    fit.params["lag_h"] = v.hyper[1] / 3600;
+    what = s + (v.hyper[1] > 0 ? " (lag " + format_short(v.hyper[1] / 3600, 2) + " h)" : "");
+  }
+  fit.summary = "thermal, " + what +
+                (frame == Frame::Tool ? ", tool side: " : ", machine frame: ") +
+                (drift.empty() ? "" : drift) + (drift.empty() || scale.empty() ? "" : "; ") + scale;
+  // Where: along the signal's own coordinate, in the output the fitted growth moves most.
+  const auto& obs = data.points.observations;
+  const VectorXd moved = cols.E * coef.head(cols.E.cols());
+  std::array<double, kObservationKinds> ss{};
+  for (std::size_t i = 0; i < obs.size(); ++i)
+    ss[static_cast<std::size_t>(obs[i].output)] +=
+        moved[static_cast<Index>(i)] * moved[static_cast<Index>(i)];
+  GapRegion r;
+  r.output = observation_name(
+      static_cast<std::size_t>(std::max_element(ss.begin(), ss.end()) - ss.begin()));
+  if (kind < 2) {
+    r.by = "t_s";
+    r.unit = "s";
+    r.from = tc.t0;
+    r.to = tc.t1;
+  } else {
+    r.by = tc.sensors[static_cast<std::size_t>(v.hyper[2])];
+    r.unit = "°C";
+    const std::vector<double>& T = data.temperature.at(r.by);
+    r.from = INFINITY;
+    r.to = -INFINITY;
+    for (const auto& o : obs)
+      if (std::isfinite(T[o.row]))
+        r.from = std::min(r.from, T[o.row]), r.to = std::max(r.to, T[o.row]);
+  }
+  fit.region = r;
+}
+
 }  // namespace
 
 void add_thermal(const EffectContext& ctx, std::vector<Candidate>& out) {
@@ -208,70 +278,7 @@ void add_thermal(const EffectContext& ctx, std::vector<Candidate>& out) {
     return thermal_columns(*tc, v).E;
   };
   c.describe = [tc](const Variant& v, const VectorXd& coef, EffectFit& fit) {
-    const GapData& data = *tc->d;
-    const int kind = static_cast<int>(v.hyper[0]);
-    const Frame frame = tc->frames[static_cast<std::size_t>(v.hyper[3])];
-    const Columns cols = thermal_columns(*tc, v);
-    const std::string per = kind == 0 ? "_per_h" : kind == 1 ? "" : "_per_K";
-    const std::string per_text = kind == 0 ? "/h" : kind == 1 ? "" : "/K";
-    std::string drift, scale;
-    for (std::size_t k = 0; k < cols.labels.size() && static_cast<Index>(k) < coef.size(); ++k) {
-      const std::string& l = cols.labels[k];
-      const double x = coef[static_cast<Index>(k)];
-      const std::string sx = (x >= 0 ? "+" : "") + format_short(x, 2);
-      if (l.rfind("scale_", 0) == 0) {
-        fit.params[l + "_um_per_m" + per] = x;
-        scale += (scale.empty() ? "" : ", ") + std::string("scale of ") + l.substr(6) + " " + sx +
-                 " µm/m" + per_text;
-      } else {
-        const bool tilt = l[0] == 't';
-        fit.params[l + (tilt ? "_urad" : "_um") + per] = x;
-        drift += (drift.empty() ? "" : ", ") + std::string(tilt ? "tilt " : "") + l.back() + " " +
-                 sx + (tilt ? " µrad" : " µm") + per_text;
-      }
-    }
-    fit.params[frame == Frame::Tool ? "frame_tool" : "frame_machine"] = 1;
-    std::string what;
-    if (kind == 0) {
-      what = "drift in time";
-    } else if (kind == 1) {
-      fit.params["tau_h"] = v.hyper[1] / 3600;
-      what = "heat-up (tau " + format_short(v.hyper[1] / 3600, 2) + " h)";
-    } else {
-      const std::string& s = tc->sensors[static_cast<std::size_t>(v.hyper[2])];
-      fit.params["sensor_" + s] = 1;
-      fit.params["lag_h"] = v.hyper[1] / 3600;
-      what = s + (v.hyper[1] > 0 ? " (lag " + format_short(v.hyper[1] / 3600, 2) + " h)" : "");
-    }
-    fit.summary =
-        "thermal, " + what + (frame == Frame::Tool ? ", tool side: " : ", machine frame: ") +
-        (drift.empty() ? "" : drift) + (drift.empty() || scale.empty() ? "" : "; ") + scale;
-    // Where: along the signal's own coordinate, in the output the fitted growth moves most.
-    const auto& obs = data.points.observations;
-    const VectorXd moved = cols.E * coef.head(cols.E.cols());
-    std::array<double, kObservationKinds> ss{};
-    for (std::size_t i = 0; i < obs.size(); ++i)
-      ss[static_cast<std::size_t>(obs[i].output)] +=
-          moved[static_cast<Index>(i)] * moved[static_cast<Index>(i)];
-    GapRegion r;
-    r.output = observation_name(
-        static_cast<std::size_t>(std::max_element(ss.begin(), ss.end()) - ss.begin()));
-    if (kind < 2) {
-      r.by = "t_s";
-      r.unit = "s";
-      r.from = tc->t0;
-      r.to = tc->t1;
-    } else {
-      r.by = tc->sensors[static_cast<std::size_t>(v.hyper[2])];
-      r.unit = "°C";
-      const std::vector<double>& T = data.temperature.at(r.by);
-      r.from = INFINITY;
-      r.to = -INFINITY;
-      for (const auto& o : obs)
-        if (std::isfinite(T[o.row]))
-          r.from = std::min(r.from, T[o.row]), r.to = std::max(r.to, T[o.row]);
-    }
-    fit.region = r;
+    describe_thermal(*tc, v, coef, fit);
   };
   out.push_back(std::move(c));
 }

@@ -22,12 +22,11 @@ struct Dim {
   std::vector<std::string> same_as;
 };
 
-}  // namespace
-
-std::vector<GapRegion> localise(const GapData& d, const VectorXd& r, const VectorXd& h,
-                                const NoiseFloor& nf, double alpha) {
+// The coordinates the residual is binned along, per observation: the axes, time, each
+// direction, the cycle, the temperatures and covariates; one with fewer than two values is left
+// out, one equal to an earlier one is named beside it.
+std::vector<Dim> localisation_dims(const GapData& d) {
   const auto& obs = d.points.observations;
-  const double s2 = nf.sigma_um * nf.sigma_um;
   std::vector<Dim> dims;
   auto add = [&](const std::string& name, const std::string& unit, std::vector<double> value,
                  bool ordered) {
@@ -59,6 +58,16 @@ std::vector<GapRegion> localise(const GapData& d, const VectorXd& r, const Vecto
     const auto u = d.covariate_unit.find(n);
     add(n, u == d.covariate_unit.end() ? "" : u->second, per_obs(v), true);
   }
+  return dims;
+}
+
+}  // namespace
+
+std::vector<GapRegion> localise(const GapData& d, const VectorXd& r, const VectorXd& h,
+                                const NoiseFloor& nf, double alpha) {
+  const auto& obs = d.points.observations;
+  const double s2 = nf.sigma_um * nf.sigma_um;
+  const std::vector<Dim> dims = localisation_dims(d);
 
   auto bin_stats = [&](GapRegion& g, const std::vector<std::size_t>& idx) {
     Gap gp;

@@ -33,12 +33,17 @@ std::string emit_c_api_source(const SymbolicModel& model, const std::string& sou
 std::string emit_index_constants(const SymbolicModel& model);
 
 // A template's text with the stand-in names replaced: the identifier `standin` (alone or as the
-// prefix of an identifier, standin_deviation) by `lower`, `STANDIN` by `upper`; the block from
-// the line holding "---- weilgen template: <block> begin ----" to the line holding "... end ----"
-// by `block_text` for each (block, text) pair. Throws std::logic_error for a missing block or a
-// stand-in name left over.
-std::string instantiate_template(std::string text, const std::string& lower,
+// prefix of an identifier, standin_deviation) by `lower`, `STANDIN` by `upper`; then the block
+// from the line holding "---- weilgen template: <block> begin ----" to the line holding "... end
+// ----" by `block_text` for each (block, text) pair, in order. Throws std::logic_error for a
+// missing block or a stand-in name inside an identifier. The one place templates are filled
+// (the C API, the HAL component and the model header, templates/).
+std::string instantiate_template(const std::string& text, const std::string& lower,
                                  const std::string& upper,
                                  const std::vector<std::pair<std::string, std::string>>& blocks);
+
+// The lines strictly between a block's begin and end lines: a template's section that an
+// emitter places itself (the model header's functions, whose order depends on the model).
+std::string template_block(const std::string& text, const std::string& block);
 
 }  // namespace weilgen::gen
