@@ -1,8 +1,9 @@
 // The C API (`weilgen generate --c-api`, docs/controllers.md): for every shipped machine a C99
 // program (tests/c_api/run_body.c, built with -Wall -Wextra -Wpedantic -Werror and linked as C)
 // evaluates deviation, coefficients, nominal pose and Jacobian and compensate at many poses;
-// every double must equal the C++ header's bit for bit. Plus the named indices of the C++ header,
-// and names the C API cannot take (clashes in upper case, reserved names).
+// every double must equal the C++ header's to rounding (bit for bit without FP contraction).
+// Plus the named indices of the C++ header, and names the C API cannot take (clashes in upper
+// case, reserved names).
 #include <doctest/doctest.h>
 
 #include <cstring>
@@ -113,20 +114,32 @@ void check_against_cpp(std::size_t cases) {
   REQUIRE(r.status == 0);
   CHECK(r.out.find(std::to_string(cases) + " cases") != std::string::npos);
 
+  // The same code through two compilers: bit for bit where neither contracts a*b+c into a fused
+  // multiply-add, and equal to rounding where one does (-mfma -ffp-contract=fast): every value
+  // within 1e-12 of the case's largest (mm, rad and their coefficients; the status flags exact).
   std::ifstream f(out, std::ios::binary);
-  std::size_t identical = 0, compensated = 0;
+  std::size_t identical = 0, close = 0, compensated = 0;
+  double worst = 0;
   for (std::size_t k = 0; k < cases; ++k) {
     const std::vector<double> want = T::results(all[k]);
     std::vector<double> got(want.size());
     REQUIRE(f.read(reinterpret_cast<char*>(got.data()),
                    static_cast<std::streamsize>(sizeof(double) * got.size())));
     if (std::memcmp(got.data(), want.data(), sizeof(double) * want.size()) == 0) ++identical;
+    double scale = 1e-300, diff = 0;
+    for (std::size_t i = 0; i < want.size(); ++i) {
+      scale = std::max(scale, std::fabs(want[i]));
+      diff = std::max(diff, std::fabs(got[i] - want[i]));
+    }
+    worst = std::max(worst, diff / scale);
+    if (diff <= 1e-12 * scale && got.back() == want.back()) ++close;
     if (want.back() > 0) ++compensated;
   }
   CHECK(f.peek() == std::char_traits<char>::eof());
-  CHECK(identical == cases);
+  CHECK(close == cases);
   MESSAGE(std::string(T::name) << ": " << identical << " of " << cases << " cases bit-identical, "
-                               << compensated << " compensated");
+                               << close << " within 1e-12 (worst " << worst << "), " << compensated
+                               << " compensated");
   // The pipe cutter's compensation is singular (docs/compensation.md): every call says so.
   if (std::string(T::name) == "pipe_cutter")
     CHECK(compensated == 0);
@@ -136,7 +149,7 @@ void check_against_cpp(std::size_t cases) {
 
 }  // namespace
 
-TEST_CASE("C API: a C99 program agrees with the C++ header bit for bit on every shipped model") {
+TEST_CASE("C API: a C99 program agrees with the C++ header to rounding on every shipped model") {
   check_against_cpp<gantry_grinder_model>(2000);
   check_against_cpp<vmc_3axis_model>(2000);
   check_against_cpp<two_axis_model>(2000);

@@ -166,11 +166,12 @@ TEST_CASE("model loader: an edited machine is compiled once, then loaded from th
   CHECK(log2.empty());
   CHECK(max_disagreement(*compiled, *cached, 1e-3) == 0.0);
 
-  // The same machine through the built-in model: identical functions.
+  // The same machine through the built-in model: the same functions, equal to rounding (the
+  // run-time compiler's flags need not be the build's: -mfma contracts differently).
   const auto builtin =
       load_model(load_machine_file(test::machine_path("vmc_3axis")), options_in(cache));
   CHECK(builtin->engine() == ModelEngine::BuiltIn);
-  CHECK(max_disagreement(*compiled, *builtin, 1e-3) == 0.0);
+  CHECK(max_disagreement(*compiled, *builtin, 1e-3) <= 1e-15);
   CHECK(batch_matches(*compiled));
   CHECK(combined_matches(*compiled));
 }
