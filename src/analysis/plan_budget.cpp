@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <map>
 #include <set>
 #include <stdexcept>
@@ -96,12 +95,10 @@ bool regular_value(double v, DesignCriterion c) {
 }
 
 struct Choice {
-  std::vector<std::size_t> selected;  // candidate indices
-  ExchangeResult exchange;
-  double value = std::numeric_limits<double>::quiet_NaN();
-  double ridged = 0;  // the value with the exchange's ridge
+  ExchangeResult exchange;  // `selected`: candidate indices
+  double ridged = 0;        // the value with the exchange's ridge
   double time_s = 0;
-  bool found = false;
+  bool found() const { return !exchange.selected.empty(); }
 };
 
 // The set-ups a selection of candidate units uses, with their units and times.
@@ -142,20 +139,14 @@ std::vector<MatrixXd> compact_units(const Frame& frame) {
   return out;
 }
 
-// The rank of the information of a choice of set-ups (bit b: groups[b], or every ballbar circle
-// for the bit after them). A loose cut counts near-null directions as present: a choice is
-// skipped only when it surely cannot reach the rank.
+// The rank of the information of a choice of set-ups (`mask` over `bit_of`). A loose cut counts
+// near-null directions as present: a choice is skipped only when it surely cannot reach the rank.
 Eigen::Index union_rank(const std::vector<MatrixXd>& setup_info,
-                        const std::vector<PlanSetup>& setups,
-                        const std::vector<std::size_t>& groups, std::size_t mask) {
+                        const std::vector<std::size_t>& bit_of, std::size_t mask) {
   const Eigen::Index r = setup_info.front().rows();
   MatrixXd m = MatrixXd::Zero(r, r);
-  for (std::size_t s = 0; s < setups.size(); ++s) {
-    const auto g = std::find(groups.begin(), groups.end(), s);
-    const std::size_t bit = g != groups.end() ? static_cast<std::size_t>(g - groups.begin())
-                                              : groups.size();  // a ballbar circle
-    if (mask >> bit & 1) m += setup_info[s];
-  }
+  for (std::size_t s = 0; s < setup_info.size(); ++s)
+    if (mask >> bit_of[s] & 1) m += setup_info[s];
   const Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<MatrixXd>(m).eigenvalues();
   const double cut = 1e-13 * std::max(ev.maxCoeff(), 0.0);
   return static_cast<Eigen::Index>((ev.array() > cut).count());
@@ -170,20 +161,26 @@ void plan_budget(Context& cx, PlanResult& R) {
   // The choices: each set-up of several units (points, a 6D line's axis, an R-test nest) is
   // measured or not; ballbar circles, one unit each, are chosen one by one (their set-up time
   // is in their cost) once ballbars are allowed.
-  std::vector<std::size_t> groups;  // multi-unit set-ups
+  // bit_of[s]: the bit of the choice that opens set-up s (one per multi-unit set-up, one after
+  // them for every ballbar circle).
+  std::size_t groups = 0;
+  for (const PlanSetup& s : c.setups)
+    if (s.instrument != Instrument::Ballbar) ++groups;
+  std::vector<std::size_t> bit_of;
   bool ballbar = false;
-  for (std::size_t s = 0; s < c.setups.size(); ++s) {
-    if (c.setups[s].instrument == Instrument::Ballbar)
-      ballbar = true;
-    else
-      groups.push_back(s);
+  for (std::size_t s = 0, g = 0; s < c.setups.size(); ++s) {
+    ballbar |= c.setups[s].instrument == Instrument::Ballbar;
+    bit_of.push_back(c.setups[s].instrument == Instrument::Ballbar ? groups : g++);
   }
-  const std::size_t bits = groups.size() + (ballbar ? 1 : 0);
+  const std::size_t bits = groups + (ballbar ? 1 : 0);
   if (bits > 12)
-    throw std::invalid_argument("--instruments: " + std::to_string(groups.size()) +
+    throw std::invalid_argument("--instruments: " + std::to_string(groups) +
                                 " set-ups to choose among is more than 12 (give fewer --nest)");
-  auto instrument_of_bit = [&](std::size_t b) {
-    return b < groups.size() ? c.setups[groups[b]].instrument : Instrument::Ballbar;
+  auto instruments_in = [&](std::size_t mask) {
+    std::set<Instrument> used;
+    for (std::size_t s = 0; s < c.setups.size(); ++s)
+      if (mask >> bit_of[s] & 1) used.insert(c.setups[s].instrument);
+    return used;
   };
   // The information of every set-up's candidates together: a choice of set-ups whose union
   // cannot reach the candidates' rank plans a singular design, which loses to any regular one.
@@ -195,19 +192,12 @@ void plan_budget(Context& cx, PlanResult& R) {
   Choice best;
   std::map<Instrument, Choice> alone;
   auto run_mask = [&](std::size_t mask) {
+    // The multi-unit set-ups' time comes off the budget; a circle's is in its cost.
     double fixed = 0;
     std::vector<char> open(c.setups.size(), 0);
-    std::set<Instrument> used;
-    for (std::size_t b = 0; b < bits; ++b) {
-      if (!(mask >> b & 1)) continue;
-      used.insert(instrument_of_bit(b));
-      if (b < groups.size()) {
-        open[groups[b]] = 1;
-        fixed += c.setups[groups[b]].setup_s;
-      } else {
-        for (std::size_t s = 0; s < c.setups.size(); ++s)
-          if (c.setups[s].instrument == Instrument::Ballbar) open[s] = 1;
-      }
+    for (std::size_t s = 0; s < c.setups.size(); ++s) {
+      open[s] = mask >> bit_of[s] & 1;
+      if (open[s] && c.setups[s].instrument != Instrument::Ballbar) fixed += c.setups[s].setup_s;
     }
     if (fixed > o.budget_s) return;
     DesignProblem p;
@@ -239,52 +229,45 @@ void plan_budget(Context& cx, PlanResult& R) {
     Choice ch;
     ch.exchange = ExchangeDesign(eo).run(p);
     for (std::size_t& j : ch.exchange.selected) j = index[j];
-    ch.selected = ch.exchange.selected;
-    ch.value = ch.exchange.value;
-    for (const TimeUse& t : time_use(c, ch.selected)) ch.time_s += t.setup_s + t.units_s;
-    ch.found = !ch.selected.empty();
-    if (!ch.found) return;
+    if (!ch.found()) return;
+    for (const TimeUse& t : time_use(c, ch.exchange.selected)) ch.time_s += t.setup_s + t.units_s;
     // Among equals (singular designs all −inf): the ridge's value, then the shorter time.
     ch.ridged = ch.exchange.restart_values[ch.exchange.best_restart];
     auto take = [&](Choice& slot) {
-      if (!slot.found || better(ch.value, slot.value, o.criterion) ||
-          (ch.value == slot.value && (better(ch.ridged, slot.ridged, o.criterion) ||
-                                      (ch.ridged == slot.ridged && ch.time_s < slot.time_s))))
+      const double v = ch.exchange.value, w = slot.exchange.value;
+      if (!slot.found() || better(v, w, o.criterion) ||
+          (v == w && (better(ch.ridged, slot.ridged, o.criterion) ||
+                      (ch.ridged == slot.ridged && ch.time_s < slot.time_s))))
         slot = ch;
     };
     take(best);
+    const std::set<Instrument> used = instruments_in(mask);
     if (used.size() == 1) take(alone[*used.begin()]);
   };
   // First the choices whose union reaches the rank, then, when one of them gave a regular
   // design, only the single-instrument ones (each instrument alone, for the comparison);
   // otherwise every choice (the best singular design, by its ridge).
-  auto single_instrument = [&](std::size_t mask) {
-    std::set<Instrument> used;
-    for (std::size_t b = 0; b < bits; ++b)
-      if (mask >> b & 1) used.insert(instrument_of_bit(b));
-    return used.size() == 1;
-  };
   std::vector<char> done(std::size_t{1} << bits, 0);
   for (std::size_t mask = 1; mask < (std::size_t{1} << bits); ++mask)
-    if (union_rank(setup_info, c.setups, groups, mask) >= r) {
+    if (union_rank(setup_info, bit_of, mask) >= r) {
       run_mask(mask);
       done[mask] = 1;
     }
-  const bool regular = best.found && regular_value(best.value, o.criterion);
+  const bool regular = best.found() && regular_value(best.exchange.value, o.criterion);
   for (std::size_t mask = 1; mask < (std::size_t{1} << bits); ++mask)
-    if (!done[mask] && (!regular || single_instrument(mask))) run_mask(mask);
-  if (!best.found)
+    if (!done[mask] && (!regular || instruments_in(mask).size() == 1)) run_mask(mask);
+  if (!best.found())
     throw std::invalid_argument("--time-budget: no set-up and unit fit in " +
                                 format_significant(o.budget_s / 3600, 3) + " h");
   R.exchange = best.exchange;
-  R.plan = evaluate_candidates(cx, "plan", best.selected);
+  R.plan = evaluate_candidates(cx, "plan", best.exchange.selected);
   R.plan.name = "plan";
   R.time_used_s = best.time_s;
-  R.time_use = time_use(c, best.selected);
+  R.time_use = time_use(c, best.exchange.selected);
   for (auto& [inst, ch] : alone) {
-    if (!ch.found) continue;
-    LayoutFigures f =
-        evaluate_candidates(cx, std::string(instrument_name(inst)) + " alone", ch.selected);
+    if (!ch.found()) continue;
+    LayoutFigures f = evaluate_candidates(cx, std::string(instrument_name(inst)) + " alone",
+                                          ch.exchange.selected);
     f.time_s = ch.time_s;
     f.lost = R.candidate_rank > f.rank ? R.candidate_rank - f.rank : 0;
     R.compare.push_back(f);

@@ -106,15 +106,9 @@ int verb_plan(const Args& args) {
   if (!plot_path.empty()) check_plot_target(plot_path);
 
   const PlanRun run = run_plan(rq);
-  std::vector<std::pair<std::string, std::string>> files;
+  const auto files = plan_files(run, out, inputs);
   std::vector<std::string> written;
-  if (!out.empty()) {
-    files = plan_files(run, out);
-    std::vector<PathArg> targets;
-    for (const auto& [path, text] : files) targets.push_back({"--out", path});
-    check_output_paths(inputs, targets);
-    for (const auto& [path, text] : files) written.push_back(path);
-  }
+  for (const auto& file : files) written.push_back(file.first);
   std::cout << plan_text(run, written);
   for (const auto& [path, text] : files) write_file_atomically(path, text);
   if (!json_path.empty()) write_file_atomically(json_path, plan_json(run, written).dump(2) + "\n");

@@ -66,15 +66,9 @@ py::object plan(py::handle machine, const py::kwargs& kwargs) {
   if (!plot.empty()) check_plot_target(plot);
   const nlohmann::json doc = run_analysis([&] {
     const PlanRun run = run_plan(rq);
-    std::vector<std::pair<std::string, std::string>> files;
+    const auto files = plan_files(run, out, inputs);
     std::vector<std::string> written;
-    if (!out.empty()) {
-      files = plan_files(run, out);
-      std::vector<PathArg> targets;
-      for (const auto& file : files) targets.push_back({"--out", file.first});
-      check_output_paths(inputs, targets);
-      for (const auto& file : files) written.push_back(file.first);
-    }
+    for (const auto& file : files) written.push_back(file.first);
     for (const auto& file : files) write_file_atomically(file.first, file.second);
     if (!plot.empty()) write_plot(plot, plan_panels(run), "weilgen plan: " + run.model->name());
     return plan_json(run, written);

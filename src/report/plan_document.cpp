@@ -121,8 +121,7 @@ json figures_json(const PlanRun& run, const LayoutFigures& f, const LayoutFigure
   return j;
 }
 
-}  // namespace
-
+// The file of set-up `tag` for `--out PATH`: PATH itself when the plan has one set-up.
 std::string plan_file_path(const std::string& out, const std::string& tag, std::size_t files) {
   if (files <= 1) return out;
   const auto slash = out.find_last_of('/');
@@ -131,10 +130,15 @@ std::string plan_file_path(const std::string& out, const std::string& tag, std::
   return (ext ? out.substr(0, dot) : out) + "_" + tag + (ext ? out.substr(dot) : ".csv");
 }
 
+}  // namespace
+
 std::vector<std::pair<std::string, std::string>> plan_files(const PlanRun& run,
-                                                            const std::string& out) {
+                                                            const std::string& out,
+                                                            const std::vector<PathArg>& inputs) {
   std::vector<std::pair<std::string, std::string>> files;
+  if (out.empty()) return files;
   const Description& d = run.model->description();
+  std::vector<PathArg> targets;
   for (const auto& [tag, table] : run.templates) {
     std::vector<std::string> comments = {
         "measurement template written by weilgen plan (" +
@@ -146,7 +150,9 @@ std::vector<std::pair<std::string, std::string>> plan_files(const PlanRun& run,
       if (s.tag == tag) comments.push_back("set-up " + s.what);
     files.emplace_back(plan_file_path(out, tag, run.templates.size()),
                        measurement_csv(table, comments));
+    targets.push_back({"--out", files.back().first});
   }
+  check_output_paths(inputs, targets);
   return files;
 }
 

@@ -8,18 +8,18 @@
 #include <vector>
 
 #include "weilgen/analysis/plan.hpp"
+#include "weilgen/base/output_paths.hpp"
 #include "weilgen/report/plot.hpp"
 
 namespace weilgen {
 
-// The template files of a run for `--out PATH`: PATH itself when the plan has one set-up, else
-// one file per set-up, PATH's stem + "_" + the set-up's tag + its extension (poses_X.csv,
-// poses_XY_12.csv, poses_rtest2.csv). (path, CSV text) in set-up order; each is a measurement
-// file identify reads once its empty output cells are filled.
-std::vector<std::pair<std::string, std::string>> plan_files(const PlanRun& run,
-                                                            const std::string& out);
-// The paths plan_files would write for `--out PATH` with `tags` (for checking them before the run).
-std::string plan_file_path(const std::string& out, const std::string& tag, std::size_t files);
+// The template files of a run for `--out PATH` (none when PATH is empty): PATH itself when the
+// plan has one set-up, else one file per set-up, PATH's stem + "_" + the set-up's tag + its
+// extension (poses_X.csv, poses_XY_12.csv, poses_rtest2.csv). (path, CSV text) in set-up order;
+// each is a measurement file identify reads once its empty output cells are filled.
+// std::invalid_argument (naming --out) when one of them is one of `inputs` or another.
+std::vector<std::pair<std::string, std::string>> plan_files(
+    const PlanRun& run, const std::string& out, const std::vector<PathArg>& inputs = {});
 
 std::string plan_text(const PlanRun& run, const std::vector<std::string>& files = {});
 // "verb": "plan"; `files`: the templates written.
