@@ -750,6 +750,14 @@ TEST_CASE(
   // Measure every file the plan wrote (the exact chain, set-up references, 1 µm and 1 µrad
   // noise); identify reads them all unedited and reaches the plan's rank.
   REQUIRE(pj["files"].size() == tb["setups"].size());
+  // Each file names its own instrument (poses_ballbar_XY_25.csv: ballbar).
+  for (const auto& f : pj["files"]) {
+    const std::string path = f.get<std::string>();
+    const std::string inst = path.find("_ballbar_") != std::string::npos ? "ballbar" : "line6d";
+    CAPTURE(path);
+    CHECK(test::read_text(path).find("weilgen plan (" + inst + ", criterion D)") !=
+          std::string::npos);
+  }
   const auto model = test::builtin_model("vmc_3axis");
   CHECK(measure_and_identify(*model, Truth(*model, 31), 1.0, 9, pj, dir) > 20);
 

@@ -140,14 +140,17 @@ std::vector<std::pair<std::string, std::string>> plan_files(const PlanRun& run,
   const Description& d = run.model->description();
   std::vector<PathArg> targets;
   for (const auto& [tag, table] : run.templates) {
+    // The set-up's own instrument: with --instruments the files are of several.
+    const PlanSetup* setup = nullptr;
+    for (const PlanSetup& s : run.result.candidates.setups)
+      if (s.tag == tag) setup = &s;
     std::vector<std::string> comments = {
         "measurement template written by weilgen plan (" +
-            std::string(instrument_name(run.result.instrument)) + ", criterion " +
-            design_criterion_name(run.options.criterion) + ") for " + d.name,
+            std::string(instrument_name(setup ? setup->instrument : run.result.instrument)) +
+            ", criterion " + design_criterion_name(run.options.criterion) + ") for " + d.name,
         "fill the empty output cells with the measured values; weilgen identify " + d.name +
             " --data <this file> reads it"};
-    for (const PlanSetup& s : run.result.candidates.setups)
-      if (s.tag == tag) comments.push_back("set-up " + s.what);
+    if (setup) comments.push_back("set-up " + setup->what);
     files.emplace_back(plan_file_path(out, tag, run.templates.size()),
                        measurement_csv(table, comments));
     targets.push_back({"--out", files.back().first});
