@@ -248,6 +248,16 @@ struct ChainRow {
 using Perturb = std::function<void(const ChainRow&, std::vector<double>& q_actual,
                                    std::vector<double>& errors, Eigen::Vector3d& extra_um)>;
 
+// Every error drawn at its machine-file scale, b N(0, 1), in base units (mm, rad), from `n01`
+// over `rng` in the errors' order.
+inline std::vector<double> file_scale_errors(const Description& desc, std::mt19937& rng,
+                                             std::normal_distribution<double>& n01) {
+  std::vector<double> errors(desc.errors.size());
+  for (std::size_t i = 0; i < errors.size(); ++i)
+    errors[i] = desc.errors[i].distribution.b * desc.errors[i].to_base * n01(rng);
+  return errors;
+}
+
 inline std::string chain_csv(const Model& model, const std::vector<ChainRow>& rows, double noise,
                              std::uint32_t seed, const Perturb& perturb,
                              const std::string& extra_header = "",
@@ -256,9 +266,7 @@ inline std::string chain_csv(const Model& model, const std::vector<ChainRow>& ro
   NumericChain chain(desc);
   std::mt19937 rng(seed);
   std::normal_distribution<double> n01(0, 1);
-  std::vector<double> base(desc.errors.size());
-  for (std::size_t i = 0; i < base.size(); ++i)
-    base[i] = desc.errors[i].distribution.b * desc.errors[i].to_base * n01(rng);
+  const std::vector<double> base = file_scale_errors(desc, rng, n01);
   std::ostringstream csv;
   for (int b : desc.axes()) csv << desc.bodies[static_cast<std::size_t>(b)].joint.coordinate << ",";
   for (const auto& [a, d] : rows.front().dir) csv << "dir_" << a << ",";

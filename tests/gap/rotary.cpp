@@ -17,9 +17,7 @@ TEST_CASE(
   NumericChain chain(desc);
   std::mt19937 rng(3);
   std::normal_distribution<double> n01(0, 1);
-  std::vector<double> errors(desc.errors.size());
-  for (std::size_t i = 0; i < errors.size(); ++i)
-    errors[i] = desc.errors[i].distribution.b * desc.errors[i].to_base * n01(rng);
+  const std::vector<double> errors = file_scale_errors(desc, rng, n01);
   std::vector<std::string> names;
   for (int b : desc.axes())
     names.push_back(desc.bodies[static_cast<std::size_t>(b)].joint.coordinate);
@@ -69,9 +67,7 @@ TEST_CASE("gap: on a tilting table, a spindle drift fixed in the machine frame i
   NumericChain chain(desc);
   std::mt19937 rng(5);
   std::normal_distribution<double> n01(0, 1);
-  std::vector<double> errors(desc.errors.size());
-  for (std::size_t i = 0; i < errors.size(); ++i)
-    errors[i] = desc.errors[i].distribution.b * desc.errors[i].to_base * n01(rng);
+  const std::vector<double> errors = file_scale_errors(desc, rng, n01);
   std::vector<std::string> names;
   for (int b : desc.axes())
     names.push_back(desc.bodies[static_cast<std::size_t>(b)].joint.coordinate);
