@@ -189,13 +189,7 @@ def component_run(s, args, machine, m, name, out, params_json, extra_flags, join
         f.write("\n".join(lines) + "\n")
     code, log = s.halrun(hal)
     check(code == 0, "%s: halrun exit %d\n%s" % (name, code, log))
-    readings = {}
-    if os.path.exists(results):
-        with open(results) as f:
-            for line in f:
-                r = json.loads(line)
-                readings[r["label"]] = r["values"]
-    return readings
+    return halsession.driver_readings(results)
 
 
 def comp_table_trims(path):

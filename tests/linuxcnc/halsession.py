@@ -11,6 +11,7 @@ CI is not set; under CI that is a failure (scripts/install_deps.sh installs linu
 linuxcnc-uspace-dev).
 """
 import fcntl
+import json
 import os
 import re
 import shutil
@@ -171,3 +172,15 @@ class Session:
 def driver_line(program, results):
     """The .hal line that runs hal_driver.py with a program (a JSON file) and waits for it."""
     return "loadusr -Wn weilgen_driver /usr/bin/python3 %s %s %s" % (DRIVER, program, results)
+
+
+def driver_readings(results):
+    """What hal_driver.py recorded (one JSON object per line): label -> values; {} when the
+    driver wrote nothing."""
+    readings = {}
+    if os.path.exists(results):
+        with open(results) as f:
+            for line in f:
+                r = json.loads(line)
+                readings[r["label"]] = r["values"]
+    return readings

@@ -111,13 +111,7 @@ def session(s, case, out, steps, loadrt_args=""):
     code, log = s.halrun(hal)
     print("halrun %s: exit %d\n%s" % (case.name, code, log))
     check(code == 0, "%s: halrun exit %d" % (case.name, code))
-    readings = {}
-    if os.path.exists(results):
-        with open(results) as f:
-            for line in f:
-                r = json.loads(line)
-                readings[r["label"]] = r["values"]
-    return readings
+    return halsession.driver_readings(results)
 
 
 def check_mapping(case, v):
