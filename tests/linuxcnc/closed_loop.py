@@ -30,7 +30,6 @@ Exit 0 pass, 1 fail, 77 skip (LinuxCNC missing and CI unset).
 """
 import argparse
 import bisect
-import csv
 import json
 import math
 import os
