@@ -1,11 +1,11 @@
 #include "weilgen/analysis/ballbar_model.hpp"
 
-#include <Eigen/Dense>
 #include <stdexcept>
 #include <string>
 #include <utility>
 
 #include "weilgen/model/numeric_chain.hpp"
+#include "weilgen/uq/dense.hpp"
 
 namespace weilgen {
 

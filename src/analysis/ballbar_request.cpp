@@ -2,7 +2,6 @@
 // and with a machine the model's terms behind each geometric cause (docs/ballbar.md).
 #include "weilgen/analysis/ballbar_request.hpp"
 
-#include <Eigen/Dense>
 #include <cmath>
 #include <filesystem>
 #include <stdexcept>
@@ -13,6 +12,7 @@
 #include "weilgen/base/output_paths.hpp"
 #include "weilgen/base/text.hpp"
 #include "weilgen/base/units.hpp"
+#include "weilgen/uq/dense.hpp"
 
 namespace weilgen {
 

@@ -1,6 +1,5 @@
 #include "weilgen/analysis/identify.hpp"
 
-#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -14,6 +13,7 @@
 #include "weilgen/base/text.hpp"
 #include "weilgen/base/units.hpp"
 #include "weilgen/machine/derived.hpp"
+#include "weilgen/uq/dense.hpp"
 #include "weilgen/uq/lsq.hpp"
 
 namespace weilgen {

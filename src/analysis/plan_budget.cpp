@@ -129,7 +129,7 @@ std::vector<MatrixXd> compact_units(const Frame& frame) {
       out[j] = z;
       continue;
     }
-    const Eigen::SelfAdjointEigenSolver<MatrixXd> es(z.transpose() * z);
+    const Eigen::SelfAdjointEigenSolver<MatrixXd> es(MatrixXd(z.transpose() * z));
     const double cut = 1e-14 * std::max(es.eigenvalues().maxCoeff(), 0.0);
     const Eigen::Index keep = (es.eigenvalues().array() > cut).count();
     out[j] =

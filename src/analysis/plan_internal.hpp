@@ -2,12 +2,12 @@
 // time budget): the planning model, the frame of the exchange and the exact evaluation.
 #pragma once
 
-#include <Eigen/Dense>
 #include <map>
 #include <string>
 #include <vector>
 
 #include "weilgen/analysis/plan.hpp"
+#include "weilgen/uq/dense.hpp"
 #include "weilgen/uq/lsq.hpp"
 
 namespace weilgen::plan_detail {

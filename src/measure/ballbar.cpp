@@ -1,6 +1,5 @@
 #include "weilgen/measure/ballbar.hpp"
 
-#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -11,6 +10,7 @@
 #include "weilgen/base/format.hpp"
 #include "weilgen/base/text.hpp"
 #include "weilgen/base/units.hpp"
+#include "weilgen/uq/dense.hpp"
 
 namespace weilgen {
 namespace {

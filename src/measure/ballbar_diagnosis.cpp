@@ -2,15 +2,15 @@
 // conventions, the tests and the recovery proof: docs/ballbar.md, "weilgen ballbar".
 #include "weilgen/measure/ballbar_diagnosis.hpp"
 
-#include <Eigen/Dense>
 #include <algorithm>
-#include <boost/math/distributions/fisher_f.hpp>
 #include <cmath>
 #include <functional>
 #include <stdexcept>
 
 #include "weilgen/base/constants.hpp"
 #include "weilgen/base/format.hpp"
+#include "weilgen/uq/dense.hpp"
+#include "weilgen/uq/test_statistics.hpp"
 
 namespace weilgen {
 
@@ -403,10 +403,7 @@ class BallbarDiagnosisPasses {
       reduced << full.leftCols(col), full.rightCols(full.cols() - col - w);
       const Fit without = solve(reduced, y);
       const double F = without.ok ? ((without.sse - fit.sse) / static_cast<double>(w)) / sigma2 : 0;
-      c.p_value =
-          F > 0 ? boost::math::cdf(boost::math::complement(
-                      boost::math::fisher_f_distribution<double>(static_cast<double>(w), dof), F))
-                : 1.0;
+      c.p_value = F > 0 ? fisher_f_sf(F, static_cast<double>(w), dof) : 1.0;
       const double grid = s.kind == Kind::Linear ? 1.0 : static_cast<double>(s.grid.size());
       c.threshold_p = options_.alpha / static_cast<double>(tests) / grid;
       c.significant =

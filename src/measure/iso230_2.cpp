@@ -3,8 +3,6 @@
 #include "weilgen/measure/iso230_2.hpp"
 
 #include <algorithm>
-#include <boost/math/distributions/normal.hpp>
-#include <boost/math/distributions/students_t.hpp>
 #include <map>
 #include <stdexcept>
 
@@ -12,6 +10,8 @@
 #include "weilgen/base/format.hpp"
 #include "weilgen/base/text.hpp"
 #include "weilgen/base/units.hpp"
+#include "weilgen/uq/distribution.hpp"
+#include "weilgen/uq/test_statistics.hpp"
 
 namespace weilgen {
 
@@ -54,9 +54,7 @@ double difference_sd_ratio(const std::vector<double>& a) {
 
 double student_coverage_factor(std::size_t dof, double k_normal) {
   if (dof < 1) throw std::invalid_argument("student_coverage_factor: dof must be >= 1");
-  const double p = boost::math::cdf(boost::math::normal_distribution<double>(0.0, 1.0), k_normal);
-  return boost::math::quantile(
-      boost::math::students_t_distribution<double>(static_cast<double>(dof)), p);
+  return students_t_quantile(static_cast<double>(dof), normal_cdf(k_normal));
 }
 
 std::string axis_deviation_column(const std::string& axis) {

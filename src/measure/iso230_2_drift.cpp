@@ -2,7 +2,6 @@
 // differences, the deviation chart rebuilt from a reference position and cycle, the anomaly test
 // on the differences' spreads, and the drift per cycle. docs/iso230-2.md, "Drift elimination".
 #include <algorithm>
-#include <boost/math/distributions/fisher_f.hpp>
 #include <iterator>
 #include <stdexcept>
 #include <tuple>
@@ -11,6 +10,7 @@
 #include "weilgen/base/format.hpp"
 #include "weilgen/base/units.hpp"
 #include "weilgen/measure/iso230_2.hpp"
+#include "weilgen/uq/test_statistics.hpp"
 
 namespace weilgen {
 
@@ -123,8 +123,7 @@ void adjacent_differences(const IsoRuns& R, DriftResult& res) {
       double F = kNaN, pv = 1.0;
       if (pooled > 0) {
         F = num / pooled;
-        pv = boost::math::cdf(
-            boost::math::complement(boost::math::fisher_f_distribution<double>(nu1, nu1 * p), F));
+        pv = fisher_f_sf(F, nu1, nu1 * p);
       } else if (num > 0) {
         F = INFINITY;
         pv = 0.0;

@@ -1,6 +1,5 @@
 #include "weilgen/measure/pdge_fit.hpp"
 
-#include <Eigen/Dense>
 #include <algorithm>
 #include <boost/math/tools/minima.hpp>
 #include <cstdint>
@@ -12,6 +11,7 @@
 
 #include "weilgen/base/constants.hpp"
 #include "weilgen/base/format.hpp"
+#include "weilgen/uq/dense.hpp"
 
 namespace weilgen {
 namespace {

@@ -3,7 +3,6 @@
 #include "weilgen/uq/sobol_indices.hpp"
 
 #include <algorithm>
-#include <boost/math/distributions/students_t.hpp>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -14,6 +13,7 @@
 #include "sobol_detail.hpp"
 #include "weilgen/base/constants.hpp"
 #include "weilgen/base/parallel.hpp"
+#include "weilgen/uq/test_statistics.hpp"
 
 namespace weilgen {
 
@@ -188,11 +188,7 @@ SobolResult SobolAnalysis::run(const SobolDesign& design, std::size_t outputs,
   result.outputs.resize(outputs);
   const double hi_p = (1 + options.confidence) / 2, lo_p = 1 - hi_p;
   const double t_quantile =
-      replicates > 1
-          ? boost::math::quantile(
-                boost::math::students_t_distribution<double>(static_cast<double>(replicates - 1)),
-                hi_p)
-          : kNaN;
+      replicates > 1 ? students_t_quantile(static_cast<double>(replicates - 1), hi_p) : kNaN;
   const auto nd = static_cast<double>(n), two_n_all = 2 * static_cast<double>(big_n);
   std::vector<double> acc(w), first(replicates * kv), total(replicates * kv);
   for (std::size_t o = 0; o < outputs; ++o) {

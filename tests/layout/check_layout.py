@@ -28,7 +28,7 @@ ALLOWED = {
     "codegen": {"machine", "base"},
     "model": {"machine", "base"},
     "uq": {"base"},
-    "measure": {"machine", "base"},
+    "measure": {"machine", "uq", "base"},
     "analysis": {"model", "uq", "measure", "codegen", "machine", "base"},
     "report": {"analysis", "model", "uq", "measure", "codegen", "machine", "base"},
     "cli": {"report", "analysis", "model", "uq", "measure", "codegen", "machine", "base"},

@@ -35,7 +35,7 @@ struct RidgePath {
   Eigen::MatrixXd V;
   Eigen::VectorXd vty;  // V^T X^T y
   RidgePath(const MatrixXd& X, const VectorXd& y) {
-    Eigen::SelfAdjointEigenSolver<MatrixXd> es(X.transpose() * X);
+    Eigen::SelfAdjointEigenSolver<MatrixXd> es(MatrixXd(X.transpose() * X));
     s = es.eigenvalues().cwiseMax(0.0);
     V = es.eigenvectors();
     vty = V.transpose() * (X.transpose() * y);

@@ -3,7 +3,6 @@
 // extra design columns for every observation. Internal to the gap diagnosis and its tests.
 #pragma once
 
-#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -16,6 +15,7 @@
 #include "internal.hpp"
 #include "weilgen/base/format.hpp"
 #include "weilgen/model/numeric_chain.hpp"
+#include "weilgen/uq/dense.hpp"
 
 namespace weilgen::gap_detail {
 

@@ -4,7 +4,6 @@
 // whole design for a candidate: per candidate column the work is one pass over the blocks
 // (Q_bᵀ E_b), and per split a few products of (folds · rank) × rank matrices.
 #include <algorithm>
-#include <boost/math/distributions/fisher_f.hpp>
 #include <cmath>
 #include <map>
 #include <set>
@@ -12,12 +11,13 @@
 #include "internal.hpp"
 #include "weilgen/base/parallel.hpp"
 #include "weilgen/uq/lsq.hpp"
+#include "weilgen/uq/test_statistics.hpp"
 
 namespace weilgen::gap_detail {
 
 double f_sf(double f, double d1, double d2) {
   if (!(f > 0) || !(d1 > 0) || !(d2 > 0) || !std::isfinite(f)) return f > 0 ? 0.0 : 1.0;
-  return boost::math::cdf(boost::math::complement(boost::math::fisher_f(d1, d2), f));
+  return fisher_f_sf(f, d1, d2);
 }
 
 std::size_t distinct(const std::vector<double>& v) {
@@ -436,7 +436,7 @@ VectorXd determined_part(const BlockFactors& F, const FoldFit& full, const Matri
   if (!(d.minCoeff() > 1e-12 * d.maxCoeff())) return c;  // dependent terms: leave c alone
   const MatrixXd L = d.cwiseSqrt().asDiagonal() * ee.eigenvectors().transpose();
   const MatrixXd Linv = ee.eigenvectors() * d.cwiseSqrt().cwiseInverse().asDiagonal();
-  const Eigen::SelfAdjointEigenSolver<MatrixXd> bb(Linv.transpose() * perp * Linv);
+  const Eigen::SelfAdjointEigenSolver<MatrixXd> bb(MatrixXd(Linv.transpose() * perp * Linv));
   const MatrixXd W = bb.eigenvectors();
   VectorXd z = W.transpose() * (L * c);
   // The nearly absorbed part is left out only when it is absurd: more than kAbsurd times the

@@ -41,8 +41,9 @@ HeldoutCovariance::HeldoutCovariance(const DesignLeastSquares& e, bool estimable
       for (std::size_t b : ff.blocks) N += RtR[b];
       const MatrixXd T = all - N;
       const MatrixXd P = MatrixXd::Identity(F.cols, F.cols) - ff.VS * (ff.VS.transpose() * N);
-      const Eigen::SelfAdjointEigenSolver<MatrixXd> top(D * T * D, Eigen::EigenvaluesOnly);
-      const Eigen::SelfAdjointEigenSolver<MatrixXd> eig(D * P.transpose() * T * P * D);
+      const Eigen::SelfAdjointEigenSolver<MatrixXd> top(MatrixXd(D * T * D),
+                                                        Eigen::EigenvaluesOnly);
+      const Eigen::SelfAdjointEigenSolver<MatrixXd> eig(MatrixXd(D * P.transpose() * T * P * D));
       const double cut = kEstimableCut * kEstimableCut * top.eigenvalues().maxCoeff();
       std::vector<Index> keep;
       for (Index j = 0; j < eig.eigenvalues().size(); ++j)

@@ -3,7 +3,6 @@
 // projection), the F-test helpers, the noise floor and the localisation.
 #pragma once
 
-#include <Eigen/Dense>
 #include <limits>
 #include <memory>
 #include <numeric>
@@ -11,6 +10,7 @@
 
 #include "weilgen/analysis/gap.hpp"
 #include "weilgen/base/constants.hpp"
+#include "weilgen/uq/dense.hpp"
 
 namespace weilgen::gap_detail {
 

@@ -2,13 +2,13 @@
 // scale), the sensitivity of every observation to each motion error of each axis (periodic and
 // bump shapes of one error), and the orientation of the tool and machine frames in the workpiece
 // frame (thermal growth of the spindle or of the structure).
-#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 
 #include "effects.hpp"
 #include "weilgen/base/parallel.hpp"
 #include "weilgen/machine/iso_names.hpp"
+#include "weilgen/uq/dense.hpp"
 
 namespace weilgen::gap_detail {
 

@@ -7,11 +7,11 @@
 // neighbours too (a bump or a reversal its pose neighbours, a drift its time neighbours: the
 // same pose an hour later is not its neighbour), so it is not taken for an outlier; a spike is.
 #include <algorithm>
-#include <boost/math/distributions/normal.hpp>
 #include <cmath>
 #include <numeric>
 
 #include "internal.hpp"
+#include "weilgen/uq/test_statistics.hpp"
 
 namespace weilgen::gap_detail {
 
@@ -61,9 +61,7 @@ std::vector<GapOutlier> find_outliers(const GapData& d, const VectorXd& res, con
     const double sigma = 1.4826 * median(v);
     if (!(sigma > 0)) continue;
     const double n = static_cast<double>(mine.size());
-    const boost::math::normal_distribution<double> normal;
-    const double z =
-        std::max(6.0, boost::math::quantile(boost::math::complement(normal, 0.005 / n)));
+    const double z = std::max(6.0, normal_upper_quantile(0.005 / n));
     // Structure when neighbours share a good part of the deviation (a bump or a step moves them
     // by a similar amount); a spike's neighbours are at most pulled a little by the fit.
     auto shared = [&](const std::vector<std::size_t>& nb, double dev) {

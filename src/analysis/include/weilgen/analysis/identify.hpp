@@ -15,7 +15,6 @@
 // variance, identifiability flags and the residual RMS per output.
 #pragma once
 
-#include <Eigen/Dense>
 #include <array>
 #include <cstddef>
 #include <functional>
@@ -30,6 +29,7 @@
 #include "weilgen/measure/ballbar.hpp"
 #include "weilgen/measure/measurement_csv.hpp"
 #include "weilgen/model/model.hpp"
+#include "weilgen/uq/dense.hpp"
 #include "weilgen/uq/lsq.hpp"
 
 namespace weilgen {

@@ -4,9 +4,10 @@
 // of rounding noise is not scaled up: it counts as zero (kNegligibleColumn).
 #pragma once
 
-#include <Eigen/Dense>
 #include <cstddef>
 #include <vector>
+
+#include "weilgen/uq/dense.hpp"
 
 namespace weilgen {
 

@@ -23,11 +23,12 @@
 // each has its own random stream, so the result does not depend on the thread count.
 #pragma once
 
-#include <Eigen/Dense>
 #include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
+
+#include "weilgen/uq/dense.hpp"
 
 namespace weilgen {
 
