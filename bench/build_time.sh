@@ -63,7 +63,8 @@ EOS
   export TIMES="$tmp/times.txt"
   launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER="$tmp/tw.sh")
 fi
-cmake -S . -B build-cli -DCMAKE_BUILD_TYPE=Release -DWEILGEN_BUILD_TESTS=OFF -DWEILGEN_BUILD_PYTHON=OFF \
+read -ra generator <<<"$(bash scripts/cmake_generator.sh build-cli)"
+cmake -S . -B build-cli "${generator[@]}" -DCMAKE_BUILD_TYPE=Release -DWEILGEN_BUILD_TESTS=OFF -DWEILGEN_BUILD_PYTHON=OFF \
   -DWEILGEN_BUILD_BENCH=OFF "${launcher[@]}" "${extra[@]}" >/dev/null
 echo "| \`weilgen\` target from scratch, -j$jobs | $(measure cmake --build build-cli -j"$jobs" --target weilgen) |"
 ((full)) && echo "| full build of the test command (\`scripts/build.sh\`) from scratch, -j$jobs | $(BUILD_DIR=build-full measure bash scripts/build.sh "${extra[@]}") |"

@@ -12,10 +12,10 @@ case "$mode" in "" | --cli | --bench) ;; *)
   exit 2
   ;;
 esac
-# The CLI: compiler, CMake, GiNaC (generator), Eigen, Boost.Program_options and Boost.Math,
-# yaml-cpp (machine files), nlohmann-json (documents), NLopt (tolerance allocation).
+# The CLI: compiler, CMake and Ninja, GiNaC (generator), Eigen, Boost.Program_options and
+# Boost.Math, yaml-cpp (machine files), nlohmann-json (documents), NLopt (tolerance allocation).
 packages=(
-  build-essential cmake pkg-config
+  build-essential cmake ninja-build pkg-config
   libginac-dev libeigen3-dev libboost-program-options-dev libboost-dev
   libyaml-cpp-dev nlohmann-json3-dev libnlopt-cxx-dev
 )
