@@ -26,10 +26,19 @@ function(weilgen_add_layer name)
   weilgen_unity(weilgen_${name})
 endfunction()
 
-# weilgen_unity(<target>): compile the target's files in batches (WEILGEN_UNITY_BUILD).
+# weilgen_unity(<target>): compile the target's files in batches (WEILGEN_UNITY_BUILD) of equal
+# size: n files in ceil(n / WEILGEN_UNITY_BATCH) batches, so that the last batch is not a few files
+# beside full ones (the longest batch is what two cores wait for at the end of the build).
 function(weilgen_unity target)
   if(WEILGEN_UNITY_BUILD)
-    set_target_properties(${target} PROPERTIES UNITY_BUILD ON
-      UNITY_BUILD_BATCH_SIZE ${WEILGEN_UNITY_BATCH})
+    set(size ${WEILGEN_UNITY_BATCH})
+    get_target_property(sources ${target} SOURCES)
+    list(FILTER sources INCLUDE REGEX "\\.cpp$")
+    list(LENGTH sources n)
+    if(size GREATER 0 AND n GREATER 0)
+      math(EXPR batches "(${n} + ${size} - 1) / ${size}")
+      math(EXPR size "(${n} + ${batches} - 1) / ${batches}")
+    endif()
+    set_target_properties(${target} PROPERTIES UNITY_BUILD ON UNITY_BUILD_BATCH_SIZE ${size})
   endif()
 endfunction()

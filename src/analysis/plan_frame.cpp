@@ -87,8 +87,10 @@ std::vector<MatrixXd> PlanModel::blocks(const std::vector<PlanUnit>& units, bool
       }
       remove_references(one, B);
       // Compressed to its information (Bᵀ B = Vᵀ S² V): the rows S Vᵀ, as many as its rank.
+      // Jacobi, not Eigen 3.4.0's BDCSVD: it reads out of bounds on rank-deficient input
+      // (uq/lsq.cpp), and a unit or a set of candidates often does not see every combination.
       if (B.rows() > B.cols()) {
-        const Eigen::BDCSVD<MatrixXd> svd(B, Eigen::ComputeThinV);
+        const Eigen::JacobiSVD<MatrixXd> svd(B, Eigen::ComputeThinV);
         const VectorXd& sv = svd.singularValues();
         Eigen::Index k = 0;
         while (k < sv.size() && sv[k] > 1e-15 * sv[0]) ++k;
@@ -119,7 +121,7 @@ Frame make_frame(const std::vector<MatrixXd>& blocks, double rank_tol, Eigen::In
   for (Eigen::Index p = 0; p < width; ++p)
     if (!(f.scale[p] > 1e-10 * big)) f.scale[p] = 1;  // a column no candidate sees
   X = X * f.scale.cwiseInverse().asDiagonal();
-  const Eigen::BDCSVD<MatrixXd> svd(X, Eigen::ComputeThinV);
+  const Eigen::JacobiSVD<MatrixXd> svd(X, Eigen::ComputeThinV);
   const VectorXd& s = svd.singularValues();
   Eigen::Index r = 0;
   while (r < s.size() && r < max_rank && s[r] > rank_tol * s[0]) ++r;
