@@ -289,6 +289,16 @@ FunctionCode function_body(const InputTable& inputs, const std::vector<OutputGro
     if (g.fill_zeros) os << "    " << alias << ".fill(Scalar(0));\n";
     for (std::size_t i = 0; i < g.values.size(); ++i, ++k) {
       if (g.fill_zeros && cse.outputs[k].is_zero()) continue;
+      // Neighbours 2j, 2j + 1 by one StorePair (model.hpp: a 16-byte store for double); compilers
+      // store them one by one otherwise, and the stores bound these functions.
+      if (!g.fill_zeros && i % 2 == 0 && i + 1 < g.values.size()) {
+        os << "    StorePair(" << alias << ".data()" << (i ? " + " + std::to_string(i) : "")
+           << ", " << printer.print(cse.outputs[k]) << ", " << printer.print(cse.outputs[k + 1])
+           << ");\n";
+        ++i;
+        ++k;
+        continue;
+      }
       os << "    " << alias << "[" << i << "] = " << printer.print(cse.outputs[k]) << ";\n";
     }
     os << "  }\n";

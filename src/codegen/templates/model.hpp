@@ -25,6 +25,10 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <type_traits>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 // ---- weilgen template: higher_includes begin ----
 #include <cstdint>
 // ---- weilgen template: higher_includes end ----
@@ -118,6 +122,22 @@ inline constexpr std::array<std::array<int, 1>, kNumHigherTerms> kHigherTerms = 
 inline constexpr std::size_t kNumMonomialCoefficients = 0;
 // ---- weilgen template: monomial_count end ----
 // ---- weilgen template: monomial_tables end ----
+// out[0] = first, out[1] = second: two neighbouring outputs. With SSE2, a double pair is one
+// 16-byte store; compilers store mixed pairs (a constant and a symbol) one by one otherwise, and
+// the stores, not the arithmetic, bound the generated functions (docs/performance.md). The values
+// convert to Scalar (expression-template scalars).
+template <typename Scalar>
+inline void StorePair(Scalar* const out, const std::common_type_t<Scalar>& first,
+                      const std::common_type_t<Scalar>& second) {
+  out[0] = first;
+  out[1] = second;
+}
+#if defined(__SSE2__)
+inline void StorePair(double* const out, const double first, const double second) {
+  _mm_storeu_pd(out, _mm_set_pd(second, first));
+}
+#endif
+
 // ---- weilgen template: functions begin ----
 // ---- weilgen template: deviation begin ----
 // ---- weilgen template: deviation_subject begin ----
