@@ -4,9 +4,9 @@
 // Units: axes as in kAxes (mm, deg), errors in base units (mm, rad), parameters in mm/deg;
 //        position outputs dx, dy, dz in mm, orientation outputs da, db, dc in rad.
 // Operation counts (after common-subexpression elimination):
-//   Deviation:    359 (adds 193, muls 162, divs 0, functions 4), 39 temporaries
+//   Deviation:    331 (adds 193, muls 134, divs 0, functions 4), 39 temporaries
 //   Coefficients: 151 (adds 89, muls 58, divs 0, functions 4), 47 temporaries
-//   DeviationAndCoefficients: 359 (adds 193, muls 162, divs 0, functions 4), 39 temporaries
+//   DeviationAndCoefficients: 331 (adds 193, muls 134, divs 0, functions 4), 39 temporaries
 //   NominalPose:  38 (adds 9, muls 25, divs 0, functions 4), 0 temporaries
 //   NominalJacobian: 60 (adds 12, muls 44, divs 0, functions 4), 0 temporaries
 //   Compensate:   per iteration errors_at + Deviation + NominalPose + 6x5 least-squares step; once per call NominalJacobian + NominalPose + Cholesky
@@ -371,13 +371,13 @@ void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
   // Outputs
   if (position != nullptr) {
     auto& _position = *position;
-    StorePair(_position.data(), E_A0C * _coef19 + E_AZ * _coef4 + E_B0A * _coef15 + E_B0Z * _coef6 + E_BC * _coef17 + E_BX * _coef3 + E_C0Y * _coef11 + E_CY * _coef10 + E_XX * cos_C + E_XZ * cos_C + E_Y0A * _coef14 + _coef0 * _tmp33 + _coef13 * _tmp35 + _coef8 * _tmp36 - E_XC - E_A0Z * _coef7 - E_AX * _coef2 - E_B0C * _coef20 - E_BA * _coef12 - E_BY * _coef9 - E_BZ * _coef5 - E_C0A * _coef16 - E_X0C * _coef18 - E_XA * cos_C - E_XY * cos_C - E_Y0C * sin_C - E_YA * sin_C - _coef1 * _tmp34, E_A0C * _coef20 + E_AZ * _coef25 + E_B0C * _coef19 + E_BA * _coef8 + E_BZ * _coef26 + E_C0A * _coef35 + E_CY * _coef30 + E_X0C * sin_C + E_XA * sin_C + E_XY * sin_C + E_Y0A * _coef33 + _coef12 * _tmp36 + _coef21 * _tmp33 - E_YC - E_A0Z * _coef28 - E_AC * _coef17 - E_AX * _coef23 - E_B0A * _coef34 - E_B0Z * _coef27 - E_BX * _coef24 - E_BY * _coef29 - E_C0Y * _coef31 - E_XX * sin_C - E_XZ * sin_C - E_Y0C * _coef18 - E_YA * cos_C - _coef22 * _tmp34 - _coef32 * _tmp35);
-    _position[2] = E_A0C * _coef44 + E_A0Z * _coef38 + E_AX * _coef36 + E_BA * X + E_BC * _coef32 + E_BY * _coef40 + E_Y0A * sin_A + E_YY * sin_A + E_ZX * cos_A + E_ZZ * cos_A + _coef41 * (E_C0A + E_CY) - E_ZA - E_ZC - E_AC * _coef13 - E_AZ * _coef37 - E_B0A * _coef43 - E_B0C * _coef45 - E_YX * sin_A - E_YZ * sin_A - E_Z0A * _coef42 - E_ZY * cos_A - _coef39 * _tmp36;
+    StorePair(_position.data(), E_A0C * _coef19 + E_AZ * _coef4 + E_B0A * _coef15 + E_B0Z * _coef6 + E_BC * _coef17 + E_BX * _coef3 + E_C0Y * _coef11 + E_CY * _coef10 + E_Y0A * _coef14 + _coef0 * _tmp33 + _coef13 * _tmp35 + _coef8 * _tmp36 - E_XC - E_A0Z * _coef7 - E_AX * _coef2 - E_B0C * _coef20 - E_BA * _coef12 - E_BY * _coef9 - E_BZ * _coef5 - E_C0A * _coef16 - E_X0C * _coef18 - _coef1 * _tmp34 - (E_XA + E_XY - E_XX - E_XZ) * cos_C - (E_Y0C + E_YA) * sin_C, E_A0C * _coef20 + E_AZ * _coef25 + E_B0C * _coef19 + E_BA * _coef8 + E_BZ * _coef26 + E_C0A * _coef35 + E_CY * _coef30 + E_Y0A * _coef33 + _coef12 * _tmp36 + _coef21 * _tmp33 + (E_X0C + E_XA + E_XY - E_XX - E_XZ) * sin_C - E_YC - E_A0Z * _coef28 - E_AC * _coef17 - E_AX * _coef23 - E_B0A * _coef34 - E_B0Z * _coef27 - E_BX * _coef24 - E_BY * _coef29 - E_C0Y * _coef31 - E_Y0C * _coef18 - E_YA * cos_C - _coef22 * _tmp34 - _coef32 * _tmp35);
+    _position[2] = E_A0C * _coef44 + E_A0Z * _coef38 + E_AX * _coef36 + E_BA * X + E_BC * _coef32 + E_BY * _coef40 + _coef41 * (E_C0A + E_CY) + (E_Y0A + E_YY - E_YX - E_YZ) * sin_A + (E_ZX + E_ZZ - E_ZY) * cos_A - E_ZA - E_ZC - E_AC * _coef13 - E_AZ * _coef37 - E_B0A * _coef43 - E_B0C * _coef45 - E_Z0A * _coef42 - _coef39 * _tmp36;
   }
   if (orientation != nullptr) {
     auto& _orientation = *orientation;
-    StorePair(_orientation.data(), E_AX * cos_C + E_AZ * cos_C + E_B0A * _coef14 + _coef0 * _tmp37 - E_AC - E_A0A * cos_C - E_A0C * _coef18 - E_AA * cos_C - E_AY * cos_C - E_B0C * sin_C - E_BA * sin_C - _coef1 * _tmp38, E_A0A * sin_C + E_A0C * sin_C + E_AA * sin_C + E_AY * sin_C + E_B0A * _coef33 + _coef21 * _tmp37 - E_BC - E_AX * sin_C - E_AZ * sin_C - E_B0C * _coef18 - E_BA * cos_C - _coef22 * _tmp38);
-    _orientation[2] = E_B0A * sin_A + E_BY * sin_A + E_CX * cos_A + E_CZ * cos_A - E_C0C - E_CA - E_CC - E_BX * sin_A - E_BZ * sin_A - E_C0A * _coef42 - E_CY * cos_A;
+    StorePair(_orientation.data(), E_B0A * _coef14 + _coef0 * _tmp37 - E_AC - E_A0C * _coef18 - _coef1 * _tmp38 - (E_A0A + E_AA + E_AY - E_AX - E_AZ) * cos_C - (E_B0C + E_BA) * sin_C, E_B0A * _coef33 + _coef21 * _tmp37 + (E_A0A + E_A0C + E_AA + E_AY - E_AX - E_AZ) * sin_C - E_BC - E_B0C * _coef18 - E_BA * cos_C - _coef22 * _tmp38);
+    _orientation[2] = (E_B0A + E_BY - E_BX - E_BZ) * sin_A + (E_CX + E_CZ - E_CY) * cos_A - E_C0C - E_CA - E_CC - E_C0A * _coef42;
   }
 }
 
@@ -755,13 +755,13 @@ void DeviationAndCoefficients(
   // Outputs
   if (position != nullptr) {
     auto& _position = *position;
-    StorePair(_position.data(), E_A0C * _coef19 + E_AZ * _coef4 + E_B0A * _coef15 + E_B0Z * _coef6 + E_BC * _coef17 + E_BX * _coef3 + E_C0Y * _coef11 + E_CY * _coef10 + E_XX * cos_C + E_XZ * cos_C + E_Y0A * _coef14 + _coef0 * _tmp33 + _coef13 * _tmp35 + _coef8 * _tmp36 - E_XC - E_A0Z * _coef7 - E_AX * _coef2 - E_B0C * _coef20 - E_BA * _coef12 - E_BY * _coef9 - E_BZ * _coef5 - E_C0A * _coef16 - E_X0C * _coef18 - E_XA * cos_C - E_XY * cos_C - E_Y0C * sin_C - E_YA * sin_C - _coef1 * _tmp34, E_A0C * _coef20 + E_AZ * _coef25 + E_B0C * _coef19 + E_BA * _coef8 + E_BZ * _coef26 + E_C0A * _coef35 + E_CY * _coef30 + E_X0C * sin_C + E_XA * sin_C + E_XY * sin_C + E_Y0A * _coef33 + _coef12 * _tmp36 + _coef21 * _tmp33 - E_YC - E_A0Z * _coef28 - E_AC * _coef17 - E_AX * _coef23 - E_B0A * _coef34 - E_B0Z * _coef27 - E_BX * _coef24 - E_BY * _coef29 - E_C0Y * _coef31 - E_XX * sin_C - E_XZ * sin_C - E_Y0C * _coef18 - E_YA * cos_C - _coef22 * _tmp34 - _coef32 * _tmp35);
-    _position[2] = E_A0C * _coef44 + E_A0Z * _coef38 + E_AX * _coef36 + E_BA * X + E_BC * _coef32 + E_BY * _coef40 + E_Y0A * sin_A + E_YY * sin_A + E_ZX * cos_A + E_ZZ * cos_A + _coef41 * (E_C0A + E_CY) - E_ZA - E_ZC - E_AC * _coef13 - E_AZ * _coef37 - E_B0A * _coef43 - E_B0C * _coef45 - E_YX * sin_A - E_YZ * sin_A - E_Z0A * _coef42 - E_ZY * cos_A - _coef39 * _tmp36;
+    StorePair(_position.data(), E_A0C * _coef19 + E_AZ * _coef4 + E_B0A * _coef15 + E_B0Z * _coef6 + E_BC * _coef17 + E_BX * _coef3 + E_C0Y * _coef11 + E_CY * _coef10 + E_Y0A * _coef14 + _coef0 * _tmp33 + _coef13 * _tmp35 + _coef8 * _tmp36 - E_XC - E_A0Z * _coef7 - E_AX * _coef2 - E_B0C * _coef20 - E_BA * _coef12 - E_BY * _coef9 - E_BZ * _coef5 - E_C0A * _coef16 - E_X0C * _coef18 - _coef1 * _tmp34 - (E_XA + E_XY - E_XX - E_XZ) * cos_C - (E_Y0C + E_YA) * sin_C, E_A0C * _coef20 + E_AZ * _coef25 + E_B0C * _coef19 + E_BA * _coef8 + E_BZ * _coef26 + E_C0A * _coef35 + E_CY * _coef30 + E_Y0A * _coef33 + _coef12 * _tmp36 + _coef21 * _tmp33 + (E_X0C + E_XA + E_XY - E_XX - E_XZ) * sin_C - E_YC - E_A0Z * _coef28 - E_AC * _coef17 - E_AX * _coef23 - E_B0A * _coef34 - E_B0Z * _coef27 - E_BX * _coef24 - E_BY * _coef29 - E_C0Y * _coef31 - E_Y0C * _coef18 - E_YA * cos_C - _coef22 * _tmp34 - _coef32 * _tmp35);
+    _position[2] = E_A0C * _coef44 + E_A0Z * _coef38 + E_AX * _coef36 + E_BA * X + E_BC * _coef32 + E_BY * _coef40 + _coef41 * (E_C0A + E_CY) + (E_Y0A + E_YY - E_YX - E_YZ) * sin_A + (E_ZX + E_ZZ - E_ZY) * cos_A - E_ZA - E_ZC - E_AC * _coef13 - E_AZ * _coef37 - E_B0A * _coef43 - E_B0C * _coef45 - E_Z0A * _coef42 - _coef39 * _tmp36;
   }
   if (orientation != nullptr) {
     auto& _orientation = *orientation;
-    StorePair(_orientation.data(), E_AX * cos_C + E_AZ * cos_C + E_B0A * _coef14 + _coef0 * _tmp37 - E_AC - E_A0A * cos_C - E_A0C * _coef18 - E_AA * cos_C - E_AY * cos_C - E_B0C * sin_C - E_BA * sin_C - _coef1 * _tmp38, E_A0A * sin_C + E_A0C * sin_C + E_AA * sin_C + E_AY * sin_C + E_B0A * _coef33 + _coef21 * _tmp37 - E_BC - E_AX * sin_C - E_AZ * sin_C - E_B0C * _coef18 - E_BA * cos_C - _coef22 * _tmp38);
-    _orientation[2] = E_B0A * sin_A + E_BY * sin_A + E_CX * cos_A + E_CZ * cos_A - E_C0C - E_CA - E_CC - E_BX * sin_A - E_BZ * sin_A - E_C0A * _coef42 - E_CY * cos_A;
+    StorePair(_orientation.data(), E_B0A * _coef14 + _coef0 * _tmp37 - E_AC - E_A0C * _coef18 - _coef1 * _tmp38 - (E_A0A + E_AA + E_AY - E_AX - E_AZ) * cos_C - (E_B0C + E_BA) * sin_C, E_B0A * _coef33 + _coef21 * _tmp37 + (E_A0A + E_A0C + E_AA + E_AY - E_AX - E_AZ) * sin_C - E_BC - E_B0C * _coef18 - E_BA * cos_C - _coef22 * _tmp38);
+    _orientation[2] = (E_B0A + E_BY - E_BX - E_BZ) * sin_A + (E_CX + E_CZ - E_CY) * cos_A - E_C0C - E_CA - E_CC - E_C0A * _coef42;
   }
   if (position_coeff != nullptr) {
     auto& _position_coeff = *position_coeff;

@@ -4,9 +4,9 @@
 // Units: axes as in kAxes (mm, deg), errors in base units (mm, rad), parameters in mm/deg;
 //        position outputs dx, dy, dz in mm, orientation outputs da, db, dc in rad.
 // Operation counts (after common-subexpression elimination):
-//   Deviation:    50 (adds 33, muls 17, divs 0, functions 0), 0 temporaries
+//   Deviation:    41 (adds 33, muls 8, divs 0, functions 0), 0 temporaries
 //   Coefficients: 2 (adds 2, muls 0, divs 0, functions 0), 0 temporaries
-//   DeviationAndCoefficients: 50 (adds 33, muls 17, divs 0, functions 0), 0 temporaries
+//   DeviationAndCoefficients: 41 (adds 33, muls 8, divs 0, functions 0), 0 temporaries
 //   NominalPose:  1 (adds 1, muls 0, divs 0, functions 0), 0 temporaries
 //   NominalJacobian: 0 (adds 0, muls 0, divs 0, functions 0), 0 temporaries
 //   Compensate:   per iteration errors_at + Deviation + NominalPose + 3x3 least-squares step; once per call NominalJacobian + NominalPose + Cholesky
@@ -208,8 +208,8 @@ void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
   // Outputs
   if (position != nullptr) {
     auto& _position = *position;
-    StorePair(_position.data(), E_XY + E_XZ + E_C0X * Y + E_CX * Y - E_XX - E_B0Z * tool_length - E_BX * _coef0 - E_BY * tool_length - E_BZ * tool_length - E_CZ * Y, E_YY + E_YZ + E_A0Z * tool_length + E_AX * _coef0 + E_AY * tool_length + E_AZ * tool_length + E_C0X * X + E_CX * X - E_YX);
-    _position[2] = E_ZY + E_ZZ + E_A0Z * Y + E_AZ * Y - E_ZX - E_AX * Y - E_BX * X;
+    StorePair(_position.data(), E_XY + E_XZ + (E_C0X + E_CX - E_CZ) * Y - E_XX - E_BX * _coef0 - (E_B0Z + E_BY + E_BZ) * tool_length, E_YY + E_YZ + E_AX * _coef0 + (E_A0Z + E_AY + E_AZ) * tool_length + (E_C0X + E_CX) * X - E_YX);
+    _position[2] = E_ZY + E_ZZ + (E_A0Z + E_AZ - E_AX) * Y - E_ZX - E_BX * X;
   }
   if (orientation != nullptr) {
     auto& _orientation = *orientation;
@@ -359,8 +359,8 @@ void DeviationAndCoefficients(
   // Outputs
   if (position != nullptr) {
     auto& _position = *position;
-    StorePair(_position.data(), E_XY + E_XZ + E_C0X * Y + E_CX * Y - E_XX - E_B0Z * tool_length - E_BX * _coef0 - E_BY * tool_length - E_BZ * tool_length - E_CZ * Y, E_YY + E_YZ + E_A0Z * tool_length + E_AX * _coef0 + E_AY * tool_length + E_AZ * tool_length + E_C0X * X + E_CX * X - E_YX);
-    _position[2] = E_ZY + E_ZZ + E_A0Z * Y + E_AZ * Y - E_ZX - E_AX * Y - E_BX * X;
+    StorePair(_position.data(), E_XY + E_XZ + (E_C0X + E_CX - E_CZ) * Y - E_XX - E_BX * _coef0 - (E_B0Z + E_BY + E_BZ) * tool_length, E_YY + E_YZ + E_AX * _coef0 + (E_A0Z + E_AY + E_AZ) * tool_length + (E_C0X + E_CX) * X - E_YX);
+    _position[2] = E_ZY + E_ZZ + (E_A0Z + E_AZ - E_AX) * Y - E_ZX - E_BX * X;
   }
   if (orientation != nullptr) {
     auto& _orientation = *orientation;

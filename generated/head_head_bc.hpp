@@ -4,9 +4,9 @@
 // Units: axes as in kAxes (mm, deg), errors in base units (mm, rad), parameters in mm/deg;
 //        position outputs dx, dy, dz in mm, orientation outputs da, db, dc in rad.
 // Operation counts (after common-subexpression elimination):
-//   Deviation:    249 (adds 142, muls 103, divs 0, functions 4), 20 temporaries
+//   Deviation:    234 (adds 139, muls 91, divs 0, functions 4), 22 temporaries
 //   Coefficients: 92 (adds 54, muls 34, divs 0, functions 4), 37 temporaries
-//   DeviationAndCoefficients: 249 (adds 142, muls 103, divs 0, functions 4), 20 temporaries
+//   DeviationAndCoefficients: 234 (adds 139, muls 91, divs 0, functions 4), 22 temporaries
 //   NominalPose:  29 (adds 7, muls 18, divs 0, functions 4), 0 temporaries
 //   NominalJacobian: 38 (adds 5, muls 29, divs 0, functions 4), 0 temporaries
 //   Compensate:   per iteration errors_at + Deviation + NominalPose + 6x5 least-squares step; once per call NominalJacobian + NominalPose + Cholesky
@@ -281,7 +281,7 @@ void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
   const Scalar pivot_length = params[1];
   const Scalar c_to_b = params[2];
 
-  // Intermediate terms (20)
+  // Intermediate terms (22)
   const Scalar _tmp0 = cos_B * pivot_length;
   const Scalar _tmp1 = cos_B * tool_length;
   const Scalar _tmp2 = cos_B * pivot_length * sin_C;
@@ -300,8 +300,10 @@ void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
   const Scalar _tmp15 = pivot_length * sin_B;
   const Scalar _tmp16 = sin_B * tool_length;
   const Scalar _tmp17 = E_B0B + E_BB;
-  const Scalar _tmp18 = E_Z0B - E_ZB;
-  const Scalar _tmp19 = E_C0B - E_CB;
+  const Scalar _tmp18 = E_A0C - E_AC;
+  const Scalar _tmp19 = E_Z0B - E_ZB;
+  const Scalar _tmp20 = E_B0B + E_BB + E_BC;
+  const Scalar _tmp21 = E_C0B - E_CB;
 
   // Coefficients of the error monomials (24)
   const Scalar _coef0 = _tmp0 + _tmp1 + c_to_b - Z;
@@ -332,13 +334,13 @@ void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
   // Outputs
   if (position != nullptr) {
     auto& _position = *position;
-    StorePair(_position.data(), E_XX + E_XY + E_XZ + E_A0B * _coef12 + E_AB * _coef9 + E_B0Z * Z + E_BC * _coef4 + E_X0B * _coef11 + E_XB * _coef7 + E_XC * cos_C + E_Y0C * sin_C + _coef10 * _tmp17 - E_B0C * _coef6 - E_BZ * _coef2 - E_X0C * _coef5 - E_YB * sin_C - E_YC * sin_C - _coef0 * (E_BX + E_BY) - _coef1 * (E_C0B + E_C0C + E_CC + E_CX + E_CY + E_CZ) - _coef3 * (E_A0C - E_AC) - _coef8 * _tmp18, E_YX + E_YY + E_YZ + E_A0C * _coef6 + E_AZ * _coef2 + E_C0X * X + E_CY * _coef13 + E_X0B * _coef19 + E_XB * _coef15 + E_XC * sin_C + E_YB * cos_C + E_YC * cos_C + _coef0 * (E_AX + E_AY) + _coef14 * (E_C0B + E_C0C + E_CC + E_CX + E_CZ) + _coef18 * _tmp17 - E_A0B * _coef20 - E_A0Z * Z - E_AB * _coef17 - E_AC * _coef4 - E_X0C * sin_C - E_Y0C * _coef5 - _coef16 * _tmp18 - _coef3 * (E_B0C - E_BC));
-    _position[2] = E_ZC + E_ZX + E_ZY + E_ZZ + E_X0B * sin_B + E_ZB * cos_B + _coef1 * (E_A0C + E_AX + E_AY + E_AZ) - E_B0C * _coef22 - E_BY * _coef13 - E_XB * sin_B - E_Z0B * _coef23 - _coef14 * (E_BX + E_BZ) - _coef21 * (E_B0B + E_BB + E_BC);
+    StorePair(_position.data(), E_XX + E_XY + E_XZ + E_A0B * _coef12 + E_AB * _coef9 + E_B0Z * Z + E_BC * _coef4 + E_X0B * _coef11 + E_XB * _coef7 + E_XC * cos_C + _coef10 * _tmp17 + (E_Y0C - E_YB - E_YC) * sin_C - E_B0C * _coef6 - E_BZ * _coef2 - E_X0C * _coef5 - _coef0 * (E_BX + E_BY) - _coef1 * (E_C0B + E_C0C + E_CC + E_CX + E_CY + E_CZ) - _coef3 * _tmp18 - _coef8 * _tmp19, E_YX + E_YY + E_YZ + E_A0C * _coef6 + E_AZ * _coef2 + E_C0X * X + E_CY * _coef13 + E_X0B * _coef19 + E_XB * _coef15 + _coef0 * (E_AX + E_AY) + _coef14 * (E_C0B + E_C0C + E_CC + E_CX + E_CZ) + _coef18 * _tmp17 + (E_YB + E_YC) * cos_C - E_A0B * _coef20 - E_A0Z * Z - E_AB * _coef17 - E_AC * _coef4 - E_Y0C * _coef5 - _coef16 * _tmp19 - _coef3 * (E_B0C - E_BC) - (E_X0C - E_XC) * sin_C);
+    _position[2] = E_ZC + E_ZX + E_ZY + E_ZZ + E_ZB * cos_B + _coef1 * (E_A0C + E_AX + E_AY + E_AZ) + (E_X0B - E_XB) * sin_B - E_B0C * _coef22 - E_BY * _coef13 - E_Z0B * _coef23 - _coef14 * (E_BX + E_BZ) - _coef21 * _tmp20;
   }
   if (orientation != nullptr) {
     auto& _orientation = *orientation;
-    StorePair(_orientation.data(), E_AX + E_AY + E_AZ + E_A0B * _coef11 + E_AB * _coef7 + E_AC * cos_C + E_B0C * sin_C - E_A0C * _coef5 - E_B0B * sin_C - E_BB * sin_C - E_BC * sin_C - _coef8 * _tmp19, E_BX + E_BY + E_BZ + E_A0B * _coef19 + E_AB * _coef15 + E_AC * sin_C + E_B0B * cos_C + E_BB * cos_C + E_BC * cos_C - E_A0C * sin_C - E_B0C * _coef5 - _coef16 * _tmp19);
-    _orientation[2] = E_C0C + E_CC + E_CX + E_CY + E_CZ + E_A0B * sin_B + E_CB * cos_B - E_AB * sin_B - E_C0B * _coef23;
+    StorePair(_orientation.data(), E_AX + E_AY + E_AZ + E_A0B * _coef11 + E_AB * _coef7 + E_AC * cos_C - E_A0C * _coef5 - _coef8 * _tmp21 - (E_B0B + E_BB + E_BC - E_B0C) * sin_C, E_BX + E_BY + E_BZ + E_A0B * _coef19 + E_AB * _coef15 + _tmp20 * cos_C - E_B0C * _coef5 - _coef16 * _tmp21 - _tmp18 * sin_C);
+    _orientation[2] = E_C0C + E_CC + E_CX + E_CY + E_CZ + E_CB * cos_B + (E_A0B - E_AB) * sin_B - E_C0B * _coef23;
   }
 }
 
@@ -614,7 +616,7 @@ void DeviationAndCoefficients(
   const Scalar pivot_length = params[1];
   const Scalar c_to_b = params[2];
 
-  // Intermediate terms (20)
+  // Intermediate terms (22)
   const Scalar _tmp0 = cos_B * pivot_length;
   const Scalar _tmp1 = cos_B * tool_length;
   const Scalar _tmp2 = cos_B * pivot_length * sin_C;
@@ -633,8 +635,10 @@ void DeviationAndCoefficients(
   const Scalar _tmp15 = pivot_length * sin_B;
   const Scalar _tmp16 = sin_B * tool_length;
   const Scalar _tmp17 = E_B0B + E_BB;
-  const Scalar _tmp18 = E_Z0B - E_ZB;
-  const Scalar _tmp19 = E_C0B - E_CB;
+  const Scalar _tmp18 = E_A0C - E_AC;
+  const Scalar _tmp19 = E_Z0B - E_ZB;
+  const Scalar _tmp20 = E_B0B + E_BB + E_BC;
+  const Scalar _tmp21 = E_C0B - E_CB;
 
   // Coefficients of the error monomials (24)
   const Scalar _coef0 = _tmp0 + _tmp1 + c_to_b - Z;
@@ -665,13 +669,13 @@ void DeviationAndCoefficients(
   // Outputs
   if (position != nullptr) {
     auto& _position = *position;
-    StorePair(_position.data(), E_XX + E_XY + E_XZ + E_A0B * _coef12 + E_AB * _coef9 + E_B0Z * Z + E_BC * _coef4 + E_X0B * _coef11 + E_XB * _coef7 + E_XC * cos_C + E_Y0C * sin_C + _coef10 * _tmp17 - E_B0C * _coef6 - E_BZ * _coef2 - E_X0C * _coef5 - E_YB * sin_C - E_YC * sin_C - _coef0 * (E_BX + E_BY) - _coef1 * (E_C0B + E_C0C + E_CC + E_CX + E_CY + E_CZ) - _coef3 * (E_A0C - E_AC) - _coef8 * _tmp18, E_YX + E_YY + E_YZ + E_A0C * _coef6 + E_AZ * _coef2 + E_C0X * X + E_CY * _coef13 + E_X0B * _coef19 + E_XB * _coef15 + E_XC * sin_C + E_YB * cos_C + E_YC * cos_C + _coef0 * (E_AX + E_AY) + _coef14 * (E_C0B + E_C0C + E_CC + E_CX + E_CZ) + _coef18 * _tmp17 - E_A0B * _coef20 - E_A0Z * Z - E_AB * _coef17 - E_AC * _coef4 - E_X0C * sin_C - E_Y0C * _coef5 - _coef16 * _tmp18 - _coef3 * (E_B0C - E_BC));
-    _position[2] = E_ZC + E_ZX + E_ZY + E_ZZ + E_X0B * sin_B + E_ZB * cos_B + _coef1 * (E_A0C + E_AX + E_AY + E_AZ) - E_B0C * _coef22 - E_BY * _coef13 - E_XB * sin_B - E_Z0B * _coef23 - _coef14 * (E_BX + E_BZ) - _coef21 * (E_B0B + E_BB + E_BC);
+    StorePair(_position.data(), E_XX + E_XY + E_XZ + E_A0B * _coef12 + E_AB * _coef9 + E_B0Z * Z + E_BC * _coef4 + E_X0B * _coef11 + E_XB * _coef7 + E_XC * cos_C + _coef10 * _tmp17 + (E_Y0C - E_YB - E_YC) * sin_C - E_B0C * _coef6 - E_BZ * _coef2 - E_X0C * _coef5 - _coef0 * (E_BX + E_BY) - _coef1 * (E_C0B + E_C0C + E_CC + E_CX + E_CY + E_CZ) - _coef3 * _tmp18 - _coef8 * _tmp19, E_YX + E_YY + E_YZ + E_A0C * _coef6 + E_AZ * _coef2 + E_C0X * X + E_CY * _coef13 + E_X0B * _coef19 + E_XB * _coef15 + _coef0 * (E_AX + E_AY) + _coef14 * (E_C0B + E_C0C + E_CC + E_CX + E_CZ) + _coef18 * _tmp17 + (E_YB + E_YC) * cos_C - E_A0B * _coef20 - E_A0Z * Z - E_AB * _coef17 - E_AC * _coef4 - E_Y0C * _coef5 - _coef16 * _tmp19 - _coef3 * (E_B0C - E_BC) - (E_X0C - E_XC) * sin_C);
+    _position[2] = E_ZC + E_ZX + E_ZY + E_ZZ + E_ZB * cos_B + _coef1 * (E_A0C + E_AX + E_AY + E_AZ) + (E_X0B - E_XB) * sin_B - E_B0C * _coef22 - E_BY * _coef13 - E_Z0B * _coef23 - _coef14 * (E_BX + E_BZ) - _coef21 * _tmp20;
   }
   if (orientation != nullptr) {
     auto& _orientation = *orientation;
-    StorePair(_orientation.data(), E_AX + E_AY + E_AZ + E_A0B * _coef11 + E_AB * _coef7 + E_AC * cos_C + E_B0C * sin_C - E_A0C * _coef5 - E_B0B * sin_C - E_BB * sin_C - E_BC * sin_C - _coef8 * _tmp19, E_BX + E_BY + E_BZ + E_A0B * _coef19 + E_AB * _coef15 + E_AC * sin_C + E_B0B * cos_C + E_BB * cos_C + E_BC * cos_C - E_A0C * sin_C - E_B0C * _coef5 - _coef16 * _tmp19);
-    _orientation[2] = E_C0C + E_CC + E_CX + E_CY + E_CZ + E_A0B * sin_B + E_CB * cos_B - E_AB * sin_B - E_C0B * _coef23;
+    StorePair(_orientation.data(), E_AX + E_AY + E_AZ + E_A0B * _coef11 + E_AB * _coef7 + E_AC * cos_C - E_A0C * _coef5 - _coef8 * _tmp21 - (E_B0B + E_BB + E_BC - E_B0C) * sin_C, E_BX + E_BY + E_BZ + E_A0B * _coef19 + E_AB * _coef15 + _tmp20 * cos_C - E_B0C * _coef5 - _coef16 * _tmp21 - _tmp18 * sin_C);
+    _orientation[2] = E_C0C + E_CC + E_CX + E_CY + E_CZ + E_CB * cos_B + (E_A0B - E_AB) * sin_B - E_C0B * _coef23;
   }
   if (position_coeff != nullptr) {
     auto& _position_coeff = *position_coeff;

@@ -4,9 +4,9 @@
 // Units: axes as in kAxes (mm, deg), errors in base units (mm, rad), parameters in mm/deg;
 //        position outputs dx, dy, dz in mm, orientation outputs da, db, dc in rad.
 // Operation counts (after common-subexpression elimination):
-//   Deviation:    605 (adds 240, muls 358, divs 5, functions 2), 54 temporaries
+//   Deviation:    604 (adds 240, muls 357, divs 5, functions 2), 54 temporaries
 //   Coefficients: 482 (adds 140, muls 335, divs 5, functions 2), 100 temporaries
-//   DeviationAndCoefficients: 677 (adds 240, muls 430, divs 5, functions 2), 54 temporaries
+//   DeviationAndCoefficients: 676 (adds 240, muls 429, divs 5, functions 2), 54 temporaries
 //   NominalPose:  1 (adds 1, muls 0, divs 0, functions 0), 0 temporaries
 //   NominalJacobian: 0 (adds 0, muls 0, divs 0, functions 0), 0 temporaries
 //   Compensate:   per iteration errors_at + Deviation + NominalPose + 3x5 least-squares step; once per call NominalJacobian + NominalPose + Cholesky
@@ -490,7 +490,7 @@ void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
   // Outputs
   if (position != nullptr) {
     auto& _position = *position;
-    StorePair(_position.data(), E_XA12 + E_XX + Scalar(0.5) * (E_XY231 + E_XY232 + E_C0Y232 * Y231 + _coef6 * _tmp39 - E_C0Y231 * Y231 - _coef2 * _tmp37 - _coef3 * _tmp38 - _coef7 * _tmp40 - _coef8 * _tmp41) + E_BA12 * _coef4 + E_CA04 * _coef10 + _coef1 * _tmp36 - E_B0A04 * _coef11 - E_BA04 * _coef9 - E_CA12 * _coef5 - E_ZX * _coef0, E_AA04 * _coef28 + E_BA12 * _coef17 + E_BY231 * _coef20 + E_CA12 * _coef18 + E_YX * _coef12 + E_ZA04 * _coef27 + E_ZY232 * _coef23 + _coef13 * (E_AA12 + E_AX) + _coef14 * _tmp42 + Scalar(0.5) * (_coef15 * _tmp43 + _coef21 * _tmp44) + _coef33 * _tmp46 + _coef36 * _tmp49 + _coef38 * _tmp51 - E_A0Y231 * _coef22 - E_A0Y232 * _coef25 - E_BA04 * _coef29 - E_BY232 * _coef24 - E_C0A04 * _coef31 - E_CA04 * _coef30 - E_YA04 * _coef26 - E_ZA12 * _coef16 - E_ZY231 * _coef19 - _coef32 * _tmp45 - _coef34 * _tmp47 - _coef35 * _tmp48 - _coef37 * _tmp50 - _coef39 * _tmp52 - _coef40 * _tmp53);
+    StorePair(_position.data(), E_XA12 + E_XX + Scalar(0.5) * (E_XY231 + E_XY232 + _coef6 * _tmp39 - _coef2 * _tmp37 - _coef3 * _tmp38 - _coef7 * _tmp40 - _coef8 * _tmp41 - (E_C0Y231 - E_C0Y232) * Y231) + E_BA12 * _coef4 + E_CA04 * _coef10 + _coef1 * _tmp36 - E_B0A04 * _coef11 - E_BA04 * _coef9 - E_CA12 * _coef5 - E_ZX * _coef0, E_AA04 * _coef28 + E_BA12 * _coef17 + E_BY231 * _coef20 + E_CA12 * _coef18 + E_YX * _coef12 + E_ZA04 * _coef27 + E_ZY232 * _coef23 + _coef13 * (E_AA12 + E_AX) + _coef14 * _tmp42 + Scalar(0.5) * (_coef15 * _tmp43 + _coef21 * _tmp44) + _coef33 * _tmp46 + _coef36 * _tmp49 + _coef38 * _tmp51 - E_A0Y231 * _coef22 - E_A0Y232 * _coef25 - E_BA04 * _coef29 - E_BY232 * _coef24 - E_C0A04 * _coef31 - E_CA04 * _coef30 - E_YA04 * _coef26 - E_ZA12 * _coef16 - E_ZY231 * _coef19 - _coef32 * _tmp45 - _coef34 * _tmp47 - _coef35 * _tmp48 - _coef37 * _tmp50 - _coef39 * _tmp52 - _coef40 * _tmp53);
     _position[2] = E_B0A04 * _coef31 + E_BA04 * _coef30 + E_CA12 * _coef17 + E_ZX * _coef12 + Scalar(0.5) * (_coef15 * (Scalar(2) * E_ZA12 + E_ZY231 + E_ZY232) + _coef16 * _tmp43 + _coef41 * _tmp44 + _coef42 * _tmp41 - _coef21 * (E_BY231 + E_BY232)) + _coef35 * _tmp52 - E_BA12 * _coef18 - E_CA04 * _coef29 - E_YA04 * _coef27 - E_ZA04 * _coef26 - _coef14 * _tmp36 - _coef32 * _tmp51 - _coef38 * _tmp45 - _coef39 * _tmp48;
   }
   if (orientation != nullptr) {
@@ -1069,7 +1069,7 @@ void DeviationAndCoefficients(
   // Outputs
   if (position != nullptr) {
     auto& _position = *position;
-    StorePair(_position.data(), E_XA12 + E_XX + Scalar(0.5) * (E_XY231 + E_XY232 + E_C0Y232 * Y231 + _coef6 * _tmp39 - E_C0Y231 * Y231 - _coef2 * _tmp37 - _coef3 * _tmp38 - _coef7 * _tmp40 - _coef8 * _tmp41) + E_BA12 * _coef4 + E_CA04 * _coef10 + _coef1 * _tmp36 - E_B0A04 * _coef11 - E_BA04 * _coef9 - E_CA12 * _coef5 - E_ZX * _coef0, E_AA04 * _coef28 + E_BA12 * _coef17 + E_BY231 * _coef20 + E_CA12 * _coef18 + E_YX * _coef12 + E_ZA04 * _coef27 + E_ZY232 * _coef23 + _coef13 * (E_AA12 + E_AX) + _coef14 * _tmp42 + Scalar(0.5) * (_coef15 * _tmp43 + _coef21 * _tmp44) + _coef33 * _tmp46 + _coef36 * _tmp49 + _coef38 * _tmp51 - E_A0Y231 * _coef22 - E_A0Y232 * _coef25 - E_BA04 * _coef29 - E_BY232 * _coef24 - E_C0A04 * _coef31 - E_CA04 * _coef30 - E_YA04 * _coef26 - E_ZA12 * _coef16 - E_ZY231 * _coef19 - _coef32 * _tmp45 - _coef34 * _tmp47 - _coef35 * _tmp48 - _coef37 * _tmp50 - _coef39 * _tmp52 - _coef40 * _tmp53);
+    StorePair(_position.data(), E_XA12 + E_XX + Scalar(0.5) * (E_XY231 + E_XY232 + _coef6 * _tmp39 - _coef2 * _tmp37 - _coef3 * _tmp38 - _coef7 * _tmp40 - _coef8 * _tmp41 - (E_C0Y231 - E_C0Y232) * Y231) + E_BA12 * _coef4 + E_CA04 * _coef10 + _coef1 * _tmp36 - E_B0A04 * _coef11 - E_BA04 * _coef9 - E_CA12 * _coef5 - E_ZX * _coef0, E_AA04 * _coef28 + E_BA12 * _coef17 + E_BY231 * _coef20 + E_CA12 * _coef18 + E_YX * _coef12 + E_ZA04 * _coef27 + E_ZY232 * _coef23 + _coef13 * (E_AA12 + E_AX) + _coef14 * _tmp42 + Scalar(0.5) * (_coef15 * _tmp43 + _coef21 * _tmp44) + _coef33 * _tmp46 + _coef36 * _tmp49 + _coef38 * _tmp51 - E_A0Y231 * _coef22 - E_A0Y232 * _coef25 - E_BA04 * _coef29 - E_BY232 * _coef24 - E_C0A04 * _coef31 - E_CA04 * _coef30 - E_YA04 * _coef26 - E_ZA12 * _coef16 - E_ZY231 * _coef19 - _coef32 * _tmp45 - _coef34 * _tmp47 - _coef35 * _tmp48 - _coef37 * _tmp50 - _coef39 * _tmp52 - _coef40 * _tmp53);
     _position[2] = E_B0A04 * _coef31 + E_BA04 * _coef30 + E_CA12 * _coef17 + E_ZX * _coef12 + Scalar(0.5) * (_coef15 * (Scalar(2) * E_ZA12 + E_ZY231 + E_ZY232) + _coef16 * _tmp43 + _coef41 * _tmp44 + _coef42 * _tmp41 - _coef21 * (E_BY231 + E_BY232)) + _coef35 * _tmp52 - E_BA12 * _coef18 - E_CA04 * _coef29 - E_YA04 * _coef27 - E_ZA04 * _coef26 - _coef14 * _tmp36 - _coef32 * _tmp51 - _coef38 * _tmp45 - _coef39 * _tmp48;
   }
   if (orientation != nullptr) {

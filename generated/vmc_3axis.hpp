@@ -4,9 +4,9 @@
 // Units: axes as in kAxes (mm, deg), errors in base units (mm, rad), parameters in mm/deg;
 //        position outputs dx, dy, dz in mm, orientation outputs da, db, dc in rad.
 // Operation counts (after common-subexpression elimination):
-//   Deviation:    41 (adds 28, muls 13, divs 0, functions 0), 0 temporaries
+//   Deviation:    37 (adds 27, muls 10, divs 0, functions 0), 1 temporaries
 //   Coefficients: 2 (adds 2, muls 0, divs 0, functions 0), 2 temporaries
-//   DeviationAndCoefficients: 41 (adds 28, muls 13, divs 0, functions 0), 0 temporaries
+//   DeviationAndCoefficients: 37 (adds 27, muls 10, divs 0, functions 0), 1 temporaries
 //   NominalPose:  1 (adds 1, muls 0, divs 0, functions 0), 0 temporaries
 //   NominalJacobian: 0 (adds 0, muls 0, divs 0, functions 0), 0 temporaries
 //   Compensate:   per iteration errors_at + Deviation + NominalPose + 3x3 least-squares step; once per call NominalJacobian + NominalPose + Cholesky
@@ -200,7 +200,8 @@ void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
   const Scalar E_A0Z = errors[20];
   const Scalar tool_length = params[0];
 
-  // Intermediate terms (0)
+  // Intermediate terms (1)
+  const Scalar _tmp0 = E_AX + E_AY;
 
   // Coefficients of the error monomials (1)
   const Scalar _coef0 = Z - tool_length;
@@ -208,8 +209,8 @@ void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
   // Outputs
   if (position != nullptr) {
     auto& _position = *position;
-    StorePair(_position.data(), E_XZ + E_B0Z * Z + E_C0Y * Y - E_XX - E_XY - E_BZ * tool_length - E_CX * Y - E_CY * Y - _coef0 * (E_BX + E_BY), E_YZ + E_AZ * tool_length + E_CX * X + _coef0 * (E_AX + E_AY) - E_YX - E_YY - E_A0Z * Z);
-    _position[2] = E_ZZ + E_AX * Y + E_AY * Y - E_ZX - E_ZY - E_BX * X;
+    StorePair(_position.data(), E_XZ + E_B0Z * Z + (E_C0Y - E_CX - E_CY) * Y - E_XX - E_XY - E_BZ * tool_length - _coef0 * (E_BX + E_BY), E_YZ + E_AZ * tool_length + E_CX * X + _coef0 * _tmp0 - E_YX - E_YY - E_A0Z * Z);
+    _position[2] = E_ZZ + _tmp0 * Y - E_ZX - E_ZY - E_BX * X;
   }
   if (orientation != nullptr) {
     auto& _orientation = *orientation;
@@ -353,7 +354,8 @@ void DeviationAndCoefficients(
   const Scalar E_A0Z = errors[20];
   const Scalar tool_length = params[0];
 
-  // Intermediate terms (0)
+  // Intermediate terms (1)
+  const Scalar _tmp0 = E_AX + E_AY;
 
   // Coefficients of the error monomials (1)
   const Scalar _coef0 = Z - tool_length;
@@ -361,8 +363,8 @@ void DeviationAndCoefficients(
   // Outputs
   if (position != nullptr) {
     auto& _position = *position;
-    StorePair(_position.data(), E_XZ + E_B0Z * Z + E_C0Y * Y - E_XX - E_XY - E_BZ * tool_length - E_CX * Y - E_CY * Y - _coef0 * (E_BX + E_BY), E_YZ + E_AZ * tool_length + E_CX * X + _coef0 * (E_AX + E_AY) - E_YX - E_YY - E_A0Z * Z);
-    _position[2] = E_ZZ + E_AX * Y + E_AY * Y - E_ZX - E_ZY - E_BX * X;
+    StorePair(_position.data(), E_XZ + E_B0Z * Z + (E_C0Y - E_CX - E_CY) * Y - E_XX - E_XY - E_BZ * tool_length - _coef0 * (E_BX + E_BY), E_YZ + E_AZ * tool_length + E_CX * X + _coef0 * _tmp0 - E_YX - E_YY - E_A0Z * Z);
+    _position[2] = E_ZZ + _tmp0 * Y - E_ZX - E_ZY - E_BX * X;
   }
   if (orientation != nullptr) {
     auto& _orientation = *orientation;
