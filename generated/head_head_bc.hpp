@@ -197,7 +197,9 @@ inline constexpr std::array<std::array<int, 1>, kNumHigherTerms> kHigherTerms = 
 // out[0] = first, out[1] = second: two neighbouring outputs. With SSE2, a double pair is one
 // 16-byte store; compilers store mixed pairs (a constant and a symbol) one by one otherwise, and
 // the stores, not the arithmetic, bound the generated functions (docs/performance.md). The values
-// convert to Scalar (expression-template scalars).
+// convert to Scalar (expression-template scalars). Deviation, Coefficients and
+// DeviationAndCoefficients are declared inline (a hint that raises the compiler's size limit):
+// a small model's function then becomes part of the caller's loop, without the call.
 template <typename Scalar>
 inline void StorePair(Scalar* const out, const std::common_type_t<Scalar>& first,
                       const std::common_type_t<Scalar>& second) {
@@ -217,11 +219,11 @@ inline void StorePair(double* const out, const double first, const double second
 //   errors: E_XY, E_YY, E_ZY, E_AY, E_BY, E_CY, E_XX, E_YX, E_ZX, E_AX, E_BX, E_CX, E_C0X, E_XZ, E_YZ, E_ZZ, E_AZ, E_BZ, E_CZ, E_A0Z, E_B0Z, E_XC, E_YC, E_ZC, E_AC, E_BC, E_CC, E_X0C, E_Y0C, E_A0C, E_B0C, E_C0C, E_XB, E_YB, E_ZB, E_AB, E_BB, E_CB, E_X0B, E_Z0B, E_A0B, E_C0B, E_B0B
 //   params: tool_length, pivot_length, c_to_b
 template <typename Scalar>
-void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
-               [[maybe_unused]] const std::array<Scalar, kNumErrors>& errors,
-               [[maybe_unused]] const std::array<Scalar, kNumParams>& params,
-               std::array<Scalar, 3>* const position,
-               std::array<Scalar, 3>* const orientation = nullptr) {
+inline void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
+                      [[maybe_unused]] const std::array<Scalar, kNumErrors>& errors,
+                      [[maybe_unused]] const std::array<Scalar, kNumParams>& params,
+                      std::array<Scalar, 3>* const position,
+                      std::array<Scalar, 3>* const orientation = nullptr) {
   using std::cos;
   using std::sin;
   using std::sqrt;
@@ -348,10 +350,10 @@ void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
 // position_coeff rows dx, dy, dz (mm per base unit of the error), orientation_coeff rows
 // da, db, dc (rad per base unit).
 template <typename Scalar>
-void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
-                  [[maybe_unused]] const std::array<Scalar, kNumParams>& params,
-                  std::array<Scalar, 3 * kNumErrors>* const position_coeff,
-                  std::array<Scalar, 3 * kNumErrors>* const orientation_coeff = nullptr) {
+inline void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
+                         [[maybe_unused]] const std::array<Scalar, kNumParams>& params,
+                         std::array<Scalar, 3 * kNumErrors>* const position_coeff,
+                         std::array<Scalar, 3 * kNumErrors>* const orientation_coeff = nullptr) {
   using std::cos;
   using std::sin;
   using std::sqrt;
@@ -550,7 +552,7 @@ void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
 // the terms common to both (one common-subexpression pass over both). The same outputs
 // as the two functions, equal to rounding; null outputs are skipped.
 template <typename Scalar>
-void DeviationAndCoefficients(
+inline void DeviationAndCoefficients(
     [[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
     [[maybe_unused]] const std::array<Scalar, kNumErrors>& errors,
     [[maybe_unused]] const std::array<Scalar, kNumParams>& params,

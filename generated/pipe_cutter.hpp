@@ -261,7 +261,9 @@ inline constexpr std::array<std::array<int, 1>, kNumHigherTerms> kHigherTerms = 
 // out[0] = first, out[1] = second: two neighbouring outputs. With SSE2, a double pair is one
 // 16-byte store; compilers store mixed pairs (a constant and a symbol) one by one otherwise, and
 // the stores, not the arithmetic, bound the generated functions (docs/performance.md). The values
-// convert to Scalar (expression-template scalars).
+// convert to Scalar (expression-template scalars). Deviation, Coefficients and
+// DeviationAndCoefficients are declared inline (a hint that raises the compiler's size limit):
+// a small model's function then becomes part of the caller's loop, without the call.
 template <typename Scalar>
 inline void StorePair(Scalar* const out, const std::common_type_t<Scalar>& first,
                       const std::common_type_t<Scalar>& second) {
@@ -281,11 +283,11 @@ inline void StorePair(double* const out, const double first, const double second
 //   errors: E_XX, E_YX, E_ZX, E_AX, E_BX, E_CX, E_XA12, E_YA12, E_ZA12, E_AA12, E_BA12, E_CA12, E_B0A12, E_C0A12, E_XY231, E_YY231, E_ZY231, E_AY231, E_BY231, E_CY231, E_C0Y231, E_A0Y231, E_XY232, E_YY232, E_ZY232, E_AY232, E_BY232, E_CY232, E_C0Y232, E_A0Y232, E_XA04, E_YA04, E_ZA04, E_AA04, E_BA04, E_CA04, E_B0A04, E_C0A04, E_XY451, E_YY451, E_ZY451, E_AY451, E_BY451, E_CY451, E_C0Y451, E_A0Y451, E_XY452, E_YY452, E_ZY452, E_AY452, E_BY452, E_CY452, E_C0Y452, E_A0Y452, E_XZ453, E_YZ453, E_ZZ453, E_AZ453, E_BZ453, E_CZ453, E_B0Z453, E_A0Z453, E_XZ454, E_YZ454, E_ZZ454, E_AZ454, E_BZ454, E_CZ454, E_B0Z454, E_A0Z454
 //   params: L01, L23, L04, L45, LW, jaw_reach, grip_feed, grip_main
 template <typename Scalar>
-void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
-               [[maybe_unused]] const std::array<Scalar, kNumErrors>& errors,
-               [[maybe_unused]] const std::array<Scalar, kNumParams>& params,
-               std::array<Scalar, 3>* const position,
-               std::array<Scalar, 3>* const orientation = nullptr) {
+inline void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
+                      [[maybe_unused]] const std::array<Scalar, kNumErrors>& errors,
+                      [[maybe_unused]] const std::array<Scalar, kNumParams>& params,
+                      std::array<Scalar, 3>* const position,
+                      std::array<Scalar, 3>* const orientation = nullptr) {
   using std::cos;
   using std::sin;
   using std::sqrt;
@@ -504,10 +506,10 @@ void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
 // position_coeff rows dx, dy, dz (mm per base unit of the error), orientation_coeff rows
 // da, db, dc (rad per base unit).
 template <typename Scalar>
-void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
-                  [[maybe_unused]] const std::array<Scalar, kNumParams>& params,
-                  std::array<Scalar, 3 * kNumErrors>* const position_coeff,
-                  std::array<Scalar, 3 * kNumErrors>* const orientation_coeff = nullptr) {
+inline void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
+                         [[maybe_unused]] const std::array<Scalar, kNumParams>& params,
+                         std::array<Scalar, 3 * kNumErrors>* const position_coeff,
+                         std::array<Scalar, 3 * kNumErrors>* const orientation_coeff = nullptr) {
   using std::cos;
   using std::sin;
   using std::sqrt;
@@ -858,7 +860,7 @@ void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
 // the terms common to both (one common-subexpression pass over both). The same outputs
 // as the two functions, equal to rounding; null outputs are skipped.
 template <typename Scalar>
-void DeviationAndCoefficients(
+inline void DeviationAndCoefficients(
     [[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
     [[maybe_unused]] const std::array<Scalar, kNumErrors>& errors,
     [[maybe_unused]] const std::array<Scalar, kNumParams>& params,

@@ -145,7 +145,9 @@ inline constexpr std::array<std::array<int, 1>, kNumHigherTerms> kHigherTerms = 
 // out[0] = first, out[1] = second: two neighbouring outputs. With SSE2, a double pair is one
 // 16-byte store; compilers store mixed pairs (a constant and a symbol) one by one otherwise, and
 // the stores, not the arithmetic, bound the generated functions (docs/performance.md). The values
-// convert to Scalar (expression-template scalars).
+// convert to Scalar (expression-template scalars). Deviation, Coefficients and
+// DeviationAndCoefficients are declared inline (a hint that raises the compiler's size limit):
+// a small model's function then becomes part of the caller's loop, without the call.
 template <typename Scalar>
 inline void StorePair(Scalar* const out, const std::common_type_t<Scalar>& first,
                       const std::common_type_t<Scalar>& second) {
@@ -165,11 +167,11 @@ inline void StorePair(double* const out, const double first, const double second
 //   errors: E_XY, E_YY, E_ZY, E_AY, E_BY, E_CY, E_C0Y, E_XX, E_YX, E_ZX, E_AX, E_BX, E_CX, E_XZ, E_YZ, E_ZZ, E_AZ, E_BZ, E_CZ, E_B0Z, E_A0Z
 //   params: tool_length
 template <typename Scalar>
-void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
-               [[maybe_unused]] const std::array<Scalar, kNumErrors>& errors,
-               [[maybe_unused]] const std::array<Scalar, kNumParams>& params,
-               std::array<Scalar, 3>* const position,
-               std::array<Scalar, 3>* const orientation = nullptr) {
+inline void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
+                      [[maybe_unused]] const std::array<Scalar, kNumErrors>& errors,
+                      [[maybe_unused]] const std::array<Scalar, kNumParams>& params,
+                      std::array<Scalar, 3>* const position,
+                      std::array<Scalar, 3>* const orientation = nullptr) {
   using std::cos;
   using std::sin;
   using std::sqrt;
@@ -223,10 +225,10 @@ void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
 // position_coeff rows dx, dy, dz (mm per base unit of the error), orientation_coeff rows
 // da, db, dc (rad per base unit).
 template <typename Scalar>
-void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
-                  [[maybe_unused]] const std::array<Scalar, kNumParams>& params,
-                  std::array<Scalar, 3 * kNumErrors>* const position_coeff,
-                  std::array<Scalar, 3 * kNumErrors>* const orientation_coeff = nullptr) {
+inline void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
+                         [[maybe_unused]] const std::array<Scalar, kNumParams>& params,
+                         std::array<Scalar, 3 * kNumErrors>* const position_coeff,
+                         std::array<Scalar, 3 * kNumErrors>* const orientation_coeff = nullptr) {
   using std::cos;
   using std::sin;
   using std::sqrt;
@@ -317,7 +319,7 @@ void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
 // the terms common to both (one common-subexpression pass over both). The same outputs
 // as the two functions, equal to rounding; null outputs are skipped.
 template <typename Scalar>
-void DeviationAndCoefficients(
+inline void DeviationAndCoefficients(
     [[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
     [[maybe_unused]] const std::array<Scalar, kNumErrors>& errors,
     [[maybe_unused]] const std::array<Scalar, kNumParams>& params,
