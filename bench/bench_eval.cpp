@@ -10,6 +10,9 @@
 //   output_floor            the load/store floor of those outputs: their 6 + 6n values, computed
 //                           before timing, copied from an L1-resident table into the same arrays
 //                           by 16-byte loads and stores (no code producing them can be faster)
+//   output_floor+sincos     the same copy plus sin and cos of every rotary axis value of the
+//                           pose: no code computing the outputs with the C library's sin/cos
+//                           can be faster on a machine with rotary axes
 //   eigen_dev               (a) the exact deviation from a fixed-size Eigen chain compiled from the
 //                           machine description at set-up (3x3 rotations and 3-vectors, no
 //                           allocation): actual and nominal pose, AngleAxis of R R0^T
@@ -24,7 +27,7 @@
 // chain's deviation equals NumericChain::deviation to rounding, the analytic Jacobian equals the
 // generated Coefficients to rounding, the generated deviation equals the exact one to O(e^2),
 // DeviationAndCoefficients equals the two separate calls. After the run a Markdown table of CPU
-// ns/pose and ratios is printed, with DeviationAndCoefficients against its output floor.
+// ns/pose and ratios is printed, with DeviationAndCoefficients against both floors.
 // pipe_cutter's output transform (linked jaws, derived quantities) is not a serial chain: its
 // baseline is written by hand for it (pipe_cutter_baseline.hpp).
 #include <benchmark/benchmark.h>
