@@ -10,6 +10,9 @@
 //   output_floor            the load/store floor of those outputs: their 6 + 6n values, computed
 //                           before timing, copied from an L1-resident table into the same arrays
 //                           by 16-byte loads and stores (no code producing them can be faster)
+//   output_floor+sincos     the same copy plus sin and cos of every rotary axis value of the
+//                           pose: no code computing the outputs with the C library's sin/cos
+//                           can be faster on a machine with rotary axes
 //   eigen_dev               (a) the exact deviation from a fixed-size Eigen chain compiled from the
 //                           machine description at set-up (3x3 rotations and 3-vectors, no
 //                           allocation): actual and nominal pose, AngleAxis of R R0^T
@@ -24,7 +27,7 @@
 // chain's deviation equals NumericChain::deviation to rounding, the analytic Jacobian equals the
 // generated Coefficients to rounding, the generated deviation equals the exact one to O(e^2),
 // DeviationAndCoefficients equals the two separate calls. After the run a Markdown table of CPU
-// ns/pose and ratios is printed, with DeviationAndCoefficients against its output floor.
+// ns/pose and ratios is printed, with DeviationAndCoefficients against both floors.
 // pipe_cutter's output transform (linked jaws, derived quantities) is not a serial chain: its
 // baseline is written by hand for it (pipe_cutter_baseline.hpp).
 #include <benchmark/benchmark.h>
@@ -492,14 +495,28 @@ struct OutputTable {
   }
 };
 
-template <typename M>
+// kSinCos: the output floor plus what no code can skip on a machine with rotary axes, sin and
+// cos of every revolute axis value of the pose (in rad), called as the generated code calls them
+// (the compiler pairs them into one sincos there and here alike). The axis values cycle through
+// the same 1024 poses as the generated benchmarks (the cost of sin/cos depends on the argument).
+// Without revolute axes the two floors are the same loop.
+template <typename M, bool kSinCos>
 void BM_OutputFloor(benchmark::State& state) {
   static const OutputTable<M> table;
+  [[maybe_unused]] const PoseSet<M>& s = poses<M>();
   std::array<double, 3> position{}, orientation{};
   std::array<double, 3 * M::kNumErrors> position_coeff{}, orientation_coeff{};
   std::size_t p = 0;
   for (auto _ : state) {
-    const auto& row = table.rows[p];
+    if constexpr (kSinCos)
+      for (std::size_t k = 0; k < M::kNumAxes; ++k)
+        if (M::kAxes[k].revolute) {
+          const double angle = s.axes[p][k] * M::kAxes[k].to_base;
+          double c = std::cos(angle), si = std::sin(angle);
+          benchmark::DoNotOptimize(c);
+          benchmark::DoNotOptimize(si);
+        }
+    const auto& row = table.rows[p & (kFloorRows - 1)];
     copy_block(position, row.position);
     copy_block(orientation, row.orientation);
     copy_block(position_coeff, row.position_coeff);
@@ -508,7 +525,7 @@ void BM_OutputFloor(benchmark::State& state) {
     benchmark::DoNotOptimize(orientation);
     benchmark::DoNotOptimize(position_coeff);
     benchmark::DoNotOptimize(orientation_coeff);
-    p = (p + 1) & (kFloorRows - 1);
+    p = (p + 1) & (kNumPoses - 1);
   }
   state.SetItemsProcessed(static_cast<int64_t>(state.iterations()));
 }
@@ -650,7 +667,8 @@ void register_machine() {
   benchmark::RegisterBenchmark((m + "/generated_dev+coeff").c_str(),
                                BM_GeneratedDeviationCoefficients<M>);
   benchmark::RegisterBenchmark((m + "/generated_combined").c_str(), BM_GeneratedCombined<M>);
-  benchmark::RegisterBenchmark((m + "/output_floor").c_str(), BM_OutputFloor<M>);
+  benchmark::RegisterBenchmark((m + "/output_floor").c_str(), BM_OutputFloor<M, false>);
+  benchmark::RegisterBenchmark((m + "/output_floor+sincos").c_str(), BM_OutputFloor<M, true>);
   benchmark::RegisterBenchmark((m + "/eigen_dev").c_str(), BM_EigenDeviation<M>);
   benchmark::RegisterBenchmark((m + "/analytic_coeff").c_str(), BM_AnalyticCoefficients<M>);
   benchmark::RegisterBenchmark((m + "/eigen_dev+analytic_coeff").c_str(),
@@ -684,7 +702,7 @@ class SummaryReporter : public benchmark::ConsoleReporter {
 
   void Finalize() override {
     ConsoleReporter::Finalize();
-    std::ostringstream main, extra;
+    std::ostringstream main, extra, floors;
     for (const auto& [machine, n] : machines_) {
       const std::string& key = machine;  // clang < 16 cannot capture a structured binding
       const auto get = [&](const std::string& what) {
@@ -695,13 +713,17 @@ class SummaryReporter : public benchmark::ConsoleReporter {
                    two = get("generated_dev+coeff"), one = get("generated_combined"),
                    a = get("eigen_dev"), b = get("analytic_coeff"),
                    ab = get("eigen_dev+analytic_coeff"), fd = get("extra_chain_dev+fd_coeff"),
-                   floor = get("output_floor");
+                   floor = get("output_floor"), trig = get("output_floor+sincos");
       if (dev == 0 || coeff == 0 || two == 0 || one == 0 || a == 0 || b == 0 || ab == 0)
         continue;  // filtered out
       main << std::fixed << std::setprecision(1) << "| " << machine << " | " << n << " | " << dev
            << " | " << a << " | **" << a / dev << "x** | " << coeff << " | " << b << " | **"
            << b / coeff << "x** | " << one << " | " << two << " | " << ab << " | **" << ab / one
            << "x** | " << floor << " | " << (floor > 0 ? one / floor : 0.0) << "x |\n";
+      if (floor > 0 && trig > 0)
+        floors << std::fixed << std::setprecision(1) << "| " << machine << " | " << one << " | "
+               << ab << " | " << floor << " | " << one / floor << "x | " << trig << " | "
+               << one / trig << "x | " << ab / trig << "x |\n";
       if (fd != 0)
         extra << std::fixed << "| " << machine << " | " << std::setprecision(1) << one << " | "
               << std::setprecision(0) << fd << " | " << fd / one << "x |\n";
@@ -717,6 +739,14 @@ class SummaryReporter : public benchmark::ConsoleReporter {
         << "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | "
            "---: | ---: |\n"
         << main.str();
+    if (!floors.str().empty())
+      out << "\nDeviationAndCoefficients against its floors (CPU ns per pose): the copy of its 6 + "
+             "6n outputs, and that copy plus sin and cos of every rotary axis; (a + b) / floor is "
+             "the highest ratio any code computing these outputs can reach\n\n"
+          << "| machine | generated DeviationAndCoefficients | (a) + (b) | output floor | "
+             "generated / floor | floor + sin/cos | generated / (floor + sin/cos) | (a + b) / "
+             "(floor + sin/cos) |\n| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n"
+          << floors.str();
     if (!extra.str().empty())
       out << "\nExtra (not a competent baseline): the numeric chain with finite-difference "
              "coefficients\n\n"

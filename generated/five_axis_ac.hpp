@@ -4,9 +4,9 @@
 // Units: axes as in kAxes (mm, deg), errors in base units (mm, rad), parameters in mm/deg;
 //        position outputs dx, dy, dz in mm, orientation outputs da, db, dc in rad.
 // Operation counts (after common-subexpression elimination):
-//   Deviation:    359 (adds 193, muls 162, divs 0, functions 4), 39 temporaries
+//   Deviation:    331 (adds 193, muls 134, divs 0, functions 4), 39 temporaries
 //   Coefficients: 151 (adds 89, muls 58, divs 0, functions 4), 47 temporaries
-//   DeviationAndCoefficients: 359 (adds 193, muls 162, divs 0, functions 4), 39 temporaries
+//   DeviationAndCoefficients: 331 (adds 193, muls 134, divs 0, functions 4), 39 temporaries
 //   NominalPose:  38 (adds 9, muls 25, divs 0, functions 4), 0 temporaries
 //   NominalJacobian: 60 (adds 12, muls 44, divs 0, functions 4), 0 temporaries
 //   Compensate:   per iteration errors_at + Deviation + NominalPose + 6x5 least-squares step; once per call NominalJacobian + NominalPose + Cholesky
@@ -15,6 +15,10 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <type_traits>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace weilgen_models {
 namespace five_axis_ac {
@@ -188,6 +192,24 @@ inline constexpr std::size_t c_above_a = 1;
 inline constexpr std::array<std::array<int, 1>, kNumHigherTerms> kHigherTerms = {{
 }};
 
+// out[0] = first, out[1] = second: two neighbouring outputs. With SSE2, a double pair is one
+// 16-byte store; compilers store mixed pairs (a constant and a symbol) one by one otherwise, and
+// the stores, not the arithmetic, bound the generated functions (docs/performance.md). The values
+// convert to Scalar (expression-template scalars). Deviation, Coefficients and
+// DeviationAndCoefficients are declared inline (a hint that raises the compiler's size limit):
+// a small model's function then becomes part of the caller's loop, without the call.
+template <typename Scalar>
+inline void StorePair(Scalar* const out, const std::common_type_t<Scalar>& first,
+                      const std::common_type_t<Scalar>& second) {
+  out[0] = first;
+  out[1] = second;
+}
+#if defined(__SSE2__)
+inline void StorePair(double* const out, const double first, const double second) {
+  _mm_storeu_pd(out, _mm_set_pd(second, first));
+}
+#endif
+
 // Deviation of the tool point relative to the workpiece, in the workpiece frame:
 // position = (dx, dy, dz) in mm, orientation = (da, db, dc) in rad. Null outputs are
 // skipped. Exact in the algebra of order kOrder.
@@ -195,11 +217,11 @@ inline constexpr std::array<std::array<int, 1>, kNumHigherTerms> kHigherTerms = 
 //   errors: E_XX, E_YX, E_ZX, E_AX, E_BX, E_CX, E_XZ, E_YZ, E_ZZ, E_AZ, E_BZ, E_CZ, E_B0Z, E_A0Z, E_XY, E_YY, E_ZY, E_AY, E_BY, E_CY, E_C0Y, E_XA, E_YA, E_ZA, E_AA, E_BA, E_CA, E_Y0A, E_Z0A, E_B0A, E_C0A, E_A0A, E_XC, E_YC, E_ZC, E_AC, E_BC, E_CC, E_X0C, E_Y0C, E_A0C, E_B0C, E_C0C
 //   params: tool_length, c_above_a
 template <typename Scalar>
-void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
-               [[maybe_unused]] const std::array<Scalar, kNumErrors>& errors,
-               [[maybe_unused]] const std::array<Scalar, kNumParams>& params,
-               std::array<Scalar, 3>* const position,
-               std::array<Scalar, 3>* const orientation = nullptr) {
+inline void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
+                      [[maybe_unused]] const std::array<Scalar, kNumErrors>& errors,
+                      [[maybe_unused]] const std::array<Scalar, kNumParams>& params,
+                      std::array<Scalar, 3>* const position,
+                      std::array<Scalar, 3>* const orientation = nullptr) {
   using std::cos;
   using std::sin;
   using std::sqrt;
@@ -351,15 +373,13 @@ void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
   // Outputs
   if (position != nullptr) {
     auto& _position = *position;
-    _position[0] = E_A0C * _coef19 + E_AZ * _coef4 + E_B0A * _coef15 + E_B0Z * _coef6 + E_BC * _coef17 + E_BX * _coef3 + E_C0Y * _coef11 + E_CY * _coef10 + E_XX * cos_C + E_XZ * cos_C + E_Y0A * _coef14 + _coef0 * _tmp33 + _coef13 * _tmp35 + _coef8 * _tmp36 - E_XC - E_A0Z * _coef7 - E_AX * _coef2 - E_B0C * _coef20 - E_BA * _coef12 - E_BY * _coef9 - E_BZ * _coef5 - E_C0A * _coef16 - E_X0C * _coef18 - E_XA * cos_C - E_XY * cos_C - E_Y0C * sin_C - E_YA * sin_C - _coef1 * _tmp34;
-    _position[1] = E_A0C * _coef20 + E_AZ * _coef25 + E_B0C * _coef19 + E_BA * _coef8 + E_BZ * _coef26 + E_C0A * _coef35 + E_CY * _coef30 + E_X0C * sin_C + E_XA * sin_C + E_XY * sin_C + E_Y0A * _coef33 + _coef12 * _tmp36 + _coef21 * _tmp33 - E_YC - E_A0Z * _coef28 - E_AC * _coef17 - E_AX * _coef23 - E_B0A * _coef34 - E_B0Z * _coef27 - E_BX * _coef24 - E_BY * _coef29 - E_C0Y * _coef31 - E_XX * sin_C - E_XZ * sin_C - E_Y0C * _coef18 - E_YA * cos_C - _coef22 * _tmp34 - _coef32 * _tmp35;
-    _position[2] = E_A0C * _coef44 + E_A0Z * _coef38 + E_AX * _coef36 + E_BA * X + E_BC * _coef32 + E_BY * _coef40 + E_Y0A * sin_A + E_YY * sin_A + E_ZX * cos_A + E_ZZ * cos_A + _coef41 * (E_C0A + E_CY) - E_ZA - E_ZC - E_AC * _coef13 - E_AZ * _coef37 - E_B0A * _coef43 - E_B0C * _coef45 - E_YX * sin_A - E_YZ * sin_A - E_Z0A * _coef42 - E_ZY * cos_A - _coef39 * _tmp36;
+    StorePair(_position.data(), E_A0C * _coef19 + E_AZ * _coef4 + E_B0A * _coef15 + E_B0Z * _coef6 + E_BC * _coef17 + E_BX * _coef3 + E_C0Y * _coef11 + E_CY * _coef10 + E_Y0A * _coef14 + _coef0 * _tmp33 + _coef13 * _tmp35 + _coef8 * _tmp36 - E_XC - E_A0Z * _coef7 - E_AX * _coef2 - E_B0C * _coef20 - E_BA * _coef12 - E_BY * _coef9 - E_BZ * _coef5 - E_C0A * _coef16 - E_X0C * _coef18 - _coef1 * _tmp34 - (E_XA + E_XY - E_XX - E_XZ) * cos_C - (E_Y0C + E_YA) * sin_C, E_A0C * _coef20 + E_AZ * _coef25 + E_B0C * _coef19 + E_BA * _coef8 + E_BZ * _coef26 + E_C0A * _coef35 + E_CY * _coef30 + E_Y0A * _coef33 + _coef12 * _tmp36 + _coef21 * _tmp33 + (E_X0C + E_XA + E_XY - E_XX - E_XZ) * sin_C - E_YC - E_A0Z * _coef28 - E_AC * _coef17 - E_AX * _coef23 - E_B0A * _coef34 - E_B0Z * _coef27 - E_BX * _coef24 - E_BY * _coef29 - E_C0Y * _coef31 - E_Y0C * _coef18 - E_YA * cos_C - _coef22 * _tmp34 - _coef32 * _tmp35);
+    _position[2] = E_A0C * _coef44 + E_A0Z * _coef38 + E_AX * _coef36 + E_BA * X + E_BC * _coef32 + E_BY * _coef40 + _coef41 * (E_C0A + E_CY) + (E_Y0A + E_YY - E_YX - E_YZ) * sin_A + (E_ZX + E_ZZ - E_ZY) * cos_A - E_ZA - E_ZC - E_AC * _coef13 - E_AZ * _coef37 - E_B0A * _coef43 - E_B0C * _coef45 - E_Z0A * _coef42 - _coef39 * _tmp36;
   }
   if (orientation != nullptr) {
     auto& _orientation = *orientation;
-    _orientation[0] = E_AX * cos_C + E_AZ * cos_C + E_B0A * _coef14 + _coef0 * _tmp37 - E_AC - E_A0A * cos_C - E_A0C * _coef18 - E_AA * cos_C - E_AY * cos_C - E_B0C * sin_C - E_BA * sin_C - _coef1 * _tmp38;
-    _orientation[1] = E_A0A * sin_C + E_A0C * sin_C + E_AA * sin_C + E_AY * sin_C + E_B0A * _coef33 + _coef21 * _tmp37 - E_BC - E_AX * sin_C - E_AZ * sin_C - E_B0C * _coef18 - E_BA * cos_C - _coef22 * _tmp38;
-    _orientation[2] = E_B0A * sin_A + E_BY * sin_A + E_CX * cos_A + E_CZ * cos_A - E_C0C - E_CA - E_CC - E_BX * sin_A - E_BZ * sin_A - E_C0A * _coef42 - E_CY * cos_A;
+    StorePair(_orientation.data(), E_B0A * _coef14 + _coef0 * _tmp37 - E_AC - E_A0C * _coef18 - _coef1 * _tmp38 - (E_A0A + E_AA + E_AY - E_AX - E_AZ) * cos_C - (E_B0C + E_BA) * sin_C, E_B0A * _coef33 + _coef21 * _tmp37 + (E_A0A + E_A0C + E_AA + E_AY - E_AX - E_AZ) * sin_C - E_BC - E_B0C * _coef18 - E_BA * cos_C - _coef22 * _tmp38);
+    _orientation[2] = (E_B0A + E_BY - E_BX - E_BZ) * sin_A + (E_CX + E_CZ - E_CY) * cos_A - E_C0C - E_CA - E_CC - E_C0A * _coef42;
   }
 }
 
@@ -367,10 +387,10 @@ void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
 // position_coeff rows dx, dy, dz (mm per base unit of the error), orientation_coeff rows
 // da, db, dc (rad per base unit).
 template <typename Scalar>
-void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
-                  [[maybe_unused]] const std::array<Scalar, kNumParams>& params,
-                  std::array<Scalar, 3 * kNumErrors>* const position_coeff,
-                  std::array<Scalar, 3 * kNumErrors>* const orientation_coeff = nullptr) {
+inline void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
+                         [[maybe_unused]] const std::array<Scalar, kNumParams>& params,
+                         std::array<Scalar, 3 * kNumErrors>* const position_coeff,
+                         std::array<Scalar, 3 * kNumErrors>* const orientation_coeff = nullptr) {
   using std::cos;
   using std::sin;
   using std::sqrt;
@@ -439,266 +459,138 @@ void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
   // Outputs
   if (position_coeff != nullptr) {
     auto& _position_coeff = *position_coeff;
-    _position_coeff[0] = cos_C;
-    _position_coeff[1] = _tmp0;
-    _position_coeff[2] = _tmp1;
-    _position_coeff[3] = _tmp2 - _tmp3;
-    _position_coeff[4] = _tmp5 - _tmp4;
-    _position_coeff[5] = Scalar(0);
-    _position_coeff[6] = cos_C;
-    _position_coeff[7] = _tmp0;
-    _position_coeff[8] = _tmp1;
-    _position_coeff[9] = _tmp2;
-    _position_coeff[10] = -_tmp4;
-    _position_coeff[11] = Scalar(0);
-    _position_coeff[12] = _tmp5;
-    _position_coeff[13] = -_tmp3;
-    _position_coeff[14] = -cos_C;
-    _position_coeff[15] = -_tmp0;
-    _position_coeff[16] = -_tmp1;
-    _position_coeff[17] = -_tmp7;
-    _position_coeff[18] = _tmp4 + _tmp8 - _tmp5;
-    _position_coeff[19] = -_tmp10 - _tmp9;
-    _position_coeff[20] = _tmp10;
-    _position_coeff[21] = -cos_C;
-    _position_coeff[22] = -sin_C;
-    _position_coeff[23] = Scalar(0);
-    _position_coeff[24] = -_tmp7;
-    _position_coeff[25] = _tmp11 - _tmp12 - _tmp13;
-    _position_coeff[26] = -_tmp18;
-    _position_coeff[27] = -_tmp19;
-    _position_coeff[28] = -_tmp1;
-    _position_coeff[29] = _tmp12 + _tmp13 + _tmp4 + _tmp8 - _tmp11 - _tmp5;
-    _position_coeff[30] = _tmp14 + _tmp15 + _tmp17 - _tmp10 - _tmp16 - _tmp9;
-    _position_coeff[31] = -_tmp7;
-    _position_coeff[32] = -Scalar(1);
-    _position_coeff[33] = Scalar(0);
-    _position_coeff[34] = Scalar(0);
-    _position_coeff[35] = Scalar(0);
-    _position_coeff[36] = _tmp20 + c_above_a - _tmp21 - _tmp22;
-    _position_coeff[37] = -_tmp18;
-    _position_coeff[38] = -_tmp23;
-    _position_coeff[39] = -sin_C;
-    _position_coeff[40] = -_tmp24;
-    _position_coeff[41] = _tmp11 + _tmp21 + _tmp22 + _tmp25 - _tmp12 - _tmp13 - _tmp20 - c_above_a;
-    _position_coeff[42] = -_tmp18;
-    _position_coeff[43] = -sin_C;
-    _position_coeff[44] = _tmp26;
-    _position_coeff[45] = _tmp27;
-    _position_coeff[46] = _tmp11 - _tmp12;
-    _position_coeff[47] = _tmp28 - _tmp29;
-    _position_coeff[48] = Scalar(0);
-    _position_coeff[49] = -sin_C;
-    _position_coeff[50] = _tmp26;
-    _position_coeff[51] = _tmp27;
-    _position_coeff[52] = _tmp11;
-    _position_coeff[53] = _tmp28;
-    _position_coeff[54] = Scalar(0);
-    _position_coeff[55] = -_tmp29;
-    _position_coeff[56] = -_tmp12;
-    _position_coeff[57] = sin_C;
-    _position_coeff[58] = -_tmp26;
-    _position_coeff[59] = -_tmp27;
-    _position_coeff[60] = -_tmp30;
-    _position_coeff[61] = _tmp29 + _tmp31 - _tmp28;
-    _position_coeff[62] = _tmp33 - _tmp32;
-    _position_coeff[63] = -_tmp33;
-    _position_coeff[64] = sin_C;
-    _position_coeff[65] = -cos_C;
-    _position_coeff[66] = Scalar(0);
-    _position_coeff[67] = -_tmp30;
-    _position_coeff[68] = -_tmp7;
-    _position_coeff[69] = _tmp38;
-    _position_coeff[70] = -_tmp39;
-    _position_coeff[71] = -_tmp27;
-    _position_coeff[72] = _tmp2 + _tmp29 + _tmp31 - _tmp28 - _tmp3 - _tmp6;
-    _position_coeff[73] = _tmp33 + _tmp35 + _tmp37 - _tmp32 - _tmp34 - _tmp36;
-    _position_coeff[74] = -_tmp30;
-    _position_coeff[75] = Scalar(0);
-    _position_coeff[76] = -Scalar(1);
-    _position_coeff[77] = Scalar(0);
-    _position_coeff[78] = _tmp21 + _tmp22 - _tmp20 - c_above_a;
-    _position_coeff[79] = Scalar(0);
-    _position_coeff[80] = _tmp38;
-    _position_coeff[81] = sin_C;
-    _position_coeff[82] = -_tmp23;
-    _position_coeff[83] = _tmp12 + _tmp13 + _tmp20 + c_above_a - _tmp11 - _tmp21 - _tmp22 - _tmp25;
-    _position_coeff[84] = -_tmp24;
-    _position_coeff[85] = _tmp38;
-    _position_coeff[86] = Scalar(0);
-    _position_coeff[87] = -sin_A;
-    _position_coeff[88] = cos_A;
-    _position_coeff[89] = _tmp41 - _tmp40;
-    _position_coeff[90] = Scalar(0);
-    _position_coeff[91] = Scalar(0);
-    _position_coeff[92] = Scalar(0);
-    _position_coeff[93] = -sin_A;
-    _position_coeff[94] = cos_A;
-    _position_coeff[95] = -_tmp40;
-    _position_coeff[96] = Scalar(0);
-    _position_coeff[97] = Scalar(0);
-    _position_coeff[98] = Scalar(0);
-    _position_coeff[99] = _tmp41;
-    _position_coeff[100] = Scalar(0);
-    _position_coeff[101] = sin_A;
-    _position_coeff[102] = -cos_A;
-    _position_coeff[103] = _tmp43;
-    _position_coeff[104] = _tmp44;
-    _position_coeff[105] = _tmp45;
-    _position_coeff[106] = Scalar(0);
-    _position_coeff[107] = Scalar(0);
-    _position_coeff[108] = Scalar(0);
-    _position_coeff[109] = -Scalar(1);
-    _position_coeff[110] = _tmp43;
-    _position_coeff[111] = X;
-    _position_coeff[112] = Scalar(0);
-    _position_coeff[113] = sin_A;
-    _position_coeff[114] = -_tmp46;
-    _position_coeff[115] = _tmp44 - X;
-    _position_coeff[116] = _tmp45;
-    _position_coeff[117] = _tmp43;
-    _position_coeff[118] = Scalar(0);
-    _position_coeff[119] = Scalar(0);
-    _position_coeff[120] = -Scalar(1);
-    _position_coeff[121] = _tmp14 + _tmp15 + _tmp17 - _tmp16;
-    _position_coeff[122] = _tmp35 + _tmp37 - _tmp34 - _tmp36;
-    _position_coeff[123] = Scalar(0);
-    _position_coeff[124] = Scalar(0);
-    _position_coeff[125] = Scalar(0);
-    _position_coeff[126] = _tmp16 + _tmp40 + _tmp42 - _tmp14 - _tmp15 - _tmp17 - _tmp41;
-    _position_coeff[127] = _tmp34 + _tmp36 + X - _tmp35 - _tmp37;
+    StorePair(_position_coeff.data(), cos_C, _tmp0);
+    StorePair(_position_coeff.data() + 2, _tmp1, _tmp2 - _tmp3);
+    StorePair(_position_coeff.data() + 4, _tmp5 - _tmp4, Scalar(0));
+    StorePair(_position_coeff.data() + 6, cos_C, _tmp0);
+    StorePair(_position_coeff.data() + 8, _tmp1, _tmp2);
+    StorePair(_position_coeff.data() + 10, -_tmp4, Scalar(0));
+    StorePair(_position_coeff.data() + 12, _tmp5, -_tmp3);
+    StorePair(_position_coeff.data() + 14, -cos_C, -_tmp0);
+    StorePair(_position_coeff.data() + 16, -_tmp1, -_tmp7);
+    StorePair(_position_coeff.data() + 18, _tmp4 + _tmp8 - _tmp5, -_tmp10 - _tmp9);
+    StorePair(_position_coeff.data() + 20, _tmp10, -cos_C);
+    StorePair(_position_coeff.data() + 22, -sin_C, Scalar(0));
+    StorePair(_position_coeff.data() + 24, -_tmp7, _tmp11 - _tmp12 - _tmp13);
+    StorePair(_position_coeff.data() + 26, -_tmp18, -_tmp19);
+    StorePair(_position_coeff.data() + 28, -_tmp1, _tmp12 + _tmp13 + _tmp4 + _tmp8 - _tmp11 - _tmp5);
+    StorePair(_position_coeff.data() + 30, _tmp14 + _tmp15 + _tmp17 - _tmp10 - _tmp16 - _tmp9, -_tmp7);
+    StorePair(_position_coeff.data() + 32, -Scalar(1), Scalar(0));
+    StorePair(_position_coeff.data() + 34, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 36, _tmp20 + c_above_a - _tmp21 - _tmp22, -_tmp18);
+    StorePair(_position_coeff.data() + 38, -_tmp23, -sin_C);
+    StorePair(_position_coeff.data() + 40, -_tmp24, _tmp11 + _tmp21 + _tmp22 + _tmp25 - _tmp12 - _tmp13 - _tmp20 - c_above_a);
+    StorePair(_position_coeff.data() + 42, -_tmp18, -sin_C);
+    StorePair(_position_coeff.data() + 44, _tmp26, _tmp27);
+    StorePair(_position_coeff.data() + 46, _tmp11 - _tmp12, _tmp28 - _tmp29);
+    StorePair(_position_coeff.data() + 48, Scalar(0), -sin_C);
+    StorePair(_position_coeff.data() + 50, _tmp26, _tmp27);
+    StorePair(_position_coeff.data() + 52, _tmp11, _tmp28);
+    StorePair(_position_coeff.data() + 54, Scalar(0), -_tmp29);
+    StorePair(_position_coeff.data() + 56, -_tmp12, sin_C);
+    StorePair(_position_coeff.data() + 58, -_tmp26, -_tmp27);
+    StorePair(_position_coeff.data() + 60, -_tmp30, _tmp29 + _tmp31 - _tmp28);
+    StorePair(_position_coeff.data() + 62, _tmp33 - _tmp32, -_tmp33);
+    StorePair(_position_coeff.data() + 64, sin_C, -cos_C);
+    StorePair(_position_coeff.data() + 66, Scalar(0), -_tmp30);
+    StorePair(_position_coeff.data() + 68, -_tmp7, _tmp38);
+    StorePair(_position_coeff.data() + 70, -_tmp39, -_tmp27);
+    StorePair(_position_coeff.data() + 72, _tmp2 + _tmp29 + _tmp31 - _tmp28 - _tmp3 - _tmp6, _tmp33 + _tmp35 + _tmp37 - _tmp32 - _tmp34 - _tmp36);
+    StorePair(_position_coeff.data() + 74, -_tmp30, Scalar(0));
+    StorePair(_position_coeff.data() + 76, -Scalar(1), Scalar(0));
+    StorePair(_position_coeff.data() + 78, _tmp21 + _tmp22 - _tmp20 - c_above_a, Scalar(0));
+    StorePair(_position_coeff.data() + 80, _tmp38, sin_C);
+    StorePair(_position_coeff.data() + 82, -_tmp23, _tmp12 + _tmp13 + _tmp20 + c_above_a - _tmp11 - _tmp21 - _tmp22 - _tmp25);
+    StorePair(_position_coeff.data() + 84, -_tmp24, _tmp38);
+    StorePair(_position_coeff.data() + 86, Scalar(0), -sin_A);
+    StorePair(_position_coeff.data() + 88, cos_A, _tmp41 - _tmp40);
+    StorePair(_position_coeff.data() + 90, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 92, Scalar(0), -sin_A);
+    StorePair(_position_coeff.data() + 94, cos_A, -_tmp40);
+    StorePair(_position_coeff.data() + 96, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 98, Scalar(0), _tmp41);
+    StorePair(_position_coeff.data() + 100, Scalar(0), sin_A);
+    StorePair(_position_coeff.data() + 102, -cos_A, _tmp43);
+    StorePair(_position_coeff.data() + 104, _tmp44, _tmp45);
+    StorePair(_position_coeff.data() + 106, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 108, Scalar(0), -Scalar(1));
+    StorePair(_position_coeff.data() + 110, _tmp43, X);
+    StorePair(_position_coeff.data() + 112, Scalar(0), sin_A);
+    StorePair(_position_coeff.data() + 114, -_tmp46, _tmp44 - X);
+    StorePair(_position_coeff.data() + 116, _tmp45, _tmp43);
+    StorePair(_position_coeff.data() + 118, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 120, -Scalar(1), _tmp14 + _tmp15 + _tmp17 - _tmp16);
+    StorePair(_position_coeff.data() + 122, _tmp35 + _tmp37 - _tmp34 - _tmp36, Scalar(0));
+    StorePair(_position_coeff.data() + 124, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 126, _tmp16 + _tmp40 + _tmp42 - _tmp14 - _tmp15 - _tmp17 - _tmp41, _tmp34 + _tmp36 + X - _tmp35 - _tmp37);
     _position_coeff[128] = Scalar(0);
   }
   if (orientation_coeff != nullptr) {
     auto& _orientation_coeff = *orientation_coeff;
-    _orientation_coeff[0] = Scalar(0);
-    _orientation_coeff[1] = Scalar(0);
-    _orientation_coeff[2] = Scalar(0);
-    _orientation_coeff[3] = cos_C;
-    _orientation_coeff[4] = _tmp0;
-    _orientation_coeff[5] = _tmp1;
-    _orientation_coeff[6] = Scalar(0);
-    _orientation_coeff[7] = Scalar(0);
-    _orientation_coeff[8] = Scalar(0);
-    _orientation_coeff[9] = cos_C;
-    _orientation_coeff[10] = _tmp0;
-    _orientation_coeff[11] = _tmp1;
-    _orientation_coeff[12] = Scalar(0);
-    _orientation_coeff[13] = Scalar(0);
-    _orientation_coeff[14] = Scalar(0);
-    _orientation_coeff[15] = Scalar(0);
-    _orientation_coeff[16] = Scalar(0);
-    _orientation_coeff[17] = -cos_C;
-    _orientation_coeff[18] = -_tmp0;
-    _orientation_coeff[19] = -_tmp1;
-    _orientation_coeff[20] = Scalar(0);
-    _orientation_coeff[21] = Scalar(0);
-    _orientation_coeff[22] = Scalar(0);
-    _orientation_coeff[23] = Scalar(0);
-    _orientation_coeff[24] = -cos_C;
-    _orientation_coeff[25] = -sin_C;
-    _orientation_coeff[26] = Scalar(0);
-    _orientation_coeff[27] = Scalar(0);
-    _orientation_coeff[28] = Scalar(0);
-    _orientation_coeff[29] = -_tmp19;
-    _orientation_coeff[30] = -_tmp1;
-    _orientation_coeff[31] = -cos_C;
-    _orientation_coeff[32] = Scalar(0);
-    _orientation_coeff[33] = Scalar(0);
-    _orientation_coeff[34] = Scalar(0);
-    _orientation_coeff[35] = -Scalar(1);
-    _orientation_coeff[36] = Scalar(0);
-    _orientation_coeff[37] = Scalar(0);
-    _orientation_coeff[38] = Scalar(0);
-    _orientation_coeff[39] = Scalar(0);
-    _orientation_coeff[40] = -_tmp23;
-    _orientation_coeff[41] = -sin_C;
-    _orientation_coeff[42] = Scalar(0);
-    _orientation_coeff[43] = Scalar(0);
-    _orientation_coeff[44] = Scalar(0);
-    _orientation_coeff[45] = Scalar(0);
-    _orientation_coeff[46] = -sin_C;
-    _orientation_coeff[47] = _tmp26;
-    _orientation_coeff[48] = _tmp27;
-    _orientation_coeff[49] = Scalar(0);
-    _orientation_coeff[50] = Scalar(0);
-    _orientation_coeff[51] = Scalar(0);
-    _orientation_coeff[52] = -sin_C;
-    _orientation_coeff[53] = _tmp26;
-    _orientation_coeff[54] = _tmp27;
-    _orientation_coeff[55] = Scalar(0);
-    _orientation_coeff[56] = Scalar(0);
-    _orientation_coeff[57] = Scalar(0);
-    _orientation_coeff[58] = Scalar(0);
-    _orientation_coeff[59] = Scalar(0);
-    _orientation_coeff[60] = sin_C;
-    _orientation_coeff[61] = -_tmp26;
-    _orientation_coeff[62] = -_tmp27;
-    _orientation_coeff[63] = Scalar(0);
-    _orientation_coeff[64] = Scalar(0);
-    _orientation_coeff[65] = Scalar(0);
-    _orientation_coeff[66] = Scalar(0);
-    _orientation_coeff[67] = sin_C;
-    _orientation_coeff[68] = -cos_C;
-    _orientation_coeff[69] = Scalar(0);
-    _orientation_coeff[70] = Scalar(0);
-    _orientation_coeff[71] = Scalar(0);
-    _orientation_coeff[72] = -_tmp39;
-    _orientation_coeff[73] = -_tmp27;
-    _orientation_coeff[74] = sin_C;
-    _orientation_coeff[75] = Scalar(0);
-    _orientation_coeff[76] = Scalar(0);
-    _orientation_coeff[77] = Scalar(0);
-    _orientation_coeff[78] = Scalar(0);
-    _orientation_coeff[79] = -Scalar(1);
-    _orientation_coeff[80] = Scalar(0);
-    _orientation_coeff[81] = Scalar(0);
-    _orientation_coeff[82] = Scalar(0);
-    _orientation_coeff[83] = sin_C;
-    _orientation_coeff[84] = -_tmp23;
-    _orientation_coeff[85] = Scalar(0);
-    _orientation_coeff[86] = Scalar(0);
-    _orientation_coeff[87] = Scalar(0);
-    _orientation_coeff[88] = Scalar(0);
-    _orientation_coeff[89] = Scalar(0);
-    _orientation_coeff[90] = -sin_A;
-    _orientation_coeff[91] = cos_A;
-    _orientation_coeff[92] = Scalar(0);
-    _orientation_coeff[93] = Scalar(0);
-    _orientation_coeff[94] = Scalar(0);
-    _orientation_coeff[95] = Scalar(0);
-    _orientation_coeff[96] = -sin_A;
-    _orientation_coeff[97] = cos_A;
-    _orientation_coeff[98] = Scalar(0);
-    _orientation_coeff[99] = Scalar(0);
-    _orientation_coeff[100] = Scalar(0);
-    _orientation_coeff[101] = Scalar(0);
-    _orientation_coeff[102] = Scalar(0);
-    _orientation_coeff[103] = Scalar(0);
-    _orientation_coeff[104] = sin_A;
-    _orientation_coeff[105] = -cos_A;
-    _orientation_coeff[106] = Scalar(0);
-    _orientation_coeff[107] = Scalar(0);
-    _orientation_coeff[108] = Scalar(0);
-    _orientation_coeff[109] = Scalar(0);
-    _orientation_coeff[110] = Scalar(0);
-    _orientation_coeff[111] = Scalar(0);
-    _orientation_coeff[112] = -Scalar(1);
-    _orientation_coeff[113] = Scalar(0);
-    _orientation_coeff[114] = Scalar(0);
-    _orientation_coeff[115] = sin_A;
-    _orientation_coeff[116] = -_tmp46;
-    _orientation_coeff[117] = Scalar(0);
-    _orientation_coeff[118] = Scalar(0);
-    _orientation_coeff[119] = Scalar(0);
-    _orientation_coeff[120] = Scalar(0);
-    _orientation_coeff[121] = Scalar(0);
-    _orientation_coeff[122] = Scalar(0);
-    _orientation_coeff[123] = -Scalar(1);
-    _orientation_coeff[124] = Scalar(0);
-    _orientation_coeff[125] = Scalar(0);
-    _orientation_coeff[126] = Scalar(0);
-    _orientation_coeff[127] = Scalar(0);
+    StorePair(_orientation_coeff.data(), Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 2, Scalar(0), cos_C);
+    StorePair(_orientation_coeff.data() + 4, _tmp0, _tmp1);
+    StorePair(_orientation_coeff.data() + 6, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 8, Scalar(0), cos_C);
+    StorePair(_orientation_coeff.data() + 10, _tmp0, _tmp1);
+    StorePair(_orientation_coeff.data() + 12, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 14, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 16, Scalar(0), -cos_C);
+    StorePair(_orientation_coeff.data() + 18, -_tmp0, -_tmp1);
+    StorePair(_orientation_coeff.data() + 20, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 22, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 24, -cos_C, -sin_C);
+    StorePair(_orientation_coeff.data() + 26, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 28, Scalar(0), -_tmp19);
+    StorePair(_orientation_coeff.data() + 30, -_tmp1, -cos_C);
+    StorePair(_orientation_coeff.data() + 32, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 34, Scalar(0), -Scalar(1));
+    StorePair(_orientation_coeff.data() + 36, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 38, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 40, -_tmp23, -sin_C);
+    StorePair(_orientation_coeff.data() + 42, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 44, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 46, -sin_C, _tmp26);
+    StorePair(_orientation_coeff.data() + 48, _tmp27, Scalar(0));
+    StorePair(_orientation_coeff.data() + 50, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 52, -sin_C, _tmp26);
+    StorePair(_orientation_coeff.data() + 54, _tmp27, Scalar(0));
+    StorePair(_orientation_coeff.data() + 56, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 58, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 60, sin_C, -_tmp26);
+    StorePair(_orientation_coeff.data() + 62, -_tmp27, Scalar(0));
+    StorePair(_orientation_coeff.data() + 64, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 66, Scalar(0), sin_C);
+    StorePair(_orientation_coeff.data() + 68, -cos_C, Scalar(0));
+    StorePair(_orientation_coeff.data() + 70, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 72, -_tmp39, -_tmp27);
+    StorePair(_orientation_coeff.data() + 74, sin_C, Scalar(0));
+    StorePair(_orientation_coeff.data() + 76, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 78, Scalar(0), -Scalar(1));
+    StorePair(_orientation_coeff.data() + 80, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 82, Scalar(0), sin_C);
+    StorePair(_orientation_coeff.data() + 84, -_tmp23, Scalar(0));
+    StorePair(_orientation_coeff.data() + 86, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 88, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 90, -sin_A, cos_A);
+    StorePair(_orientation_coeff.data() + 92, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 94, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 96, -sin_A, cos_A);
+    StorePair(_orientation_coeff.data() + 98, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 100, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 102, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 104, sin_A, -cos_A);
+    StorePair(_orientation_coeff.data() + 106, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 108, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 110, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 112, -Scalar(1), Scalar(0));
+    StorePair(_orientation_coeff.data() + 114, Scalar(0), sin_A);
+    StorePair(_orientation_coeff.data() + 116, -_tmp46, Scalar(0));
+    StorePair(_orientation_coeff.data() + 118, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 120, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 122, Scalar(0), -Scalar(1));
+    StorePair(_orientation_coeff.data() + 124, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 126, Scalar(0), Scalar(0));
     _orientation_coeff[128] = -Scalar(1);
   }
 }
@@ -707,7 +599,7 @@ void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
 // the terms common to both (one common-subexpression pass over both). The same outputs
 // as the two functions, equal to rounding; null outputs are skipped.
 template <typename Scalar>
-void DeviationAndCoefficients(
+inline void DeviationAndCoefficients(
     [[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
     [[maybe_unused]] const std::array<Scalar, kNumErrors>& errors,
     [[maybe_unused]] const std::array<Scalar, kNumParams>& params,
@@ -865,278 +757,148 @@ void DeviationAndCoefficients(
   // Outputs
   if (position != nullptr) {
     auto& _position = *position;
-    _position[0] = E_A0C * _coef19 + E_AZ * _coef4 + E_B0A * _coef15 + E_B0Z * _coef6 + E_BC * _coef17 + E_BX * _coef3 + E_C0Y * _coef11 + E_CY * _coef10 + E_XX * cos_C + E_XZ * cos_C + E_Y0A * _coef14 + _coef0 * _tmp33 + _coef13 * _tmp35 + _coef8 * _tmp36 - E_XC - E_A0Z * _coef7 - E_AX * _coef2 - E_B0C * _coef20 - E_BA * _coef12 - E_BY * _coef9 - E_BZ * _coef5 - E_C0A * _coef16 - E_X0C * _coef18 - E_XA * cos_C - E_XY * cos_C - E_Y0C * sin_C - E_YA * sin_C - _coef1 * _tmp34;
-    _position[1] = E_A0C * _coef20 + E_AZ * _coef25 + E_B0C * _coef19 + E_BA * _coef8 + E_BZ * _coef26 + E_C0A * _coef35 + E_CY * _coef30 + E_X0C * sin_C + E_XA * sin_C + E_XY * sin_C + E_Y0A * _coef33 + _coef12 * _tmp36 + _coef21 * _tmp33 - E_YC - E_A0Z * _coef28 - E_AC * _coef17 - E_AX * _coef23 - E_B0A * _coef34 - E_B0Z * _coef27 - E_BX * _coef24 - E_BY * _coef29 - E_C0Y * _coef31 - E_XX * sin_C - E_XZ * sin_C - E_Y0C * _coef18 - E_YA * cos_C - _coef22 * _tmp34 - _coef32 * _tmp35;
-    _position[2] = E_A0C * _coef44 + E_A0Z * _coef38 + E_AX * _coef36 + E_BA * X + E_BC * _coef32 + E_BY * _coef40 + E_Y0A * sin_A + E_YY * sin_A + E_ZX * cos_A + E_ZZ * cos_A + _coef41 * (E_C0A + E_CY) - E_ZA - E_ZC - E_AC * _coef13 - E_AZ * _coef37 - E_B0A * _coef43 - E_B0C * _coef45 - E_YX * sin_A - E_YZ * sin_A - E_Z0A * _coef42 - E_ZY * cos_A - _coef39 * _tmp36;
+    StorePair(_position.data(), E_A0C * _coef19 + E_AZ * _coef4 + E_B0A * _coef15 + E_B0Z * _coef6 + E_BC * _coef17 + E_BX * _coef3 + E_C0Y * _coef11 + E_CY * _coef10 + E_Y0A * _coef14 + _coef0 * _tmp33 + _coef13 * _tmp35 + _coef8 * _tmp36 - E_XC - E_A0Z * _coef7 - E_AX * _coef2 - E_B0C * _coef20 - E_BA * _coef12 - E_BY * _coef9 - E_BZ * _coef5 - E_C0A * _coef16 - E_X0C * _coef18 - _coef1 * _tmp34 - (E_XA + E_XY - E_XX - E_XZ) * cos_C - (E_Y0C + E_YA) * sin_C, E_A0C * _coef20 + E_AZ * _coef25 + E_B0C * _coef19 + E_BA * _coef8 + E_BZ * _coef26 + E_C0A * _coef35 + E_CY * _coef30 + E_Y0A * _coef33 + _coef12 * _tmp36 + _coef21 * _tmp33 + (E_X0C + E_XA + E_XY - E_XX - E_XZ) * sin_C - E_YC - E_A0Z * _coef28 - E_AC * _coef17 - E_AX * _coef23 - E_B0A * _coef34 - E_B0Z * _coef27 - E_BX * _coef24 - E_BY * _coef29 - E_C0Y * _coef31 - E_Y0C * _coef18 - E_YA * cos_C - _coef22 * _tmp34 - _coef32 * _tmp35);
+    _position[2] = E_A0C * _coef44 + E_A0Z * _coef38 + E_AX * _coef36 + E_BA * X + E_BC * _coef32 + E_BY * _coef40 + _coef41 * (E_C0A + E_CY) + (E_Y0A + E_YY - E_YX - E_YZ) * sin_A + (E_ZX + E_ZZ - E_ZY) * cos_A - E_ZA - E_ZC - E_AC * _coef13 - E_AZ * _coef37 - E_B0A * _coef43 - E_B0C * _coef45 - E_Z0A * _coef42 - _coef39 * _tmp36;
   }
   if (orientation != nullptr) {
     auto& _orientation = *orientation;
-    _orientation[0] = E_AX * cos_C + E_AZ * cos_C + E_B0A * _coef14 + _coef0 * _tmp37 - E_AC - E_A0A * cos_C - E_A0C * _coef18 - E_AA * cos_C - E_AY * cos_C - E_B0C * sin_C - E_BA * sin_C - _coef1 * _tmp38;
-    _orientation[1] = E_A0A * sin_C + E_A0C * sin_C + E_AA * sin_C + E_AY * sin_C + E_B0A * _coef33 + _coef21 * _tmp37 - E_BC - E_AX * sin_C - E_AZ * sin_C - E_B0C * _coef18 - E_BA * cos_C - _coef22 * _tmp38;
-    _orientation[2] = E_B0A * sin_A + E_BY * sin_A + E_CX * cos_A + E_CZ * cos_A - E_C0C - E_CA - E_CC - E_BX * sin_A - E_BZ * sin_A - E_C0A * _coef42 - E_CY * cos_A;
+    StorePair(_orientation.data(), E_B0A * _coef14 + _coef0 * _tmp37 - E_AC - E_A0C * _coef18 - _coef1 * _tmp38 - (E_A0A + E_AA + E_AY - E_AX - E_AZ) * cos_C - (E_B0C + E_BA) * sin_C, E_B0A * _coef33 + _coef21 * _tmp37 + (E_A0A + E_A0C + E_AA + E_AY - E_AX - E_AZ) * sin_C - E_BC - E_B0C * _coef18 - E_BA * cos_C - _coef22 * _tmp38);
+    _orientation[2] = (E_B0A + E_BY - E_BX - E_BZ) * sin_A + (E_CX + E_CZ - E_CY) * cos_A - E_C0C - E_CA - E_CC - E_C0A * _coef42;
   }
   if (position_coeff != nullptr) {
     auto& _position_coeff = *position_coeff;
-    _position_coeff[0] = cos_C;
-    _position_coeff[1] = _coef0;
-    _position_coeff[2] = _coef1;
-    _position_coeff[3] = -_coef2;
-    _position_coeff[4] = _coef3;
-    _position_coeff[5] = Scalar(0);
-    _position_coeff[6] = cos_C;
-    _position_coeff[7] = _coef0;
-    _position_coeff[8] = _coef1;
-    _position_coeff[9] = _coef4;
-    _position_coeff[10] = -_coef5;
-    _position_coeff[11] = Scalar(0);
-    _position_coeff[12] = _coef6;
-    _position_coeff[13] = -_coef7;
-    _position_coeff[14] = -cos_C;
-    _position_coeff[15] = -_coef0;
-    _position_coeff[16] = -_coef1;
-    _position_coeff[17] = _coef8;
-    _position_coeff[18] = -_coef9;
-    _position_coeff[19] = _coef10;
-    _position_coeff[20] = _coef11;
-    _position_coeff[21] = -cos_C;
-    _position_coeff[22] = -sin_C;
-    _position_coeff[23] = Scalar(0);
-    _position_coeff[24] = _coef8;
-    _position_coeff[25] = -_coef12;
-    _position_coeff[26] = _coef13;
-    _position_coeff[27] = _coef14;
-    _position_coeff[28] = -_coef1;
-    _position_coeff[29] = _coef15;
-    _position_coeff[30] = -_coef16;
-    _position_coeff[31] = _coef8;
-    _position_coeff[32] = -Scalar(1);
-    _position_coeff[33] = Scalar(0);
-    _position_coeff[34] = Scalar(0);
-    _position_coeff[35] = Scalar(0);
-    _position_coeff[36] = _coef17;
-    _position_coeff[37] = _coef13;
-    _position_coeff[38] = -_coef18;
-    _position_coeff[39] = -sin_C;
-    _position_coeff[40] = _coef19;
-    _position_coeff[41] = -_coef20;
-    _position_coeff[42] = _coef13;
-    _position_coeff[43] = -sin_C;
-    _position_coeff[44] = _coef21;
-    _position_coeff[45] = _coef22;
-    _position_coeff[46] = -_coef23;
-    _position_coeff[47] = -_coef24;
-    _position_coeff[48] = Scalar(0);
-    _position_coeff[49] = -sin_C;
-    _position_coeff[50] = _coef21;
-    _position_coeff[51] = _coef22;
-    _position_coeff[52] = _coef25;
-    _position_coeff[53] = _coef26;
-    _position_coeff[54] = Scalar(0);
-    _position_coeff[55] = -_coef27;
-    _position_coeff[56] = -_coef28;
-    _position_coeff[57] = sin_C;
-    _position_coeff[58] = -_coef21;
-    _position_coeff[59] = -_coef22;
-    _position_coeff[60] = _coef12;
-    _position_coeff[61] = -_coef29;
-    _position_coeff[62] = _coef30;
-    _position_coeff[63] = -_coef31;
-    _position_coeff[64] = sin_C;
-    _position_coeff[65] = -cos_C;
-    _position_coeff[66] = Scalar(0);
-    _position_coeff[67] = _coef12;
-    _position_coeff[68] = _coef8;
-    _position_coeff[69] = -_coef32;
-    _position_coeff[70] = _coef33;
-    _position_coeff[71] = -_coef22;
-    _position_coeff[72] = -_coef34;
-    _position_coeff[73] = _coef35;
-    _position_coeff[74] = _coef12;
-    _position_coeff[75] = Scalar(0);
-    _position_coeff[76] = -Scalar(1);
-    _position_coeff[77] = Scalar(0);
-    _position_coeff[78] = -_coef17;
-    _position_coeff[79] = Scalar(0);
-    _position_coeff[80] = -_coef32;
-    _position_coeff[81] = sin_C;
-    _position_coeff[82] = -_coef18;
-    _position_coeff[83] = _coef20;
-    _position_coeff[84] = _coef19;
-    _position_coeff[85] = -_coef32;
-    _position_coeff[86] = Scalar(0);
-    _position_coeff[87] = -sin_A;
-    _position_coeff[88] = cos_A;
-    _position_coeff[89] = _coef36;
-    _position_coeff[90] = Scalar(0);
-    _position_coeff[91] = Scalar(0);
-    _position_coeff[92] = Scalar(0);
-    _position_coeff[93] = -sin_A;
-    _position_coeff[94] = cos_A;
-    _position_coeff[95] = -_coef37;
-    _position_coeff[96] = Scalar(0);
-    _position_coeff[97] = Scalar(0);
-    _position_coeff[98] = Scalar(0);
-    _position_coeff[99] = _coef38;
-    _position_coeff[100] = Scalar(0);
-    _position_coeff[101] = sin_A;
-    _position_coeff[102] = -cos_A;
-    _position_coeff[103] = -_coef39;
-    _position_coeff[104] = _coef40;
-    _position_coeff[105] = _coef41;
-    _position_coeff[106] = Scalar(0);
-    _position_coeff[107] = Scalar(0);
-    _position_coeff[108] = Scalar(0);
-    _position_coeff[109] = -Scalar(1);
-    _position_coeff[110] = -_coef39;
-    _position_coeff[111] = X;
-    _position_coeff[112] = Scalar(0);
-    _position_coeff[113] = sin_A;
-    _position_coeff[114] = -_coef42;
-    _position_coeff[115] = -_coef43;
-    _position_coeff[116] = _coef41;
-    _position_coeff[117] = -_coef39;
-    _position_coeff[118] = Scalar(0);
-    _position_coeff[119] = Scalar(0);
-    _position_coeff[120] = -Scalar(1);
-    _position_coeff[121] = -_coef13;
-    _position_coeff[122] = _coef32;
-    _position_coeff[123] = Scalar(0);
-    _position_coeff[124] = Scalar(0);
-    _position_coeff[125] = Scalar(0);
-    _position_coeff[126] = _coef44;
-    _position_coeff[127] = -_coef45;
+    StorePair(_position_coeff.data(), cos_C, _coef0);
+    StorePair(_position_coeff.data() + 2, _coef1, -_coef2);
+    StorePair(_position_coeff.data() + 4, _coef3, Scalar(0));
+    StorePair(_position_coeff.data() + 6, cos_C, _coef0);
+    StorePair(_position_coeff.data() + 8, _coef1, _coef4);
+    StorePair(_position_coeff.data() + 10, -_coef5, Scalar(0));
+    StorePair(_position_coeff.data() + 12, _coef6, -_coef7);
+    StorePair(_position_coeff.data() + 14, -cos_C, -_coef0);
+    StorePair(_position_coeff.data() + 16, -_coef1, _coef8);
+    StorePair(_position_coeff.data() + 18, -_coef9, _coef10);
+    StorePair(_position_coeff.data() + 20, _coef11, -cos_C);
+    StorePair(_position_coeff.data() + 22, -sin_C, Scalar(0));
+    StorePair(_position_coeff.data() + 24, _coef8, -_coef12);
+    StorePair(_position_coeff.data() + 26, _coef13, _coef14);
+    StorePair(_position_coeff.data() + 28, -_coef1, _coef15);
+    StorePair(_position_coeff.data() + 30, -_coef16, _coef8);
+    StorePair(_position_coeff.data() + 32, -Scalar(1), Scalar(0));
+    StorePair(_position_coeff.data() + 34, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 36, _coef17, _coef13);
+    StorePair(_position_coeff.data() + 38, -_coef18, -sin_C);
+    StorePair(_position_coeff.data() + 40, _coef19, -_coef20);
+    StorePair(_position_coeff.data() + 42, _coef13, -sin_C);
+    StorePair(_position_coeff.data() + 44, _coef21, _coef22);
+    StorePair(_position_coeff.data() + 46, -_coef23, -_coef24);
+    StorePair(_position_coeff.data() + 48, Scalar(0), -sin_C);
+    StorePair(_position_coeff.data() + 50, _coef21, _coef22);
+    StorePair(_position_coeff.data() + 52, _coef25, _coef26);
+    StorePair(_position_coeff.data() + 54, Scalar(0), -_coef27);
+    StorePair(_position_coeff.data() + 56, -_coef28, sin_C);
+    StorePair(_position_coeff.data() + 58, -_coef21, -_coef22);
+    StorePair(_position_coeff.data() + 60, _coef12, -_coef29);
+    StorePair(_position_coeff.data() + 62, _coef30, -_coef31);
+    StorePair(_position_coeff.data() + 64, sin_C, -cos_C);
+    StorePair(_position_coeff.data() + 66, Scalar(0), _coef12);
+    StorePair(_position_coeff.data() + 68, _coef8, -_coef32);
+    StorePair(_position_coeff.data() + 70, _coef33, -_coef22);
+    StorePair(_position_coeff.data() + 72, -_coef34, _coef35);
+    StorePair(_position_coeff.data() + 74, _coef12, Scalar(0));
+    StorePair(_position_coeff.data() + 76, -Scalar(1), Scalar(0));
+    StorePair(_position_coeff.data() + 78, -_coef17, Scalar(0));
+    StorePair(_position_coeff.data() + 80, -_coef32, sin_C);
+    StorePair(_position_coeff.data() + 82, -_coef18, _coef20);
+    StorePair(_position_coeff.data() + 84, _coef19, -_coef32);
+    StorePair(_position_coeff.data() + 86, Scalar(0), -sin_A);
+    StorePair(_position_coeff.data() + 88, cos_A, _coef36);
+    StorePair(_position_coeff.data() + 90, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 92, Scalar(0), -sin_A);
+    StorePair(_position_coeff.data() + 94, cos_A, -_coef37);
+    StorePair(_position_coeff.data() + 96, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 98, Scalar(0), _coef38);
+    StorePair(_position_coeff.data() + 100, Scalar(0), sin_A);
+    StorePair(_position_coeff.data() + 102, -cos_A, -_coef39);
+    StorePair(_position_coeff.data() + 104, _coef40, _coef41);
+    StorePair(_position_coeff.data() + 106, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 108, Scalar(0), -Scalar(1));
+    StorePair(_position_coeff.data() + 110, -_coef39, X);
+    StorePair(_position_coeff.data() + 112, Scalar(0), sin_A);
+    StorePair(_position_coeff.data() + 114, -_coef42, -_coef43);
+    StorePair(_position_coeff.data() + 116, _coef41, -_coef39);
+    StorePair(_position_coeff.data() + 118, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 120, -Scalar(1), -_coef13);
+    StorePair(_position_coeff.data() + 122, _coef32, Scalar(0));
+    StorePair(_position_coeff.data() + 124, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 126, _coef44, -_coef45);
     _position_coeff[128] = Scalar(0);
   }
   if (orientation_coeff != nullptr) {
     auto& _orientation_coeff = *orientation_coeff;
-    _orientation_coeff[0] = Scalar(0);
-    _orientation_coeff[1] = Scalar(0);
-    _orientation_coeff[2] = Scalar(0);
-    _orientation_coeff[3] = cos_C;
-    _orientation_coeff[4] = _coef0;
-    _orientation_coeff[5] = _coef1;
-    _orientation_coeff[6] = Scalar(0);
-    _orientation_coeff[7] = Scalar(0);
-    _orientation_coeff[8] = Scalar(0);
-    _orientation_coeff[9] = cos_C;
-    _orientation_coeff[10] = _coef0;
-    _orientation_coeff[11] = _coef1;
-    _orientation_coeff[12] = Scalar(0);
-    _orientation_coeff[13] = Scalar(0);
-    _orientation_coeff[14] = Scalar(0);
-    _orientation_coeff[15] = Scalar(0);
-    _orientation_coeff[16] = Scalar(0);
-    _orientation_coeff[17] = -cos_C;
-    _orientation_coeff[18] = -_coef0;
-    _orientation_coeff[19] = -_coef1;
-    _orientation_coeff[20] = Scalar(0);
-    _orientation_coeff[21] = Scalar(0);
-    _orientation_coeff[22] = Scalar(0);
-    _orientation_coeff[23] = Scalar(0);
-    _orientation_coeff[24] = -cos_C;
-    _orientation_coeff[25] = -sin_C;
-    _orientation_coeff[26] = Scalar(0);
-    _orientation_coeff[27] = Scalar(0);
-    _orientation_coeff[28] = Scalar(0);
-    _orientation_coeff[29] = _coef14;
-    _orientation_coeff[30] = -_coef1;
-    _orientation_coeff[31] = -cos_C;
-    _orientation_coeff[32] = Scalar(0);
-    _orientation_coeff[33] = Scalar(0);
-    _orientation_coeff[34] = Scalar(0);
-    _orientation_coeff[35] = -Scalar(1);
-    _orientation_coeff[36] = Scalar(0);
-    _orientation_coeff[37] = Scalar(0);
-    _orientation_coeff[38] = Scalar(0);
-    _orientation_coeff[39] = Scalar(0);
-    _orientation_coeff[40] = -_coef18;
-    _orientation_coeff[41] = -sin_C;
-    _orientation_coeff[42] = Scalar(0);
-    _orientation_coeff[43] = Scalar(0);
-    _orientation_coeff[44] = Scalar(0);
-    _orientation_coeff[45] = Scalar(0);
-    _orientation_coeff[46] = -sin_C;
-    _orientation_coeff[47] = _coef21;
-    _orientation_coeff[48] = _coef22;
-    _orientation_coeff[49] = Scalar(0);
-    _orientation_coeff[50] = Scalar(0);
-    _orientation_coeff[51] = Scalar(0);
-    _orientation_coeff[52] = -sin_C;
-    _orientation_coeff[53] = _coef21;
-    _orientation_coeff[54] = _coef22;
-    _orientation_coeff[55] = Scalar(0);
-    _orientation_coeff[56] = Scalar(0);
-    _orientation_coeff[57] = Scalar(0);
-    _orientation_coeff[58] = Scalar(0);
-    _orientation_coeff[59] = Scalar(0);
-    _orientation_coeff[60] = sin_C;
-    _orientation_coeff[61] = -_coef21;
-    _orientation_coeff[62] = -_coef22;
-    _orientation_coeff[63] = Scalar(0);
-    _orientation_coeff[64] = Scalar(0);
-    _orientation_coeff[65] = Scalar(0);
-    _orientation_coeff[66] = Scalar(0);
-    _orientation_coeff[67] = sin_C;
-    _orientation_coeff[68] = -cos_C;
-    _orientation_coeff[69] = Scalar(0);
-    _orientation_coeff[70] = Scalar(0);
-    _orientation_coeff[71] = Scalar(0);
-    _orientation_coeff[72] = _coef33;
-    _orientation_coeff[73] = -_coef22;
-    _orientation_coeff[74] = sin_C;
-    _orientation_coeff[75] = Scalar(0);
-    _orientation_coeff[76] = Scalar(0);
-    _orientation_coeff[77] = Scalar(0);
-    _orientation_coeff[78] = Scalar(0);
-    _orientation_coeff[79] = -Scalar(1);
-    _orientation_coeff[80] = Scalar(0);
-    _orientation_coeff[81] = Scalar(0);
-    _orientation_coeff[82] = Scalar(0);
-    _orientation_coeff[83] = sin_C;
-    _orientation_coeff[84] = -_coef18;
-    _orientation_coeff[85] = Scalar(0);
-    _orientation_coeff[86] = Scalar(0);
-    _orientation_coeff[87] = Scalar(0);
-    _orientation_coeff[88] = Scalar(0);
-    _orientation_coeff[89] = Scalar(0);
-    _orientation_coeff[90] = -sin_A;
-    _orientation_coeff[91] = cos_A;
-    _orientation_coeff[92] = Scalar(0);
-    _orientation_coeff[93] = Scalar(0);
-    _orientation_coeff[94] = Scalar(0);
-    _orientation_coeff[95] = Scalar(0);
-    _orientation_coeff[96] = -sin_A;
-    _orientation_coeff[97] = cos_A;
-    _orientation_coeff[98] = Scalar(0);
-    _orientation_coeff[99] = Scalar(0);
-    _orientation_coeff[100] = Scalar(0);
-    _orientation_coeff[101] = Scalar(0);
-    _orientation_coeff[102] = Scalar(0);
-    _orientation_coeff[103] = Scalar(0);
-    _orientation_coeff[104] = sin_A;
-    _orientation_coeff[105] = -cos_A;
-    _orientation_coeff[106] = Scalar(0);
-    _orientation_coeff[107] = Scalar(0);
-    _orientation_coeff[108] = Scalar(0);
-    _orientation_coeff[109] = Scalar(0);
-    _orientation_coeff[110] = Scalar(0);
-    _orientation_coeff[111] = Scalar(0);
-    _orientation_coeff[112] = -Scalar(1);
-    _orientation_coeff[113] = Scalar(0);
-    _orientation_coeff[114] = Scalar(0);
-    _orientation_coeff[115] = sin_A;
-    _orientation_coeff[116] = -_coef42;
-    _orientation_coeff[117] = Scalar(0);
-    _orientation_coeff[118] = Scalar(0);
-    _orientation_coeff[119] = Scalar(0);
-    _orientation_coeff[120] = Scalar(0);
-    _orientation_coeff[121] = Scalar(0);
-    _orientation_coeff[122] = Scalar(0);
-    _orientation_coeff[123] = -Scalar(1);
-    _orientation_coeff[124] = Scalar(0);
-    _orientation_coeff[125] = Scalar(0);
-    _orientation_coeff[126] = Scalar(0);
-    _orientation_coeff[127] = Scalar(0);
+    StorePair(_orientation_coeff.data(), Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 2, Scalar(0), cos_C);
+    StorePair(_orientation_coeff.data() + 4, _coef0, _coef1);
+    StorePair(_orientation_coeff.data() + 6, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 8, Scalar(0), cos_C);
+    StorePair(_orientation_coeff.data() + 10, _coef0, _coef1);
+    StorePair(_orientation_coeff.data() + 12, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 14, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 16, Scalar(0), -cos_C);
+    StorePair(_orientation_coeff.data() + 18, -_coef0, -_coef1);
+    StorePair(_orientation_coeff.data() + 20, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 22, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 24, -cos_C, -sin_C);
+    StorePair(_orientation_coeff.data() + 26, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 28, Scalar(0), _coef14);
+    StorePair(_orientation_coeff.data() + 30, -_coef1, -cos_C);
+    StorePair(_orientation_coeff.data() + 32, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 34, Scalar(0), -Scalar(1));
+    StorePair(_orientation_coeff.data() + 36, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 38, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 40, -_coef18, -sin_C);
+    StorePair(_orientation_coeff.data() + 42, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 44, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 46, -sin_C, _coef21);
+    StorePair(_orientation_coeff.data() + 48, _coef22, Scalar(0));
+    StorePair(_orientation_coeff.data() + 50, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 52, -sin_C, _coef21);
+    StorePair(_orientation_coeff.data() + 54, _coef22, Scalar(0));
+    StorePair(_orientation_coeff.data() + 56, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 58, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 60, sin_C, -_coef21);
+    StorePair(_orientation_coeff.data() + 62, -_coef22, Scalar(0));
+    StorePair(_orientation_coeff.data() + 64, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 66, Scalar(0), sin_C);
+    StorePair(_orientation_coeff.data() + 68, -cos_C, Scalar(0));
+    StorePair(_orientation_coeff.data() + 70, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 72, _coef33, -_coef22);
+    StorePair(_orientation_coeff.data() + 74, sin_C, Scalar(0));
+    StorePair(_orientation_coeff.data() + 76, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 78, Scalar(0), -Scalar(1));
+    StorePair(_orientation_coeff.data() + 80, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 82, Scalar(0), sin_C);
+    StorePair(_orientation_coeff.data() + 84, -_coef18, Scalar(0));
+    StorePair(_orientation_coeff.data() + 86, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 88, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 90, -sin_A, cos_A);
+    StorePair(_orientation_coeff.data() + 92, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 94, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 96, -sin_A, cos_A);
+    StorePair(_orientation_coeff.data() + 98, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 100, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 102, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 104, sin_A, -cos_A);
+    StorePair(_orientation_coeff.data() + 106, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 108, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 110, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 112, -Scalar(1), Scalar(0));
+    StorePair(_orientation_coeff.data() + 114, Scalar(0), sin_A);
+    StorePair(_orientation_coeff.data() + 116, -_coef42, Scalar(0));
+    StorePair(_orientation_coeff.data() + 118, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 120, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 122, Scalar(0), -Scalar(1));
+    StorePair(_orientation_coeff.data() + 124, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 126, Scalar(0), Scalar(0));
     _orientation_coeff[128] = -Scalar(1);
   }
 }
@@ -1169,20 +931,15 @@ void NominalPose([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
   // Outputs
   if (position != nullptr) {
     auto& _position = *position;
-    _position[0] = cos_C * X + sin_A * sin_C * Z - cos_A * sin_C * Y - sin_A * sin_C * tool_length;
-    _position[1] = cos_C * sin_A * Z - cos_A * cos_C * Y - cos_C * sin_A * tool_length - sin_C * X;
+    StorePair(_position.data(), cos_C * X + sin_A * sin_C * Z - cos_A * sin_C * Y - sin_A * sin_C * tool_length, cos_C * sin_A * Z - cos_A * cos_C * Y - cos_C * sin_A * tool_length - sin_C * X);
     _position[2] = cos_A * Z + sin_A * Y - c_above_a - cos_A * tool_length;
   }
   if (rotation != nullptr) {
     auto& _rotation = *rotation;
-    _rotation[0] = cos_C;
-    _rotation[1] = cos_A * sin_C;
-    _rotation[2] = sin_A * sin_C;
-    _rotation[3] = -sin_C;
-    _rotation[4] = cos_A * cos_C;
-    _rotation[5] = cos_C * sin_A;
-    _rotation[6] = Scalar(0);
-    _rotation[7] = -sin_A;
+    StorePair(_rotation.data(), cos_C, cos_A * sin_C);
+    StorePair(_rotation.data() + 2, sin_A * sin_C, -sin_C);
+    StorePair(_rotation.data() + 4, cos_A * cos_C, cos_C * sin_A);
+    StorePair(_rotation.data() + 6, Scalar(0), -sin_A);
     _rotation[8] = cos_A;
   }
 }
@@ -1215,36 +972,21 @@ void NominalJacobian([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
   // Outputs
   if (jacobian != nullptr) {
     auto& _jacobian = *jacobian;
-    _jacobian[0] = cos_C;
-    _jacobian[1] = sin_A * sin_C;
-    _jacobian[2] = -cos_A * sin_C;
-    _jacobian[3] = _to_base0 * (cos_A * sin_C * Z + sin_A * sin_C * Y - cos_A * sin_C * tool_length);
-    _jacobian[4] = _to_base0 * (cos_C * sin_A * Z - cos_A * cos_C * Y - cos_C * sin_A * tool_length - sin_C * X);
-    _jacobian[5] = -sin_C;
-    _jacobian[6] = cos_C * sin_A;
-    _jacobian[7] = -cos_A * cos_C;
-    _jacobian[8] = _to_base0 * (cos_A * cos_C * Z + cos_C * sin_A * Y - cos_A * cos_C * tool_length);
-    _jacobian[9] = -_to_base0 * (cos_C * X + sin_A * sin_C * Z - cos_A * sin_C * Y - sin_A * sin_C * tool_length);
-    _jacobian[10] = Scalar(0);
-    _jacobian[11] = cos_A;
-    _jacobian[12] = sin_A;
-    _jacobian[13] = -_to_base0 * (sin_A * Z - cos_A * Y - sin_A * tool_length);
-    _jacobian[14] = Scalar(0);
-    _jacobian[15] = Scalar(0);
-    _jacobian[16] = Scalar(0);
-    _jacobian[17] = Scalar(0);
-    _jacobian[18] = -_to_base0 * cos_C;
-    _jacobian[19] = Scalar(0);
-    _jacobian[20] = Scalar(0);
-    _jacobian[21] = Scalar(0);
-    _jacobian[22] = Scalar(0);
-    _jacobian[23] = _to_base0 * sin_C;
-    _jacobian[24] = Scalar(0);
-    _jacobian[25] = Scalar(0);
-    _jacobian[26] = Scalar(0);
-    _jacobian[27] = Scalar(0);
-    _jacobian[28] = Scalar(0);
-    _jacobian[29] = -_to_base0;
+    StorePair(_jacobian.data(), cos_C, sin_A * sin_C);
+    StorePair(_jacobian.data() + 2, -cos_A * sin_C, _to_base0 * (cos_A * sin_C * Z + sin_A * sin_C * Y - cos_A * sin_C * tool_length));
+    StorePair(_jacobian.data() + 4, _to_base0 * (cos_C * sin_A * Z - cos_A * cos_C * Y - cos_C * sin_A * tool_length - sin_C * X), -sin_C);
+    StorePair(_jacobian.data() + 6, cos_C * sin_A, -cos_A * cos_C);
+    StorePair(_jacobian.data() + 8, _to_base0 * (cos_A * cos_C * Z + cos_C * sin_A * Y - cos_A * cos_C * tool_length), -_to_base0 * (cos_C * X + sin_A * sin_C * Z - cos_A * sin_C * Y - sin_A * sin_C * tool_length));
+    StorePair(_jacobian.data() + 10, Scalar(0), cos_A);
+    StorePair(_jacobian.data() + 12, sin_A, -_to_base0 * (sin_A * Z - cos_A * Y - sin_A * tool_length));
+    StorePair(_jacobian.data() + 14, Scalar(0), Scalar(0));
+    StorePair(_jacobian.data() + 16, Scalar(0), Scalar(0));
+    StorePair(_jacobian.data() + 18, -_to_base0 * cos_C, Scalar(0));
+    StorePair(_jacobian.data() + 20, Scalar(0), Scalar(0));
+    StorePair(_jacobian.data() + 22, Scalar(0), _to_base0 * sin_C);
+    StorePair(_jacobian.data() + 24, Scalar(0), Scalar(0));
+    StorePair(_jacobian.data() + 26, Scalar(0), Scalar(0));
+    StorePair(_jacobian.data() + 28, Scalar(0), -_to_base0);
   }
 }
 

@@ -4,9 +4,9 @@
 // Units: axes as in kAxes (mm, deg), errors in base units (mm, rad), parameters in mm/deg;
 //        position outputs dx, dy, dz in mm, orientation outputs da, db, dc in rad.
 // Operation counts (after common-subexpression elimination):
-//   Deviation:    50 (adds 33, muls 17, divs 0, functions 0), 0 temporaries
+//   Deviation:    41 (adds 33, muls 8, divs 0, functions 0), 0 temporaries
 //   Coefficients: 2 (adds 2, muls 0, divs 0, functions 0), 0 temporaries
-//   DeviationAndCoefficients: 50 (adds 33, muls 17, divs 0, functions 0), 0 temporaries
+//   DeviationAndCoefficients: 41 (adds 33, muls 8, divs 0, functions 0), 0 temporaries
 //   NominalPose:  1 (adds 1, muls 0, divs 0, functions 0), 0 temporaries
 //   NominalJacobian: 0 (adds 0, muls 0, divs 0, functions 0), 0 temporaries
 //   Compensate:   per iteration errors_at + Deviation + NominalPose + 3x3 least-squares step; once per call NominalJacobian + NominalPose + Cholesky
@@ -15,6 +15,10 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <type_traits>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace weilgen_models {
 namespace gantry_grinder {
@@ -138,6 +142,24 @@ inline constexpr std::size_t tool_length = 0;
 inline constexpr std::array<std::array<int, 1>, kNumHigherTerms> kHigherTerms = {{
 }};
 
+// out[0] = first, out[1] = second: two neighbouring outputs. With SSE2, a double pair is one
+// 16-byte store; compilers store mixed pairs (a constant and a symbol) one by one otherwise, and
+// the stores, not the arithmetic, bound the generated functions (docs/performance.md). The values
+// convert to Scalar (expression-template scalars). Deviation, Coefficients and
+// DeviationAndCoefficients are declared inline (a hint that raises the compiler's size limit):
+// a small model's function then becomes part of the caller's loop, without the call.
+template <typename Scalar>
+inline void StorePair(Scalar* const out, const std::common_type_t<Scalar>& first,
+                      const std::common_type_t<Scalar>& second) {
+  out[0] = first;
+  out[1] = second;
+}
+#if defined(__SSE2__)
+inline void StorePair(double* const out, const double first, const double second) {
+  _mm_storeu_pd(out, _mm_set_pd(second, first));
+}
+#endif
+
 // Deviation of the tool point relative to the workpiece, in the workpiece frame:
 // position = (dx, dy, dz) in mm, orientation = (da, db, dc) in rad. Null outputs are
 // skipped. Exact in the algebra of order kOrder.
@@ -145,11 +167,11 @@ inline constexpr std::array<std::array<int, 1>, kNumHigherTerms> kHigherTerms = 
 //   errors: E_XX, E_YX, E_ZX, E_AX, E_BX, E_CX, E_C0X, E_XZ, E_YZ, E_ZZ, E_AZ, E_BZ, E_CZ, E_B0Z, E_A0Z, E_XY, E_YY, E_ZY, E_AY, E_BY, E_CY
 //   params: tool_length
 template <typename Scalar>
-void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
-               [[maybe_unused]] const std::array<Scalar, kNumErrors>& errors,
-               [[maybe_unused]] const std::array<Scalar, kNumParams>& params,
-               std::array<Scalar, 3>* const position,
-               std::array<Scalar, 3>* const orientation = nullptr) {
+inline void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
+                      [[maybe_unused]] const std::array<Scalar, kNumErrors>& errors,
+                      [[maybe_unused]] const std::array<Scalar, kNumParams>& params,
+                      std::array<Scalar, 3>* const position,
+                      std::array<Scalar, 3>* const orientation = nullptr) {
   using std::cos;
   using std::sin;
   using std::sqrt;
@@ -188,14 +210,12 @@ void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
   // Outputs
   if (position != nullptr) {
     auto& _position = *position;
-    _position[0] = E_XY + E_XZ + E_C0X * Y + E_CX * Y - E_XX - E_B0Z * tool_length - E_BX * _coef0 - E_BY * tool_length - E_BZ * tool_length - E_CZ * Y;
-    _position[1] = E_YY + E_YZ + E_A0Z * tool_length + E_AX * _coef0 + E_AY * tool_length + E_AZ * tool_length + E_C0X * X + E_CX * X - E_YX;
-    _position[2] = E_ZY + E_ZZ + E_A0Z * Y + E_AZ * Y - E_ZX - E_AX * Y - E_BX * X;
+    StorePair(_position.data(), E_XY + E_XZ + (E_C0X + E_CX - E_CZ) * Y - E_XX - E_BX * _coef0 - (E_B0Z + E_BY + E_BZ) * tool_length, E_YY + E_YZ + E_AX * _coef0 + (E_A0Z + E_AY + E_AZ) * tool_length + (E_C0X + E_CX) * X - E_YX);
+    _position[2] = E_ZY + E_ZZ + (E_A0Z + E_AZ - E_AX) * Y - E_ZX - E_BX * X;
   }
   if (orientation != nullptr) {
     auto& _orientation = *orientation;
-    _orientation[0] = E_A0Z + E_AY + E_AZ - E_AX;
-    _orientation[1] = E_B0Z + E_BY + E_BZ - E_BX;
+    StorePair(_orientation.data(), E_A0Z + E_AY + E_AZ - E_AX, E_B0Z + E_BY + E_BZ - E_BX);
     _orientation[2] = E_CY + E_CZ - E_C0X - E_CX;
   }
 }
@@ -204,10 +224,10 @@ void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
 // position_coeff rows dx, dy, dz (mm per base unit of the error), orientation_coeff rows
 // da, db, dc (rad per base unit).
 template <typename Scalar>
-void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
-                  [[maybe_unused]] const std::array<Scalar, kNumParams>& params,
-                  std::array<Scalar, 3 * kNumErrors>* const position_coeff,
-                  std::array<Scalar, 3 * kNumErrors>* const orientation_coeff = nullptr) {
+inline void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
+                         [[maybe_unused]] const std::array<Scalar, kNumParams>& params,
+                         std::array<Scalar, 3 * kNumErrors>* const position_coeff,
+                         std::array<Scalar, 3 * kNumErrors>* const orientation_coeff = nullptr) {
   using std::cos;
   using std::sin;
   using std::sqrt;
@@ -222,134 +242,72 @@ void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
   // Outputs
   if (position_coeff != nullptr) {
     auto& _position_coeff = *position_coeff;
-    _position_coeff[0] = -Scalar(1);
-    _position_coeff[1] = Scalar(0);
-    _position_coeff[2] = Scalar(0);
-    _position_coeff[3] = Scalar(0);
-    _position_coeff[4] = tool_length - Z;
-    _position_coeff[5] = Y;
-    _position_coeff[6] = Y;
-    _position_coeff[7] = Scalar(1);
-    _position_coeff[8] = Scalar(0);
-    _position_coeff[9] = Scalar(0);
-    _position_coeff[10] = Scalar(0);
-    _position_coeff[11] = -tool_length;
-    _position_coeff[12] = -Y;
-    _position_coeff[13] = -tool_length;
-    _position_coeff[14] = Scalar(0);
-    _position_coeff[15] = Scalar(1);
-    _position_coeff[16] = Scalar(0);
-    _position_coeff[17] = Scalar(0);
-    _position_coeff[18] = Scalar(0);
-    _position_coeff[19] = -tool_length;
-    _position_coeff[20] = Scalar(0);
-    _position_coeff[21] = Scalar(0);
-    _position_coeff[22] = -Scalar(1);
-    _position_coeff[23] = Scalar(0);
-    _position_coeff[24] = Z - tool_length;
-    _position_coeff[25] = Scalar(0);
-    _position_coeff[26] = X;
-    _position_coeff[27] = X;
-    _position_coeff[28] = Scalar(0);
-    _position_coeff[29] = Scalar(1);
-    _position_coeff[30] = Scalar(0);
-    _position_coeff[31] = tool_length;
-    _position_coeff[32] = Scalar(0);
-    _position_coeff[33] = Scalar(0);
-    _position_coeff[34] = Scalar(0);
-    _position_coeff[35] = tool_length;
-    _position_coeff[36] = Scalar(0);
-    _position_coeff[37] = Scalar(1);
-    _position_coeff[38] = Scalar(0);
-    _position_coeff[39] = tool_length;
-    _position_coeff[40] = Scalar(0);
-    _position_coeff[41] = Scalar(0);
-    _position_coeff[42] = Scalar(0);
-    _position_coeff[43] = Scalar(0);
-    _position_coeff[44] = -Scalar(1);
-    _position_coeff[45] = -Y;
-    _position_coeff[46] = -X;
-    _position_coeff[47] = Scalar(0);
-    _position_coeff[48] = Scalar(0);
-    _position_coeff[49] = Scalar(0);
-    _position_coeff[50] = Scalar(0);
-    _position_coeff[51] = Scalar(1);
-    _position_coeff[52] = Y;
-    _position_coeff[53] = Scalar(0);
-    _position_coeff[54] = Scalar(0);
-    _position_coeff[55] = Scalar(0);
-    _position_coeff[56] = Y;
-    _position_coeff[57] = Scalar(0);
-    _position_coeff[58] = Scalar(0);
-    _position_coeff[59] = Scalar(1);
-    _position_coeff[60] = Scalar(0);
-    _position_coeff[61] = Scalar(0);
+    StorePair(_position_coeff.data(), -Scalar(1), Scalar(0));
+    StorePair(_position_coeff.data() + 2, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 4, tool_length - Z, Y);
+    StorePair(_position_coeff.data() + 6, Y, Scalar(1));
+    StorePair(_position_coeff.data() + 8, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 10, Scalar(0), -tool_length);
+    StorePair(_position_coeff.data() + 12, -Y, -tool_length);
+    StorePair(_position_coeff.data() + 14, Scalar(0), Scalar(1));
+    StorePair(_position_coeff.data() + 16, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 18, Scalar(0), -tool_length);
+    StorePair(_position_coeff.data() + 20, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 22, -Scalar(1), Scalar(0));
+    StorePair(_position_coeff.data() + 24, Z - tool_length, Scalar(0));
+    StorePair(_position_coeff.data() + 26, X, X);
+    StorePair(_position_coeff.data() + 28, Scalar(0), Scalar(1));
+    StorePair(_position_coeff.data() + 30, Scalar(0), tool_length);
+    StorePair(_position_coeff.data() + 32, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 34, Scalar(0), tool_length);
+    StorePair(_position_coeff.data() + 36, Scalar(0), Scalar(1));
+    StorePair(_position_coeff.data() + 38, Scalar(0), tool_length);
+    StorePair(_position_coeff.data() + 40, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 42, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 44, -Scalar(1), -Y);
+    StorePair(_position_coeff.data() + 46, -X, Scalar(0));
+    StorePair(_position_coeff.data() + 48, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 50, Scalar(0), Scalar(1));
+    StorePair(_position_coeff.data() + 52, Y, Scalar(0));
+    StorePair(_position_coeff.data() + 54, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 56, Y, Scalar(0));
+    StorePair(_position_coeff.data() + 58, Scalar(0), Scalar(1));
+    StorePair(_position_coeff.data() + 60, Scalar(0), Scalar(0));
     _position_coeff[62] = Scalar(0);
   }
   if (orientation_coeff != nullptr) {
     auto& _orientation_coeff = *orientation_coeff;
-    _orientation_coeff[0] = Scalar(0);
-    _orientation_coeff[1] = Scalar(0);
-    _orientation_coeff[2] = Scalar(0);
-    _orientation_coeff[3] = -Scalar(1);
-    _orientation_coeff[4] = Scalar(0);
-    _orientation_coeff[5] = Scalar(0);
-    _orientation_coeff[6] = Scalar(0);
-    _orientation_coeff[7] = Scalar(0);
-    _orientation_coeff[8] = Scalar(0);
-    _orientation_coeff[9] = Scalar(0);
-    _orientation_coeff[10] = Scalar(1);
-    _orientation_coeff[11] = Scalar(0);
-    _orientation_coeff[12] = Scalar(0);
-    _orientation_coeff[13] = Scalar(0);
-    _orientation_coeff[14] = Scalar(1);
-    _orientation_coeff[15] = Scalar(0);
-    _orientation_coeff[16] = Scalar(0);
-    _orientation_coeff[17] = Scalar(0);
-    _orientation_coeff[18] = Scalar(1);
-    _orientation_coeff[19] = Scalar(0);
-    _orientation_coeff[20] = Scalar(0);
-    _orientation_coeff[21] = Scalar(0);
-    _orientation_coeff[22] = Scalar(0);
-    _orientation_coeff[23] = Scalar(0);
-    _orientation_coeff[24] = Scalar(0);
-    _orientation_coeff[25] = -Scalar(1);
-    _orientation_coeff[26] = Scalar(0);
-    _orientation_coeff[27] = Scalar(0);
-    _orientation_coeff[28] = Scalar(0);
-    _orientation_coeff[29] = Scalar(0);
-    _orientation_coeff[30] = Scalar(0);
-    _orientation_coeff[31] = Scalar(0);
-    _orientation_coeff[32] = Scalar(1);
-    _orientation_coeff[33] = Scalar(0);
-    _orientation_coeff[34] = Scalar(1);
-    _orientation_coeff[35] = Scalar(0);
-    _orientation_coeff[36] = Scalar(0);
-    _orientation_coeff[37] = Scalar(0);
-    _orientation_coeff[38] = Scalar(0);
-    _orientation_coeff[39] = Scalar(0);
-    _orientation_coeff[40] = Scalar(1);
-    _orientation_coeff[41] = Scalar(0);
-    _orientation_coeff[42] = Scalar(0);
-    _orientation_coeff[43] = Scalar(0);
-    _orientation_coeff[44] = Scalar(0);
-    _orientation_coeff[45] = Scalar(0);
-    _orientation_coeff[46] = Scalar(0);
-    _orientation_coeff[47] = -Scalar(1);
-    _orientation_coeff[48] = -Scalar(1);
-    _orientation_coeff[49] = Scalar(0);
-    _orientation_coeff[50] = Scalar(0);
-    _orientation_coeff[51] = Scalar(0);
-    _orientation_coeff[52] = Scalar(0);
-    _orientation_coeff[53] = Scalar(0);
-    _orientation_coeff[54] = Scalar(1);
-    _orientation_coeff[55] = Scalar(0);
-    _orientation_coeff[56] = Scalar(0);
-    _orientation_coeff[57] = Scalar(0);
-    _orientation_coeff[58] = Scalar(0);
-    _orientation_coeff[59] = Scalar(0);
-    _orientation_coeff[60] = Scalar(0);
-    _orientation_coeff[61] = Scalar(0);
+    StorePair(_orientation_coeff.data(), Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 2, Scalar(0), -Scalar(1));
+    StorePair(_orientation_coeff.data() + 4, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 6, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 8, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 10, Scalar(1), Scalar(0));
+    StorePair(_orientation_coeff.data() + 12, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 14, Scalar(1), Scalar(0));
+    StorePair(_orientation_coeff.data() + 16, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 18, Scalar(1), Scalar(0));
+    StorePair(_orientation_coeff.data() + 20, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 22, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 24, Scalar(0), -Scalar(1));
+    StorePair(_orientation_coeff.data() + 26, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 28, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 30, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 32, Scalar(1), Scalar(0));
+    StorePair(_orientation_coeff.data() + 34, Scalar(1), Scalar(0));
+    StorePair(_orientation_coeff.data() + 36, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 38, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 40, Scalar(1), Scalar(0));
+    StorePair(_orientation_coeff.data() + 42, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 44, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 46, Scalar(0), -Scalar(1));
+    StorePair(_orientation_coeff.data() + 48, -Scalar(1), Scalar(0));
+    StorePair(_orientation_coeff.data() + 50, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 52, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 54, Scalar(1), Scalar(0));
+    StorePair(_orientation_coeff.data() + 56, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 58, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 60, Scalar(0), Scalar(0));
     _orientation_coeff[62] = Scalar(1);
   }
 }
@@ -358,7 +316,7 @@ void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
 // the terms common to both (one common-subexpression pass over both). The same outputs
 // as the two functions, equal to rounding; null outputs are skipped.
 template <typename Scalar>
-void DeviationAndCoefficients(
+inline void DeviationAndCoefficients(
     [[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
     [[maybe_unused]] const std::array<Scalar, kNumErrors>& errors,
     [[maybe_unused]] const std::array<Scalar, kNumParams>& params,
@@ -403,146 +361,82 @@ void DeviationAndCoefficients(
   // Outputs
   if (position != nullptr) {
     auto& _position = *position;
-    _position[0] = E_XY + E_XZ + E_C0X * Y + E_CX * Y - E_XX - E_B0Z * tool_length - E_BX * _coef0 - E_BY * tool_length - E_BZ * tool_length - E_CZ * Y;
-    _position[1] = E_YY + E_YZ + E_A0Z * tool_length + E_AX * _coef0 + E_AY * tool_length + E_AZ * tool_length + E_C0X * X + E_CX * X - E_YX;
-    _position[2] = E_ZY + E_ZZ + E_A0Z * Y + E_AZ * Y - E_ZX - E_AX * Y - E_BX * X;
+    StorePair(_position.data(), E_XY + E_XZ + (E_C0X + E_CX - E_CZ) * Y - E_XX - E_BX * _coef0 - (E_B0Z + E_BY + E_BZ) * tool_length, E_YY + E_YZ + E_AX * _coef0 + (E_A0Z + E_AY + E_AZ) * tool_length + (E_C0X + E_CX) * X - E_YX);
+    _position[2] = E_ZY + E_ZZ + (E_A0Z + E_AZ - E_AX) * Y - E_ZX - E_BX * X;
   }
   if (orientation != nullptr) {
     auto& _orientation = *orientation;
-    _orientation[0] = E_A0Z + E_AY + E_AZ - E_AX;
-    _orientation[1] = E_B0Z + E_BY + E_BZ - E_BX;
+    StorePair(_orientation.data(), E_A0Z + E_AY + E_AZ - E_AX, E_B0Z + E_BY + E_BZ - E_BX);
     _orientation[2] = E_CY + E_CZ - E_C0X - E_CX;
   }
   if (position_coeff != nullptr) {
     auto& _position_coeff = *position_coeff;
-    _position_coeff[0] = -Scalar(1);
-    _position_coeff[1] = Scalar(0);
-    _position_coeff[2] = Scalar(0);
-    _position_coeff[3] = Scalar(0);
-    _position_coeff[4] = -_coef0;
-    _position_coeff[5] = Y;
-    _position_coeff[6] = Y;
-    _position_coeff[7] = Scalar(1);
-    _position_coeff[8] = Scalar(0);
-    _position_coeff[9] = Scalar(0);
-    _position_coeff[10] = Scalar(0);
-    _position_coeff[11] = -tool_length;
-    _position_coeff[12] = -Y;
-    _position_coeff[13] = -tool_length;
-    _position_coeff[14] = Scalar(0);
-    _position_coeff[15] = Scalar(1);
-    _position_coeff[16] = Scalar(0);
-    _position_coeff[17] = Scalar(0);
-    _position_coeff[18] = Scalar(0);
-    _position_coeff[19] = -tool_length;
-    _position_coeff[20] = Scalar(0);
-    _position_coeff[21] = Scalar(0);
-    _position_coeff[22] = -Scalar(1);
-    _position_coeff[23] = Scalar(0);
-    _position_coeff[24] = _coef0;
-    _position_coeff[25] = Scalar(0);
-    _position_coeff[26] = X;
-    _position_coeff[27] = X;
-    _position_coeff[28] = Scalar(0);
-    _position_coeff[29] = Scalar(1);
-    _position_coeff[30] = Scalar(0);
-    _position_coeff[31] = tool_length;
-    _position_coeff[32] = Scalar(0);
-    _position_coeff[33] = Scalar(0);
-    _position_coeff[34] = Scalar(0);
-    _position_coeff[35] = tool_length;
-    _position_coeff[36] = Scalar(0);
-    _position_coeff[37] = Scalar(1);
-    _position_coeff[38] = Scalar(0);
-    _position_coeff[39] = tool_length;
-    _position_coeff[40] = Scalar(0);
-    _position_coeff[41] = Scalar(0);
-    _position_coeff[42] = Scalar(0);
-    _position_coeff[43] = Scalar(0);
-    _position_coeff[44] = -Scalar(1);
-    _position_coeff[45] = -Y;
-    _position_coeff[46] = -X;
-    _position_coeff[47] = Scalar(0);
-    _position_coeff[48] = Scalar(0);
-    _position_coeff[49] = Scalar(0);
-    _position_coeff[50] = Scalar(0);
-    _position_coeff[51] = Scalar(1);
-    _position_coeff[52] = Y;
-    _position_coeff[53] = Scalar(0);
-    _position_coeff[54] = Scalar(0);
-    _position_coeff[55] = Scalar(0);
-    _position_coeff[56] = Y;
-    _position_coeff[57] = Scalar(0);
-    _position_coeff[58] = Scalar(0);
-    _position_coeff[59] = Scalar(1);
-    _position_coeff[60] = Scalar(0);
-    _position_coeff[61] = Scalar(0);
+    StorePair(_position_coeff.data(), -Scalar(1), Scalar(0));
+    StorePair(_position_coeff.data() + 2, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 4, -_coef0, Y);
+    StorePair(_position_coeff.data() + 6, Y, Scalar(1));
+    StorePair(_position_coeff.data() + 8, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 10, Scalar(0), -tool_length);
+    StorePair(_position_coeff.data() + 12, -Y, -tool_length);
+    StorePair(_position_coeff.data() + 14, Scalar(0), Scalar(1));
+    StorePair(_position_coeff.data() + 16, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 18, Scalar(0), -tool_length);
+    StorePair(_position_coeff.data() + 20, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 22, -Scalar(1), Scalar(0));
+    StorePair(_position_coeff.data() + 24, _coef0, Scalar(0));
+    StorePair(_position_coeff.data() + 26, X, X);
+    StorePair(_position_coeff.data() + 28, Scalar(0), Scalar(1));
+    StorePair(_position_coeff.data() + 30, Scalar(0), tool_length);
+    StorePair(_position_coeff.data() + 32, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 34, Scalar(0), tool_length);
+    StorePair(_position_coeff.data() + 36, Scalar(0), Scalar(1));
+    StorePair(_position_coeff.data() + 38, Scalar(0), tool_length);
+    StorePair(_position_coeff.data() + 40, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 42, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 44, -Scalar(1), -Y);
+    StorePair(_position_coeff.data() + 46, -X, Scalar(0));
+    StorePair(_position_coeff.data() + 48, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 50, Scalar(0), Scalar(1));
+    StorePair(_position_coeff.data() + 52, Y, Scalar(0));
+    StorePair(_position_coeff.data() + 54, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 56, Y, Scalar(0));
+    StorePair(_position_coeff.data() + 58, Scalar(0), Scalar(1));
+    StorePair(_position_coeff.data() + 60, Scalar(0), Scalar(0));
     _position_coeff[62] = Scalar(0);
   }
   if (orientation_coeff != nullptr) {
     auto& _orientation_coeff = *orientation_coeff;
-    _orientation_coeff[0] = Scalar(0);
-    _orientation_coeff[1] = Scalar(0);
-    _orientation_coeff[2] = Scalar(0);
-    _orientation_coeff[3] = -Scalar(1);
-    _orientation_coeff[4] = Scalar(0);
-    _orientation_coeff[5] = Scalar(0);
-    _orientation_coeff[6] = Scalar(0);
-    _orientation_coeff[7] = Scalar(0);
-    _orientation_coeff[8] = Scalar(0);
-    _orientation_coeff[9] = Scalar(0);
-    _orientation_coeff[10] = Scalar(1);
-    _orientation_coeff[11] = Scalar(0);
-    _orientation_coeff[12] = Scalar(0);
-    _orientation_coeff[13] = Scalar(0);
-    _orientation_coeff[14] = Scalar(1);
-    _orientation_coeff[15] = Scalar(0);
-    _orientation_coeff[16] = Scalar(0);
-    _orientation_coeff[17] = Scalar(0);
-    _orientation_coeff[18] = Scalar(1);
-    _orientation_coeff[19] = Scalar(0);
-    _orientation_coeff[20] = Scalar(0);
-    _orientation_coeff[21] = Scalar(0);
-    _orientation_coeff[22] = Scalar(0);
-    _orientation_coeff[23] = Scalar(0);
-    _orientation_coeff[24] = Scalar(0);
-    _orientation_coeff[25] = -Scalar(1);
-    _orientation_coeff[26] = Scalar(0);
-    _orientation_coeff[27] = Scalar(0);
-    _orientation_coeff[28] = Scalar(0);
-    _orientation_coeff[29] = Scalar(0);
-    _orientation_coeff[30] = Scalar(0);
-    _orientation_coeff[31] = Scalar(0);
-    _orientation_coeff[32] = Scalar(1);
-    _orientation_coeff[33] = Scalar(0);
-    _orientation_coeff[34] = Scalar(1);
-    _orientation_coeff[35] = Scalar(0);
-    _orientation_coeff[36] = Scalar(0);
-    _orientation_coeff[37] = Scalar(0);
-    _orientation_coeff[38] = Scalar(0);
-    _orientation_coeff[39] = Scalar(0);
-    _orientation_coeff[40] = Scalar(1);
-    _orientation_coeff[41] = Scalar(0);
-    _orientation_coeff[42] = Scalar(0);
-    _orientation_coeff[43] = Scalar(0);
-    _orientation_coeff[44] = Scalar(0);
-    _orientation_coeff[45] = Scalar(0);
-    _orientation_coeff[46] = Scalar(0);
-    _orientation_coeff[47] = -Scalar(1);
-    _orientation_coeff[48] = -Scalar(1);
-    _orientation_coeff[49] = Scalar(0);
-    _orientation_coeff[50] = Scalar(0);
-    _orientation_coeff[51] = Scalar(0);
-    _orientation_coeff[52] = Scalar(0);
-    _orientation_coeff[53] = Scalar(0);
-    _orientation_coeff[54] = Scalar(1);
-    _orientation_coeff[55] = Scalar(0);
-    _orientation_coeff[56] = Scalar(0);
-    _orientation_coeff[57] = Scalar(0);
-    _orientation_coeff[58] = Scalar(0);
-    _orientation_coeff[59] = Scalar(0);
-    _orientation_coeff[60] = Scalar(0);
-    _orientation_coeff[61] = Scalar(0);
+    StorePair(_orientation_coeff.data(), Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 2, Scalar(0), -Scalar(1));
+    StorePair(_orientation_coeff.data() + 4, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 6, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 8, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 10, Scalar(1), Scalar(0));
+    StorePair(_orientation_coeff.data() + 12, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 14, Scalar(1), Scalar(0));
+    StorePair(_orientation_coeff.data() + 16, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 18, Scalar(1), Scalar(0));
+    StorePair(_orientation_coeff.data() + 20, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 22, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 24, Scalar(0), -Scalar(1));
+    StorePair(_orientation_coeff.data() + 26, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 28, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 30, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 32, Scalar(1), Scalar(0));
+    StorePair(_orientation_coeff.data() + 34, Scalar(1), Scalar(0));
+    StorePair(_orientation_coeff.data() + 36, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 38, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 40, Scalar(1), Scalar(0));
+    StorePair(_orientation_coeff.data() + 42, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 44, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 46, Scalar(0), -Scalar(1));
+    StorePair(_orientation_coeff.data() + 48, -Scalar(1), Scalar(0));
+    StorePair(_orientation_coeff.data() + 50, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 52, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 54, Scalar(1), Scalar(0));
+    StorePair(_orientation_coeff.data() + 56, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 58, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 60, Scalar(0), Scalar(0));
     _orientation_coeff[62] = Scalar(1);
   }
 }
@@ -568,20 +462,15 @@ void NominalPose([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
   // Outputs
   if (position != nullptr) {
     auto& _position = *position;
-    _position[0] = -X;
-    _position[1] = Y;
+    StorePair(_position.data(), -X, Y);
     _position[2] = Z - tool_length;
   }
   if (rotation != nullptr) {
     auto& _rotation = *rotation;
-    _rotation[0] = Scalar(1);
-    _rotation[1] = Scalar(0);
-    _rotation[2] = Scalar(0);
-    _rotation[3] = Scalar(0);
-    _rotation[4] = Scalar(1);
-    _rotation[5] = Scalar(0);
-    _rotation[6] = Scalar(0);
-    _rotation[7] = Scalar(0);
+    StorePair(_rotation.data(), Scalar(1), Scalar(0));
+    StorePair(_rotation.data() + 2, Scalar(0), Scalar(0));
+    StorePair(_rotation.data() + 4, Scalar(1), Scalar(0));
+    StorePair(_rotation.data() + 6, Scalar(0), Scalar(0));
     _rotation[8] = Scalar(1);
   }
 }
@@ -603,24 +492,15 @@ void NominalJacobian([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
   // Outputs
   if (jacobian != nullptr) {
     auto& _jacobian = *jacobian;
-    _jacobian[0] = -Scalar(1);
-    _jacobian[1] = Scalar(0);
-    _jacobian[2] = Scalar(0);
-    _jacobian[3] = Scalar(0);
-    _jacobian[4] = Scalar(0);
-    _jacobian[5] = Scalar(1);
-    _jacobian[6] = Scalar(0);
-    _jacobian[7] = Scalar(1);
-    _jacobian[8] = Scalar(0);
-    _jacobian[9] = Scalar(0);
-    _jacobian[10] = Scalar(0);
-    _jacobian[11] = Scalar(0);
-    _jacobian[12] = Scalar(0);
-    _jacobian[13] = Scalar(0);
-    _jacobian[14] = Scalar(0);
-    _jacobian[15] = Scalar(0);
-    _jacobian[16] = Scalar(0);
-    _jacobian[17] = Scalar(0);
+    StorePair(_jacobian.data(), -Scalar(1), Scalar(0));
+    StorePair(_jacobian.data() + 2, Scalar(0), Scalar(0));
+    StorePair(_jacobian.data() + 4, Scalar(0), Scalar(1));
+    StorePair(_jacobian.data() + 6, Scalar(0), Scalar(1));
+    StorePair(_jacobian.data() + 8, Scalar(0), Scalar(0));
+    StorePair(_jacobian.data() + 10, Scalar(0), Scalar(0));
+    StorePair(_jacobian.data() + 12, Scalar(0), Scalar(0));
+    StorePair(_jacobian.data() + 14, Scalar(0), Scalar(0));
+    StorePair(_jacobian.data() + 16, Scalar(0), Scalar(0));
   }
 }
 

@@ -4,9 +4,9 @@
 // Units: axes as in kAxes (mm, deg), errors in base units (mm, rad), parameters in mm/deg;
 //        position outputs dx, dy, dz in mm, orientation outputs da, db, dc in rad.
 // Operation counts (after common-subexpression elimination):
-//   Deviation:    249 (adds 142, muls 103, divs 0, functions 4), 20 temporaries
+//   Deviation:    234 (adds 139, muls 91, divs 0, functions 4), 22 temporaries
 //   Coefficients: 92 (adds 54, muls 34, divs 0, functions 4), 37 temporaries
-//   DeviationAndCoefficients: 249 (adds 142, muls 103, divs 0, functions 4), 20 temporaries
+//   DeviationAndCoefficients: 234 (adds 139, muls 91, divs 0, functions 4), 22 temporaries
 //   NominalPose:  29 (adds 7, muls 18, divs 0, functions 4), 0 temporaries
 //   NominalJacobian: 38 (adds 5, muls 29, divs 0, functions 4), 0 temporaries
 //   Compensate:   per iteration errors_at + Deviation + NominalPose + 6x5 least-squares step; once per call NominalJacobian + NominalPose + Cholesky
@@ -15,6 +15,10 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <type_traits>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace weilgen_models {
 namespace head_head_bc {
@@ -190,6 +194,24 @@ inline constexpr std::size_t c_to_b = 2;
 inline constexpr std::array<std::array<int, 1>, kNumHigherTerms> kHigherTerms = {{
 }};
 
+// out[0] = first, out[1] = second: two neighbouring outputs. With SSE2, a double pair is one
+// 16-byte store; compilers store mixed pairs (a constant and a symbol) one by one otherwise, and
+// the stores, not the arithmetic, bound the generated functions (docs/performance.md). The values
+// convert to Scalar (expression-template scalars). Deviation, Coefficients and
+// DeviationAndCoefficients are declared inline (a hint that raises the compiler's size limit):
+// a small model's function then becomes part of the caller's loop, without the call.
+template <typename Scalar>
+inline void StorePair(Scalar* const out, const std::common_type_t<Scalar>& first,
+                      const std::common_type_t<Scalar>& second) {
+  out[0] = first;
+  out[1] = second;
+}
+#if defined(__SSE2__)
+inline void StorePair(double* const out, const double first, const double second) {
+  _mm_storeu_pd(out, _mm_set_pd(second, first));
+}
+#endif
+
 // Deviation of the tool point relative to the workpiece, in the workpiece frame:
 // position = (dx, dy, dz) in mm, orientation = (da, db, dc) in rad. Null outputs are
 // skipped. Exact in the algebra of order kOrder.
@@ -197,11 +219,11 @@ inline constexpr std::array<std::array<int, 1>, kNumHigherTerms> kHigherTerms = 
 //   errors: E_XY, E_YY, E_ZY, E_AY, E_BY, E_CY, E_XX, E_YX, E_ZX, E_AX, E_BX, E_CX, E_C0X, E_XZ, E_YZ, E_ZZ, E_AZ, E_BZ, E_CZ, E_A0Z, E_B0Z, E_XC, E_YC, E_ZC, E_AC, E_BC, E_CC, E_X0C, E_Y0C, E_A0C, E_B0C, E_C0C, E_XB, E_YB, E_ZB, E_AB, E_BB, E_CB, E_X0B, E_Z0B, E_A0B, E_C0B, E_B0B
 //   params: tool_length, pivot_length, c_to_b
 template <typename Scalar>
-void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
-               [[maybe_unused]] const std::array<Scalar, kNumErrors>& errors,
-               [[maybe_unused]] const std::array<Scalar, kNumParams>& params,
-               std::array<Scalar, 3>* const position,
-               std::array<Scalar, 3>* const orientation = nullptr) {
+inline void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
+                      [[maybe_unused]] const std::array<Scalar, kNumErrors>& errors,
+                      [[maybe_unused]] const std::array<Scalar, kNumParams>& params,
+                      std::array<Scalar, 3>* const position,
+                      std::array<Scalar, 3>* const orientation = nullptr) {
   using std::cos;
   using std::sin;
   using std::sqrt;
@@ -261,7 +283,7 @@ void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
   const Scalar pivot_length = params[1];
   const Scalar c_to_b = params[2];
 
-  // Intermediate terms (20)
+  // Intermediate terms (22)
   const Scalar _tmp0 = cos_B * pivot_length;
   const Scalar _tmp1 = cos_B * tool_length;
   const Scalar _tmp2 = cos_B * pivot_length * sin_C;
@@ -280,8 +302,10 @@ void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
   const Scalar _tmp15 = pivot_length * sin_B;
   const Scalar _tmp16 = sin_B * tool_length;
   const Scalar _tmp17 = E_B0B + E_BB;
-  const Scalar _tmp18 = E_Z0B - E_ZB;
-  const Scalar _tmp19 = E_C0B - E_CB;
+  const Scalar _tmp18 = E_A0C - E_AC;
+  const Scalar _tmp19 = E_Z0B - E_ZB;
+  const Scalar _tmp20 = E_B0B + E_BB + E_BC;
+  const Scalar _tmp21 = E_C0B - E_CB;
 
   // Coefficients of the error monomials (24)
   const Scalar _coef0 = _tmp0 + _tmp1 + c_to_b - Z;
@@ -312,15 +336,13 @@ void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
   // Outputs
   if (position != nullptr) {
     auto& _position = *position;
-    _position[0] = E_XX + E_XY + E_XZ + E_A0B * _coef12 + E_AB * _coef9 + E_B0Z * Z + E_BC * _coef4 + E_X0B * _coef11 + E_XB * _coef7 + E_XC * cos_C + E_Y0C * sin_C + _coef10 * _tmp17 - E_B0C * _coef6 - E_BZ * _coef2 - E_X0C * _coef5 - E_YB * sin_C - E_YC * sin_C - _coef0 * (E_BX + E_BY) - _coef1 * (E_C0B + E_C0C + E_CC + E_CX + E_CY + E_CZ) - _coef3 * (E_A0C - E_AC) - _coef8 * _tmp18;
-    _position[1] = E_YX + E_YY + E_YZ + E_A0C * _coef6 + E_AZ * _coef2 + E_C0X * X + E_CY * _coef13 + E_X0B * _coef19 + E_XB * _coef15 + E_XC * sin_C + E_YB * cos_C + E_YC * cos_C + _coef0 * (E_AX + E_AY) + _coef14 * (E_C0B + E_C0C + E_CC + E_CX + E_CZ) + _coef18 * _tmp17 - E_A0B * _coef20 - E_A0Z * Z - E_AB * _coef17 - E_AC * _coef4 - E_X0C * sin_C - E_Y0C * _coef5 - _coef16 * _tmp18 - _coef3 * (E_B0C - E_BC);
-    _position[2] = E_ZC + E_ZX + E_ZY + E_ZZ + E_X0B * sin_B + E_ZB * cos_B + _coef1 * (E_A0C + E_AX + E_AY + E_AZ) - E_B0C * _coef22 - E_BY * _coef13 - E_XB * sin_B - E_Z0B * _coef23 - _coef14 * (E_BX + E_BZ) - _coef21 * (E_B0B + E_BB + E_BC);
+    StorePair(_position.data(), E_XX + E_XY + E_XZ + E_A0B * _coef12 + E_AB * _coef9 + E_B0Z * Z + E_BC * _coef4 + E_X0B * _coef11 + E_XB * _coef7 + E_XC * cos_C + _coef10 * _tmp17 + (E_Y0C - E_YB - E_YC) * sin_C - E_B0C * _coef6 - E_BZ * _coef2 - E_X0C * _coef5 - _coef0 * (E_BX + E_BY) - _coef1 * (E_C0B + E_C0C + E_CC + E_CX + E_CY + E_CZ) - _coef3 * _tmp18 - _coef8 * _tmp19, E_YX + E_YY + E_YZ + E_A0C * _coef6 + E_AZ * _coef2 + E_C0X * X + E_CY * _coef13 + E_X0B * _coef19 + E_XB * _coef15 + _coef0 * (E_AX + E_AY) + _coef14 * (E_C0B + E_C0C + E_CC + E_CX + E_CZ) + _coef18 * _tmp17 + (E_YB + E_YC) * cos_C - E_A0B * _coef20 - E_A0Z * Z - E_AB * _coef17 - E_AC * _coef4 - E_Y0C * _coef5 - _coef16 * _tmp19 - _coef3 * (E_B0C - E_BC) - (E_X0C - E_XC) * sin_C);
+    _position[2] = E_ZC + E_ZX + E_ZY + E_ZZ + E_ZB * cos_B + _coef1 * (E_A0C + E_AX + E_AY + E_AZ) + (E_X0B - E_XB) * sin_B - E_B0C * _coef22 - E_BY * _coef13 - E_Z0B * _coef23 - _coef14 * (E_BX + E_BZ) - _coef21 * _tmp20;
   }
   if (orientation != nullptr) {
     auto& _orientation = *orientation;
-    _orientation[0] = E_AX + E_AY + E_AZ + E_A0B * _coef11 + E_AB * _coef7 + E_AC * cos_C + E_B0C * sin_C - E_A0C * _coef5 - E_B0B * sin_C - E_BB * sin_C - E_BC * sin_C - _coef8 * _tmp19;
-    _orientation[1] = E_BX + E_BY + E_BZ + E_A0B * _coef19 + E_AB * _coef15 + E_AC * sin_C + E_B0B * cos_C + E_BB * cos_C + E_BC * cos_C - E_A0C * sin_C - E_B0C * _coef5 - _coef16 * _tmp19;
-    _orientation[2] = E_C0C + E_CC + E_CX + E_CY + E_CZ + E_A0B * sin_B + E_CB * cos_B - E_AB * sin_B - E_C0B * _coef23;
+    StorePair(_orientation.data(), E_AX + E_AY + E_AZ + E_A0B * _coef11 + E_AB * _coef7 + E_AC * cos_C - E_A0C * _coef5 - _coef8 * _tmp21 - (E_B0B + E_BB + E_BC - E_B0C) * sin_C, E_BX + E_BY + E_BZ + E_A0B * _coef19 + E_AB * _coef15 + _tmp20 * cos_C - E_B0C * _coef5 - _coef16 * _tmp21 - _tmp18 * sin_C);
+    _orientation[2] = E_C0C + E_CC + E_CX + E_CY + E_CZ + E_CB * cos_B + (E_A0B - E_AB) * sin_B - E_C0B * _coef23;
   }
 }
 
@@ -328,10 +350,10 @@ void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
 // position_coeff rows dx, dy, dz (mm per base unit of the error), orientation_coeff rows
 // da, db, dc (rad per base unit).
 template <typename Scalar>
-void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
-                  [[maybe_unused]] const std::array<Scalar, kNumParams>& params,
-                  std::array<Scalar, 3 * kNumErrors>* const position_coeff,
-                  std::array<Scalar, 3 * kNumErrors>* const orientation_coeff = nullptr) {
+inline void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
+                         [[maybe_unused]] const std::array<Scalar, kNumParams>& params,
+                         std::array<Scalar, 3 * kNumErrors>* const position_coeff,
+                         std::array<Scalar, 3 * kNumErrors>* const orientation_coeff = nullptr) {
   using std::cos;
   using std::sin;
   using std::sqrt;
@@ -390,266 +412,138 @@ void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
   // Outputs
   if (position_coeff != nullptr) {
     auto& _position_coeff = *position_coeff;
-    _position_coeff[0] = Scalar(1);
-    _position_coeff[1] = Scalar(0);
-    _position_coeff[2] = Scalar(0);
-    _position_coeff[3] = Scalar(0);
-    _position_coeff[4] = -_tmp2;
-    _position_coeff[5] = _tmp5;
-    _position_coeff[6] = Scalar(1);
-    _position_coeff[7] = Scalar(0);
-    _position_coeff[8] = Scalar(0);
-    _position_coeff[9] = Scalar(0);
-    _position_coeff[10] = -_tmp2;
-    _position_coeff[11] = _tmp5;
-    _position_coeff[12] = Scalar(0);
-    _position_coeff[13] = Scalar(1);
-    _position_coeff[14] = Scalar(0);
-    _position_coeff[15] = Scalar(0);
-    _position_coeff[16] = Scalar(0);
-    _position_coeff[17] = -_tmp0 - _tmp1 - c_to_b;
-    _position_coeff[18] = _tmp5;
-    _position_coeff[19] = Scalar(0);
-    _position_coeff[20] = Z;
-    _position_coeff[21] = cos_C;
-    _position_coeff[22] = -sin_C;
-    _position_coeff[23] = Scalar(0);
-    _position_coeff[24] = -_tmp9;
-    _position_coeff[25] = -_tmp10 - _tmp11 - _tmp12;
-    _position_coeff[26] = _tmp5;
-    _position_coeff[27] = -_tmp13;
-    _position_coeff[28] = sin_C;
-    _position_coeff[29] = _tmp14;
-    _position_coeff[30] = _tmp10 + _tmp11 + _tmp12 - _tmp0 - _tmp1 - c_to_b;
-    _position_coeff[31] = _tmp5;
-    _position_coeff[32] = _tmp15;
-    _position_coeff[33] = -sin_C;
-    _position_coeff[34] = _tmp16;
-    _position_coeff[35] = -_tmp17 - _tmp18;
-    _position_coeff[36] = -_tmp19;
-    _position_coeff[37] = Scalar(0);
-    _position_coeff[38] = -_tmp20;
-    _position_coeff[39] = -_tmp16;
-    _position_coeff[40] = _tmp17 + _tmp18 - _tmp7 - _tmp8;
-    _position_coeff[41] = _tmp5;
-    _position_coeff[42] = -_tmp19;
-    _position_coeff[43] = Scalar(0);
-    _position_coeff[44] = Scalar(1);
-    _position_coeff[45] = Scalar(0);
-    _position_coeff[46] = _tmp21;
-    _position_coeff[47] = Scalar(0);
-    _position_coeff[48] = X - _tmp22 - _tmp23;
-    _position_coeff[49] = Scalar(0);
-    _position_coeff[50] = Scalar(1);
-    _position_coeff[51] = Scalar(0);
-    _position_coeff[52] = _tmp21;
-    _position_coeff[53] = Scalar(0);
-    _position_coeff[54] = -_tmp24;
-    _position_coeff[55] = X;
-    _position_coeff[56] = Scalar(0);
-    _position_coeff[57] = Scalar(1);
-    _position_coeff[58] = Scalar(0);
-    _position_coeff[59] = _tmp0 + _tmp1 + c_to_b;
-    _position_coeff[60] = Scalar(0);
-    _position_coeff[61] = -_tmp24;
-    _position_coeff[62] = -Z;
-    _position_coeff[63] = Scalar(0);
-    _position_coeff[64] = sin_C;
-    _position_coeff[65] = cos_C;
-    _position_coeff[66] = Scalar(0);
-    _position_coeff[67] = _tmp10 + _tmp11 + _tmp12;
-    _position_coeff[68] = -_tmp9;
-    _position_coeff[69] = -_tmp24;
-    _position_coeff[70] = -sin_C;
-    _position_coeff[71] = -_tmp13;
-    _position_coeff[72] = _tmp0 + _tmp1 + c_to_b - _tmp10 - _tmp11 - _tmp12;
-    _position_coeff[73] = _tmp14;
-    _position_coeff[74] = -_tmp24;
-    _position_coeff[75] = _tmp25;
-    _position_coeff[76] = cos_C;
-    _position_coeff[77] = _tmp26;
-    _position_coeff[78] = _tmp27 + _tmp28;
-    _position_coeff[79] = -_tmp29;
-    _position_coeff[80] = Scalar(0);
-    _position_coeff[81] = -_tmp30;
-    _position_coeff[82] = -_tmp26;
-    _position_coeff[83] = _tmp11 + _tmp12 - _tmp27 - _tmp28;
-    _position_coeff[84] = -_tmp24;
-    _position_coeff[85] = -_tmp29;
-    _position_coeff[86] = Scalar(0);
-    _position_coeff[87] = Scalar(0);
-    _position_coeff[88] = Scalar(1);
-    _position_coeff[89] = -_tmp31;
-    _position_coeff[90] = _tmp22 + _tmp23 - X;
-    _position_coeff[91] = Scalar(0);
-    _position_coeff[92] = Scalar(0);
-    _position_coeff[93] = Scalar(0);
-    _position_coeff[94] = Scalar(1);
-    _position_coeff[95] = -_tmp31;
-    _position_coeff[96] = _tmp32;
-    _position_coeff[97] = Scalar(0);
-    _position_coeff[98] = Scalar(0);
-    _position_coeff[99] = Scalar(0);
-    _position_coeff[100] = Scalar(0);
-    _position_coeff[101] = Scalar(1);
-    _position_coeff[102] = -_tmp31;
-    _position_coeff[103] = _tmp32;
-    _position_coeff[104] = Scalar(0);
-    _position_coeff[105] = Scalar(0);
-    _position_coeff[106] = Scalar(0);
-    _position_coeff[107] = Scalar(0);
-    _position_coeff[108] = Scalar(0);
-    _position_coeff[109] = Scalar(1);
-    _position_coeff[110] = Scalar(0);
-    _position_coeff[111] = _tmp35;
-    _position_coeff[112] = Scalar(0);
-    _position_coeff[113] = Scalar(0);
-    _position_coeff[114] = Scalar(0);
-    _position_coeff[115] = -_tmp31;
-    _position_coeff[116] = _tmp22 + _tmp23 - _tmp33 - _tmp34;
-    _position_coeff[117] = Scalar(0);
-    _position_coeff[118] = -sin_B;
-    _position_coeff[119] = Scalar(0);
-    _position_coeff[120] = cos_B;
-    _position_coeff[121] = Scalar(0);
-    _position_coeff[122] = _tmp35;
-    _position_coeff[123] = Scalar(0);
-    _position_coeff[124] = sin_B;
-    _position_coeff[125] = -_tmp36;
-    _position_coeff[126] = Scalar(0);
-    _position_coeff[127] = Scalar(0);
+    StorePair(_position_coeff.data(), Scalar(1), Scalar(0));
+    StorePair(_position_coeff.data() + 2, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 4, -_tmp2, _tmp5);
+    StorePair(_position_coeff.data() + 6, Scalar(1), Scalar(0));
+    StorePair(_position_coeff.data() + 8, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 10, -_tmp2, _tmp5);
+    StorePair(_position_coeff.data() + 12, Scalar(0), Scalar(1));
+    StorePair(_position_coeff.data() + 14, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 16, Scalar(0), -_tmp0 - _tmp1 - c_to_b);
+    StorePair(_position_coeff.data() + 18, _tmp5, Scalar(0));
+    StorePair(_position_coeff.data() + 20, Z, cos_C);
+    StorePair(_position_coeff.data() + 22, -sin_C, Scalar(0));
+    StorePair(_position_coeff.data() + 24, -_tmp9, -_tmp10 - _tmp11 - _tmp12);
+    StorePair(_position_coeff.data() + 26, _tmp5, -_tmp13);
+    StorePair(_position_coeff.data() + 28, sin_C, _tmp14);
+    StorePair(_position_coeff.data() + 30, _tmp10 + _tmp11 + _tmp12 - _tmp0 - _tmp1 - c_to_b, _tmp5);
+    StorePair(_position_coeff.data() + 32, _tmp15, -sin_C);
+    StorePair(_position_coeff.data() + 34, _tmp16, -_tmp17 - _tmp18);
+    StorePair(_position_coeff.data() + 36, -_tmp19, Scalar(0));
+    StorePair(_position_coeff.data() + 38, -_tmp20, -_tmp16);
+    StorePair(_position_coeff.data() + 40, _tmp17 + _tmp18 - _tmp7 - _tmp8, _tmp5);
+    StorePair(_position_coeff.data() + 42, -_tmp19, Scalar(0));
+    StorePair(_position_coeff.data() + 44, Scalar(1), Scalar(0));
+    StorePair(_position_coeff.data() + 46, _tmp21, Scalar(0));
+    StorePair(_position_coeff.data() + 48, X - _tmp22 - _tmp23, Scalar(0));
+    StorePair(_position_coeff.data() + 50, Scalar(1), Scalar(0));
+    StorePair(_position_coeff.data() + 52, _tmp21, Scalar(0));
+    StorePair(_position_coeff.data() + 54, -_tmp24, X);
+    StorePair(_position_coeff.data() + 56, Scalar(0), Scalar(1));
+    StorePair(_position_coeff.data() + 58, Scalar(0), _tmp0 + _tmp1 + c_to_b);
+    StorePair(_position_coeff.data() + 60, Scalar(0), -_tmp24);
+    StorePair(_position_coeff.data() + 62, -Z, Scalar(0));
+    StorePair(_position_coeff.data() + 64, sin_C, cos_C);
+    StorePair(_position_coeff.data() + 66, Scalar(0), _tmp10 + _tmp11 + _tmp12);
+    StorePair(_position_coeff.data() + 68, -_tmp9, -_tmp24);
+    StorePair(_position_coeff.data() + 70, -sin_C, -_tmp13);
+    StorePair(_position_coeff.data() + 72, _tmp0 + _tmp1 + c_to_b - _tmp10 - _tmp11 - _tmp12, _tmp14);
+    StorePair(_position_coeff.data() + 74, -_tmp24, _tmp25);
+    StorePair(_position_coeff.data() + 76, cos_C, _tmp26);
+    StorePair(_position_coeff.data() + 78, _tmp27 + _tmp28, -_tmp29);
+    StorePair(_position_coeff.data() + 80, Scalar(0), -_tmp30);
+    StorePair(_position_coeff.data() + 82, -_tmp26, _tmp11 + _tmp12 - _tmp27 - _tmp28);
+    StorePair(_position_coeff.data() + 84, -_tmp24, -_tmp29);
+    StorePair(_position_coeff.data() + 86, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 88, Scalar(1), -_tmp31);
+    StorePair(_position_coeff.data() + 90, _tmp22 + _tmp23 - X, Scalar(0));
+    StorePair(_position_coeff.data() + 92, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 94, Scalar(1), -_tmp31);
+    StorePair(_position_coeff.data() + 96, _tmp32, Scalar(0));
+    StorePair(_position_coeff.data() + 98, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 100, Scalar(0), Scalar(1));
+    StorePair(_position_coeff.data() + 102, -_tmp31, _tmp32);
+    StorePair(_position_coeff.data() + 104, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 106, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 108, Scalar(0), Scalar(1));
+    StorePair(_position_coeff.data() + 110, Scalar(0), _tmp35);
+    StorePair(_position_coeff.data() + 112, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 114, Scalar(0), -_tmp31);
+    StorePair(_position_coeff.data() + 116, _tmp22 + _tmp23 - _tmp33 - _tmp34, Scalar(0));
+    StorePair(_position_coeff.data() + 118, -sin_B, Scalar(0));
+    StorePair(_position_coeff.data() + 120, cos_B, Scalar(0));
+    StorePair(_position_coeff.data() + 122, _tmp35, Scalar(0));
+    StorePair(_position_coeff.data() + 124, sin_B, -_tmp36);
+    StorePair(_position_coeff.data() + 126, Scalar(0), Scalar(0));
     _position_coeff[128] = _tmp35;
   }
   if (orientation_coeff != nullptr) {
     auto& _orientation_coeff = *orientation_coeff;
-    _orientation_coeff[0] = Scalar(0);
-    _orientation_coeff[1] = Scalar(0);
-    _orientation_coeff[2] = Scalar(0);
-    _orientation_coeff[3] = Scalar(1);
-    _orientation_coeff[4] = Scalar(0);
-    _orientation_coeff[5] = Scalar(0);
-    _orientation_coeff[6] = Scalar(0);
-    _orientation_coeff[7] = Scalar(0);
-    _orientation_coeff[8] = Scalar(0);
-    _orientation_coeff[9] = Scalar(1);
-    _orientation_coeff[10] = Scalar(0);
-    _orientation_coeff[11] = Scalar(0);
-    _orientation_coeff[12] = Scalar(0);
-    _orientation_coeff[13] = Scalar(0);
-    _orientation_coeff[14] = Scalar(0);
-    _orientation_coeff[15] = Scalar(0);
-    _orientation_coeff[16] = Scalar(1);
-    _orientation_coeff[17] = Scalar(0);
-    _orientation_coeff[18] = Scalar(0);
-    _orientation_coeff[19] = Scalar(0);
-    _orientation_coeff[20] = Scalar(0);
-    _orientation_coeff[21] = Scalar(0);
-    _orientation_coeff[22] = Scalar(0);
-    _orientation_coeff[23] = Scalar(0);
-    _orientation_coeff[24] = cos_C;
-    _orientation_coeff[25] = -sin_C;
-    _orientation_coeff[26] = Scalar(0);
-    _orientation_coeff[27] = Scalar(0);
-    _orientation_coeff[28] = Scalar(0);
-    _orientation_coeff[29] = -_tmp13;
-    _orientation_coeff[30] = sin_C;
-    _orientation_coeff[31] = Scalar(0);
-    _orientation_coeff[32] = Scalar(0);
-    _orientation_coeff[33] = Scalar(0);
-    _orientation_coeff[34] = Scalar(0);
-    _orientation_coeff[35] = _tmp15;
-    _orientation_coeff[36] = -sin_C;
-    _orientation_coeff[37] = _tmp16;
-    _orientation_coeff[38] = Scalar(0);
-    _orientation_coeff[39] = Scalar(0);
-    _orientation_coeff[40] = -_tmp20;
-    _orientation_coeff[41] = -_tmp16;
-    _orientation_coeff[42] = -sin_C;
-    _orientation_coeff[43] = Scalar(0);
-    _orientation_coeff[44] = Scalar(0);
-    _orientation_coeff[45] = Scalar(0);
-    _orientation_coeff[46] = Scalar(0);
-    _orientation_coeff[47] = Scalar(1);
-    _orientation_coeff[48] = Scalar(0);
-    _orientation_coeff[49] = Scalar(0);
-    _orientation_coeff[50] = Scalar(0);
-    _orientation_coeff[51] = Scalar(0);
-    _orientation_coeff[52] = Scalar(0);
-    _orientation_coeff[53] = Scalar(1);
-    _orientation_coeff[54] = Scalar(0);
-    _orientation_coeff[55] = Scalar(0);
-    _orientation_coeff[56] = Scalar(0);
-    _orientation_coeff[57] = Scalar(0);
-    _orientation_coeff[58] = Scalar(0);
-    _orientation_coeff[59] = Scalar(0);
-    _orientation_coeff[60] = Scalar(1);
-    _orientation_coeff[61] = Scalar(0);
-    _orientation_coeff[62] = Scalar(0);
-    _orientation_coeff[63] = Scalar(0);
-    _orientation_coeff[64] = Scalar(0);
-    _orientation_coeff[65] = Scalar(0);
-    _orientation_coeff[66] = Scalar(0);
-    _orientation_coeff[67] = sin_C;
-    _orientation_coeff[68] = cos_C;
-    _orientation_coeff[69] = Scalar(0);
-    _orientation_coeff[70] = Scalar(0);
-    _orientation_coeff[71] = Scalar(0);
-    _orientation_coeff[72] = -sin_C;
-    _orientation_coeff[73] = -_tmp13;
-    _orientation_coeff[74] = Scalar(0);
-    _orientation_coeff[75] = Scalar(0);
-    _orientation_coeff[76] = Scalar(0);
-    _orientation_coeff[77] = Scalar(0);
-    _orientation_coeff[78] = _tmp25;
-    _orientation_coeff[79] = cos_C;
-    _orientation_coeff[80] = _tmp26;
-    _orientation_coeff[81] = Scalar(0);
-    _orientation_coeff[82] = Scalar(0);
-    _orientation_coeff[83] = -_tmp30;
-    _orientation_coeff[84] = -_tmp26;
-    _orientation_coeff[85] = cos_C;
-    _orientation_coeff[86] = Scalar(0);
-    _orientation_coeff[87] = Scalar(0);
-    _orientation_coeff[88] = Scalar(0);
-    _orientation_coeff[89] = Scalar(0);
-    _orientation_coeff[90] = Scalar(0);
-    _orientation_coeff[91] = Scalar(1);
-    _orientation_coeff[92] = Scalar(0);
-    _orientation_coeff[93] = Scalar(0);
-    _orientation_coeff[94] = Scalar(0);
-    _orientation_coeff[95] = Scalar(0);
-    _orientation_coeff[96] = Scalar(0);
-    _orientation_coeff[97] = Scalar(1);
-    _orientation_coeff[98] = Scalar(0);
-    _orientation_coeff[99] = Scalar(0);
-    _orientation_coeff[100] = Scalar(0);
-    _orientation_coeff[101] = Scalar(0);
-    _orientation_coeff[102] = Scalar(0);
-    _orientation_coeff[103] = Scalar(0);
-    _orientation_coeff[104] = Scalar(1);
-    _orientation_coeff[105] = Scalar(0);
-    _orientation_coeff[106] = Scalar(0);
-    _orientation_coeff[107] = Scalar(0);
-    _orientation_coeff[108] = Scalar(0);
-    _orientation_coeff[109] = Scalar(0);
-    _orientation_coeff[110] = Scalar(0);
-    _orientation_coeff[111] = Scalar(0);
-    _orientation_coeff[112] = Scalar(1);
-    _orientation_coeff[113] = Scalar(0);
-    _orientation_coeff[114] = Scalar(0);
-    _orientation_coeff[115] = Scalar(0);
-    _orientation_coeff[116] = Scalar(0);
-    _orientation_coeff[117] = Scalar(1);
-    _orientation_coeff[118] = Scalar(0);
-    _orientation_coeff[119] = Scalar(0);
-    _orientation_coeff[120] = Scalar(0);
-    _orientation_coeff[121] = -sin_B;
-    _orientation_coeff[122] = Scalar(0);
-    _orientation_coeff[123] = cos_B;
-    _orientation_coeff[124] = Scalar(0);
-    _orientation_coeff[125] = Scalar(0);
-    _orientation_coeff[126] = sin_B;
-    _orientation_coeff[127] = -_tmp36;
+    StorePair(_orientation_coeff.data(), Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 2, Scalar(0), Scalar(1));
+    StorePair(_orientation_coeff.data() + 4, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 6, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 8, Scalar(0), Scalar(1));
+    StorePair(_orientation_coeff.data() + 10, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 12, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 14, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 16, Scalar(1), Scalar(0));
+    StorePair(_orientation_coeff.data() + 18, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 20, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 22, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 24, cos_C, -sin_C);
+    StorePair(_orientation_coeff.data() + 26, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 28, Scalar(0), -_tmp13);
+    StorePair(_orientation_coeff.data() + 30, sin_C, Scalar(0));
+    StorePair(_orientation_coeff.data() + 32, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 34, Scalar(0), _tmp15);
+    StorePair(_orientation_coeff.data() + 36, -sin_C, _tmp16);
+    StorePair(_orientation_coeff.data() + 38, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 40, -_tmp20, -_tmp16);
+    StorePair(_orientation_coeff.data() + 42, -sin_C, Scalar(0));
+    StorePair(_orientation_coeff.data() + 44, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 46, Scalar(0), Scalar(1));
+    StorePair(_orientation_coeff.data() + 48, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 50, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 52, Scalar(0), Scalar(1));
+    StorePair(_orientation_coeff.data() + 54, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 56, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 58, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 60, Scalar(1), Scalar(0));
+    StorePair(_orientation_coeff.data() + 62, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 64, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 66, Scalar(0), sin_C);
+    StorePair(_orientation_coeff.data() + 68, cos_C, Scalar(0));
+    StorePair(_orientation_coeff.data() + 70, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 72, -sin_C, -_tmp13);
+    StorePair(_orientation_coeff.data() + 74, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 76, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 78, _tmp25, cos_C);
+    StorePair(_orientation_coeff.data() + 80, _tmp26, Scalar(0));
+    StorePair(_orientation_coeff.data() + 82, Scalar(0), -_tmp30);
+    StorePair(_orientation_coeff.data() + 84, -_tmp26, cos_C);
+    StorePair(_orientation_coeff.data() + 86, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 88, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 90, Scalar(0), Scalar(1));
+    StorePair(_orientation_coeff.data() + 92, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 94, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 96, Scalar(0), Scalar(1));
+    StorePair(_orientation_coeff.data() + 98, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 100, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 102, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 104, Scalar(1), Scalar(0));
+    StorePair(_orientation_coeff.data() + 106, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 108, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 110, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 112, Scalar(1), Scalar(0));
+    StorePair(_orientation_coeff.data() + 114, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 116, Scalar(0), Scalar(1));
+    StorePair(_orientation_coeff.data() + 118, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 120, Scalar(0), -sin_B);
+    StorePair(_orientation_coeff.data() + 122, Scalar(0), cos_B);
+    StorePair(_orientation_coeff.data() + 124, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 126, sin_B, -_tmp36);
     _orientation_coeff[128] = Scalar(0);
   }
 }
@@ -658,7 +552,7 @@ void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
 // the terms common to both (one common-subexpression pass over both). The same outputs
 // as the two functions, equal to rounding; null outputs are skipped.
 template <typename Scalar>
-void DeviationAndCoefficients(
+inline void DeviationAndCoefficients(
     [[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
     [[maybe_unused]] const std::array<Scalar, kNumErrors>& errors,
     [[maybe_unused]] const std::array<Scalar, kNumParams>& params,
@@ -724,7 +618,7 @@ void DeviationAndCoefficients(
   const Scalar pivot_length = params[1];
   const Scalar c_to_b = params[2];
 
-  // Intermediate terms (20)
+  // Intermediate terms (22)
   const Scalar _tmp0 = cos_B * pivot_length;
   const Scalar _tmp1 = cos_B * tool_length;
   const Scalar _tmp2 = cos_B * pivot_length * sin_C;
@@ -743,8 +637,10 @@ void DeviationAndCoefficients(
   const Scalar _tmp15 = pivot_length * sin_B;
   const Scalar _tmp16 = sin_B * tool_length;
   const Scalar _tmp17 = E_B0B + E_BB;
-  const Scalar _tmp18 = E_Z0B - E_ZB;
-  const Scalar _tmp19 = E_C0B - E_CB;
+  const Scalar _tmp18 = E_A0C - E_AC;
+  const Scalar _tmp19 = E_Z0B - E_ZB;
+  const Scalar _tmp20 = E_B0B + E_BB + E_BC;
+  const Scalar _tmp21 = E_C0B - E_CB;
 
   // Coefficients of the error monomials (24)
   const Scalar _coef0 = _tmp0 + _tmp1 + c_to_b - Z;
@@ -775,278 +671,148 @@ void DeviationAndCoefficients(
   // Outputs
   if (position != nullptr) {
     auto& _position = *position;
-    _position[0] = E_XX + E_XY + E_XZ + E_A0B * _coef12 + E_AB * _coef9 + E_B0Z * Z + E_BC * _coef4 + E_X0B * _coef11 + E_XB * _coef7 + E_XC * cos_C + E_Y0C * sin_C + _coef10 * _tmp17 - E_B0C * _coef6 - E_BZ * _coef2 - E_X0C * _coef5 - E_YB * sin_C - E_YC * sin_C - _coef0 * (E_BX + E_BY) - _coef1 * (E_C0B + E_C0C + E_CC + E_CX + E_CY + E_CZ) - _coef3 * (E_A0C - E_AC) - _coef8 * _tmp18;
-    _position[1] = E_YX + E_YY + E_YZ + E_A0C * _coef6 + E_AZ * _coef2 + E_C0X * X + E_CY * _coef13 + E_X0B * _coef19 + E_XB * _coef15 + E_XC * sin_C + E_YB * cos_C + E_YC * cos_C + _coef0 * (E_AX + E_AY) + _coef14 * (E_C0B + E_C0C + E_CC + E_CX + E_CZ) + _coef18 * _tmp17 - E_A0B * _coef20 - E_A0Z * Z - E_AB * _coef17 - E_AC * _coef4 - E_X0C * sin_C - E_Y0C * _coef5 - _coef16 * _tmp18 - _coef3 * (E_B0C - E_BC);
-    _position[2] = E_ZC + E_ZX + E_ZY + E_ZZ + E_X0B * sin_B + E_ZB * cos_B + _coef1 * (E_A0C + E_AX + E_AY + E_AZ) - E_B0C * _coef22 - E_BY * _coef13 - E_XB * sin_B - E_Z0B * _coef23 - _coef14 * (E_BX + E_BZ) - _coef21 * (E_B0B + E_BB + E_BC);
+    StorePair(_position.data(), E_XX + E_XY + E_XZ + E_A0B * _coef12 + E_AB * _coef9 + E_B0Z * Z + E_BC * _coef4 + E_X0B * _coef11 + E_XB * _coef7 + E_XC * cos_C + _coef10 * _tmp17 + (E_Y0C - E_YB - E_YC) * sin_C - E_B0C * _coef6 - E_BZ * _coef2 - E_X0C * _coef5 - _coef0 * (E_BX + E_BY) - _coef1 * (E_C0B + E_C0C + E_CC + E_CX + E_CY + E_CZ) - _coef3 * _tmp18 - _coef8 * _tmp19, E_YX + E_YY + E_YZ + E_A0C * _coef6 + E_AZ * _coef2 + E_C0X * X + E_CY * _coef13 + E_X0B * _coef19 + E_XB * _coef15 + _coef0 * (E_AX + E_AY) + _coef14 * (E_C0B + E_C0C + E_CC + E_CX + E_CZ) + _coef18 * _tmp17 + (E_YB + E_YC) * cos_C - E_A0B * _coef20 - E_A0Z * Z - E_AB * _coef17 - E_AC * _coef4 - E_Y0C * _coef5 - _coef16 * _tmp19 - _coef3 * (E_B0C - E_BC) - (E_X0C - E_XC) * sin_C);
+    _position[2] = E_ZC + E_ZX + E_ZY + E_ZZ + E_ZB * cos_B + _coef1 * (E_A0C + E_AX + E_AY + E_AZ) + (E_X0B - E_XB) * sin_B - E_B0C * _coef22 - E_BY * _coef13 - E_Z0B * _coef23 - _coef14 * (E_BX + E_BZ) - _coef21 * _tmp20;
   }
   if (orientation != nullptr) {
     auto& _orientation = *orientation;
-    _orientation[0] = E_AX + E_AY + E_AZ + E_A0B * _coef11 + E_AB * _coef7 + E_AC * cos_C + E_B0C * sin_C - E_A0C * _coef5 - E_B0B * sin_C - E_BB * sin_C - E_BC * sin_C - _coef8 * _tmp19;
-    _orientation[1] = E_BX + E_BY + E_BZ + E_A0B * _coef19 + E_AB * _coef15 + E_AC * sin_C + E_B0B * cos_C + E_BB * cos_C + E_BC * cos_C - E_A0C * sin_C - E_B0C * _coef5 - _coef16 * _tmp19;
-    _orientation[2] = E_C0C + E_CC + E_CX + E_CY + E_CZ + E_A0B * sin_B + E_CB * cos_B - E_AB * sin_B - E_C0B * _coef23;
+    StorePair(_orientation.data(), E_AX + E_AY + E_AZ + E_A0B * _coef11 + E_AB * _coef7 + E_AC * cos_C - E_A0C * _coef5 - _coef8 * _tmp21 - (E_B0B + E_BB + E_BC - E_B0C) * sin_C, E_BX + E_BY + E_BZ + E_A0B * _coef19 + E_AB * _coef15 + _tmp20 * cos_C - E_B0C * _coef5 - _coef16 * _tmp21 - _tmp18 * sin_C);
+    _orientation[2] = E_C0C + E_CC + E_CX + E_CY + E_CZ + E_CB * cos_B + (E_A0B - E_AB) * sin_B - E_C0B * _coef23;
   }
   if (position_coeff != nullptr) {
     auto& _position_coeff = *position_coeff;
-    _position_coeff[0] = Scalar(1);
-    _position_coeff[1] = Scalar(0);
-    _position_coeff[2] = Scalar(0);
-    _position_coeff[3] = Scalar(0);
-    _position_coeff[4] = -_coef0;
-    _position_coeff[5] = -_coef1;
-    _position_coeff[6] = Scalar(1);
-    _position_coeff[7] = Scalar(0);
-    _position_coeff[8] = Scalar(0);
-    _position_coeff[9] = Scalar(0);
-    _position_coeff[10] = -_coef0;
-    _position_coeff[11] = -_coef1;
-    _position_coeff[12] = Scalar(0);
-    _position_coeff[13] = Scalar(1);
-    _position_coeff[14] = Scalar(0);
-    _position_coeff[15] = Scalar(0);
-    _position_coeff[16] = Scalar(0);
-    _position_coeff[17] = -_coef2;
-    _position_coeff[18] = -_coef1;
-    _position_coeff[19] = Scalar(0);
-    _position_coeff[20] = Z;
-    _position_coeff[21] = cos_C;
-    _position_coeff[22] = -sin_C;
-    _position_coeff[23] = Scalar(0);
-    _position_coeff[24] = _coef3;
-    _position_coeff[25] = _coef4;
-    _position_coeff[26] = -_coef1;
-    _position_coeff[27] = -_coef5;
-    _position_coeff[28] = sin_C;
-    _position_coeff[29] = -_coef3;
-    _position_coeff[30] = -_coef6;
-    _position_coeff[31] = -_coef1;
-    _position_coeff[32] = _coef7;
-    _position_coeff[33] = -sin_C;
-    _position_coeff[34] = _coef8;
-    _position_coeff[35] = _coef9;
-    _position_coeff[36] = _coef10;
-    _position_coeff[37] = Scalar(0);
-    _position_coeff[38] = _coef11;
-    _position_coeff[39] = -_coef8;
-    _position_coeff[40] = _coef12;
-    _position_coeff[41] = -_coef1;
-    _position_coeff[42] = _coef10;
-    _position_coeff[43] = Scalar(0);
-    _position_coeff[44] = Scalar(1);
-    _position_coeff[45] = Scalar(0);
-    _position_coeff[46] = _coef0;
-    _position_coeff[47] = Scalar(0);
-    _position_coeff[48] = _coef13;
-    _position_coeff[49] = Scalar(0);
-    _position_coeff[50] = Scalar(1);
-    _position_coeff[51] = Scalar(0);
-    _position_coeff[52] = _coef0;
-    _position_coeff[53] = Scalar(0);
-    _position_coeff[54] = _coef14;
-    _position_coeff[55] = X;
-    _position_coeff[56] = Scalar(0);
-    _position_coeff[57] = Scalar(1);
-    _position_coeff[58] = Scalar(0);
-    _position_coeff[59] = _coef2;
-    _position_coeff[60] = Scalar(0);
-    _position_coeff[61] = _coef14;
-    _position_coeff[62] = -Z;
-    _position_coeff[63] = Scalar(0);
-    _position_coeff[64] = sin_C;
-    _position_coeff[65] = cos_C;
-    _position_coeff[66] = Scalar(0);
-    _position_coeff[67] = -_coef4;
-    _position_coeff[68] = _coef3;
-    _position_coeff[69] = _coef14;
-    _position_coeff[70] = -sin_C;
-    _position_coeff[71] = -_coef5;
-    _position_coeff[72] = _coef6;
-    _position_coeff[73] = -_coef3;
-    _position_coeff[74] = _coef14;
-    _position_coeff[75] = _coef15;
-    _position_coeff[76] = cos_C;
-    _position_coeff[77] = _coef16;
-    _position_coeff[78] = -_coef17;
-    _position_coeff[79] = _coef18;
-    _position_coeff[80] = Scalar(0);
-    _position_coeff[81] = _coef19;
-    _position_coeff[82] = -_coef16;
-    _position_coeff[83] = -_coef20;
-    _position_coeff[84] = _coef14;
-    _position_coeff[85] = _coef18;
-    _position_coeff[86] = Scalar(0);
-    _position_coeff[87] = Scalar(0);
-    _position_coeff[88] = Scalar(1);
-    _position_coeff[89] = _coef1;
-    _position_coeff[90] = -_coef13;
-    _position_coeff[91] = Scalar(0);
-    _position_coeff[92] = Scalar(0);
-    _position_coeff[93] = Scalar(0);
-    _position_coeff[94] = Scalar(1);
-    _position_coeff[95] = _coef1;
-    _position_coeff[96] = -_coef14;
-    _position_coeff[97] = Scalar(0);
-    _position_coeff[98] = Scalar(0);
-    _position_coeff[99] = Scalar(0);
-    _position_coeff[100] = Scalar(0);
-    _position_coeff[101] = Scalar(1);
-    _position_coeff[102] = _coef1;
-    _position_coeff[103] = -_coef14;
-    _position_coeff[104] = Scalar(0);
-    _position_coeff[105] = Scalar(0);
-    _position_coeff[106] = Scalar(0);
-    _position_coeff[107] = Scalar(0);
-    _position_coeff[108] = Scalar(0);
-    _position_coeff[109] = Scalar(1);
-    _position_coeff[110] = Scalar(0);
-    _position_coeff[111] = -_coef21;
-    _position_coeff[112] = Scalar(0);
-    _position_coeff[113] = Scalar(0);
-    _position_coeff[114] = Scalar(0);
-    _position_coeff[115] = _coef1;
-    _position_coeff[116] = -_coef22;
-    _position_coeff[117] = Scalar(0);
-    _position_coeff[118] = -sin_B;
-    _position_coeff[119] = Scalar(0);
-    _position_coeff[120] = cos_B;
-    _position_coeff[121] = Scalar(0);
-    _position_coeff[122] = -_coef21;
-    _position_coeff[123] = Scalar(0);
-    _position_coeff[124] = sin_B;
-    _position_coeff[125] = -_coef23;
-    _position_coeff[126] = Scalar(0);
-    _position_coeff[127] = Scalar(0);
+    StorePair(_position_coeff.data(), Scalar(1), Scalar(0));
+    StorePair(_position_coeff.data() + 2, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 4, -_coef0, -_coef1);
+    StorePair(_position_coeff.data() + 6, Scalar(1), Scalar(0));
+    StorePair(_position_coeff.data() + 8, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 10, -_coef0, -_coef1);
+    StorePair(_position_coeff.data() + 12, Scalar(0), Scalar(1));
+    StorePair(_position_coeff.data() + 14, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 16, Scalar(0), -_coef2);
+    StorePair(_position_coeff.data() + 18, -_coef1, Scalar(0));
+    StorePair(_position_coeff.data() + 20, Z, cos_C);
+    StorePair(_position_coeff.data() + 22, -sin_C, Scalar(0));
+    StorePair(_position_coeff.data() + 24, _coef3, _coef4);
+    StorePair(_position_coeff.data() + 26, -_coef1, -_coef5);
+    StorePair(_position_coeff.data() + 28, sin_C, -_coef3);
+    StorePair(_position_coeff.data() + 30, -_coef6, -_coef1);
+    StorePair(_position_coeff.data() + 32, _coef7, -sin_C);
+    StorePair(_position_coeff.data() + 34, _coef8, _coef9);
+    StorePair(_position_coeff.data() + 36, _coef10, Scalar(0));
+    StorePair(_position_coeff.data() + 38, _coef11, -_coef8);
+    StorePair(_position_coeff.data() + 40, _coef12, -_coef1);
+    StorePair(_position_coeff.data() + 42, _coef10, Scalar(0));
+    StorePair(_position_coeff.data() + 44, Scalar(1), Scalar(0));
+    StorePair(_position_coeff.data() + 46, _coef0, Scalar(0));
+    StorePair(_position_coeff.data() + 48, _coef13, Scalar(0));
+    StorePair(_position_coeff.data() + 50, Scalar(1), Scalar(0));
+    StorePair(_position_coeff.data() + 52, _coef0, Scalar(0));
+    StorePair(_position_coeff.data() + 54, _coef14, X);
+    StorePair(_position_coeff.data() + 56, Scalar(0), Scalar(1));
+    StorePair(_position_coeff.data() + 58, Scalar(0), _coef2);
+    StorePair(_position_coeff.data() + 60, Scalar(0), _coef14);
+    StorePair(_position_coeff.data() + 62, -Z, Scalar(0));
+    StorePair(_position_coeff.data() + 64, sin_C, cos_C);
+    StorePair(_position_coeff.data() + 66, Scalar(0), -_coef4);
+    StorePair(_position_coeff.data() + 68, _coef3, _coef14);
+    StorePair(_position_coeff.data() + 70, -sin_C, -_coef5);
+    StorePair(_position_coeff.data() + 72, _coef6, -_coef3);
+    StorePair(_position_coeff.data() + 74, _coef14, _coef15);
+    StorePair(_position_coeff.data() + 76, cos_C, _coef16);
+    StorePair(_position_coeff.data() + 78, -_coef17, _coef18);
+    StorePair(_position_coeff.data() + 80, Scalar(0), _coef19);
+    StorePair(_position_coeff.data() + 82, -_coef16, -_coef20);
+    StorePair(_position_coeff.data() + 84, _coef14, _coef18);
+    StorePair(_position_coeff.data() + 86, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 88, Scalar(1), _coef1);
+    StorePair(_position_coeff.data() + 90, -_coef13, Scalar(0));
+    StorePair(_position_coeff.data() + 92, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 94, Scalar(1), _coef1);
+    StorePair(_position_coeff.data() + 96, -_coef14, Scalar(0));
+    StorePair(_position_coeff.data() + 98, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 100, Scalar(0), Scalar(1));
+    StorePair(_position_coeff.data() + 102, _coef1, -_coef14);
+    StorePair(_position_coeff.data() + 104, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 106, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 108, Scalar(0), Scalar(1));
+    StorePair(_position_coeff.data() + 110, Scalar(0), -_coef21);
+    StorePair(_position_coeff.data() + 112, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 114, Scalar(0), _coef1);
+    StorePair(_position_coeff.data() + 116, -_coef22, Scalar(0));
+    StorePair(_position_coeff.data() + 118, -sin_B, Scalar(0));
+    StorePair(_position_coeff.data() + 120, cos_B, Scalar(0));
+    StorePair(_position_coeff.data() + 122, -_coef21, Scalar(0));
+    StorePair(_position_coeff.data() + 124, sin_B, -_coef23);
+    StorePair(_position_coeff.data() + 126, Scalar(0), Scalar(0));
     _position_coeff[128] = -_coef21;
   }
   if (orientation_coeff != nullptr) {
     auto& _orientation_coeff = *orientation_coeff;
-    _orientation_coeff[0] = Scalar(0);
-    _orientation_coeff[1] = Scalar(0);
-    _orientation_coeff[2] = Scalar(0);
-    _orientation_coeff[3] = Scalar(1);
-    _orientation_coeff[4] = Scalar(0);
-    _orientation_coeff[5] = Scalar(0);
-    _orientation_coeff[6] = Scalar(0);
-    _orientation_coeff[7] = Scalar(0);
-    _orientation_coeff[8] = Scalar(0);
-    _orientation_coeff[9] = Scalar(1);
-    _orientation_coeff[10] = Scalar(0);
-    _orientation_coeff[11] = Scalar(0);
-    _orientation_coeff[12] = Scalar(0);
-    _orientation_coeff[13] = Scalar(0);
-    _orientation_coeff[14] = Scalar(0);
-    _orientation_coeff[15] = Scalar(0);
-    _orientation_coeff[16] = Scalar(1);
-    _orientation_coeff[17] = Scalar(0);
-    _orientation_coeff[18] = Scalar(0);
-    _orientation_coeff[19] = Scalar(0);
-    _orientation_coeff[20] = Scalar(0);
-    _orientation_coeff[21] = Scalar(0);
-    _orientation_coeff[22] = Scalar(0);
-    _orientation_coeff[23] = Scalar(0);
-    _orientation_coeff[24] = cos_C;
-    _orientation_coeff[25] = -sin_C;
-    _orientation_coeff[26] = Scalar(0);
-    _orientation_coeff[27] = Scalar(0);
-    _orientation_coeff[28] = Scalar(0);
-    _orientation_coeff[29] = -_coef5;
-    _orientation_coeff[30] = sin_C;
-    _orientation_coeff[31] = Scalar(0);
-    _orientation_coeff[32] = Scalar(0);
-    _orientation_coeff[33] = Scalar(0);
-    _orientation_coeff[34] = Scalar(0);
-    _orientation_coeff[35] = _coef7;
-    _orientation_coeff[36] = -sin_C;
-    _orientation_coeff[37] = _coef8;
-    _orientation_coeff[38] = Scalar(0);
-    _orientation_coeff[39] = Scalar(0);
-    _orientation_coeff[40] = _coef11;
-    _orientation_coeff[41] = -_coef8;
-    _orientation_coeff[42] = -sin_C;
-    _orientation_coeff[43] = Scalar(0);
-    _orientation_coeff[44] = Scalar(0);
-    _orientation_coeff[45] = Scalar(0);
-    _orientation_coeff[46] = Scalar(0);
-    _orientation_coeff[47] = Scalar(1);
-    _orientation_coeff[48] = Scalar(0);
-    _orientation_coeff[49] = Scalar(0);
-    _orientation_coeff[50] = Scalar(0);
-    _orientation_coeff[51] = Scalar(0);
-    _orientation_coeff[52] = Scalar(0);
-    _orientation_coeff[53] = Scalar(1);
-    _orientation_coeff[54] = Scalar(0);
-    _orientation_coeff[55] = Scalar(0);
-    _orientation_coeff[56] = Scalar(0);
-    _orientation_coeff[57] = Scalar(0);
-    _orientation_coeff[58] = Scalar(0);
-    _orientation_coeff[59] = Scalar(0);
-    _orientation_coeff[60] = Scalar(1);
-    _orientation_coeff[61] = Scalar(0);
-    _orientation_coeff[62] = Scalar(0);
-    _orientation_coeff[63] = Scalar(0);
-    _orientation_coeff[64] = Scalar(0);
-    _orientation_coeff[65] = Scalar(0);
-    _orientation_coeff[66] = Scalar(0);
-    _orientation_coeff[67] = sin_C;
-    _orientation_coeff[68] = cos_C;
-    _orientation_coeff[69] = Scalar(0);
-    _orientation_coeff[70] = Scalar(0);
-    _orientation_coeff[71] = Scalar(0);
-    _orientation_coeff[72] = -sin_C;
-    _orientation_coeff[73] = -_coef5;
-    _orientation_coeff[74] = Scalar(0);
-    _orientation_coeff[75] = Scalar(0);
-    _orientation_coeff[76] = Scalar(0);
-    _orientation_coeff[77] = Scalar(0);
-    _orientation_coeff[78] = _coef15;
-    _orientation_coeff[79] = cos_C;
-    _orientation_coeff[80] = _coef16;
-    _orientation_coeff[81] = Scalar(0);
-    _orientation_coeff[82] = Scalar(0);
-    _orientation_coeff[83] = _coef19;
-    _orientation_coeff[84] = -_coef16;
-    _orientation_coeff[85] = cos_C;
-    _orientation_coeff[86] = Scalar(0);
-    _orientation_coeff[87] = Scalar(0);
-    _orientation_coeff[88] = Scalar(0);
-    _orientation_coeff[89] = Scalar(0);
-    _orientation_coeff[90] = Scalar(0);
-    _orientation_coeff[91] = Scalar(1);
-    _orientation_coeff[92] = Scalar(0);
-    _orientation_coeff[93] = Scalar(0);
-    _orientation_coeff[94] = Scalar(0);
-    _orientation_coeff[95] = Scalar(0);
-    _orientation_coeff[96] = Scalar(0);
-    _orientation_coeff[97] = Scalar(1);
-    _orientation_coeff[98] = Scalar(0);
-    _orientation_coeff[99] = Scalar(0);
-    _orientation_coeff[100] = Scalar(0);
-    _orientation_coeff[101] = Scalar(0);
-    _orientation_coeff[102] = Scalar(0);
-    _orientation_coeff[103] = Scalar(0);
-    _orientation_coeff[104] = Scalar(1);
-    _orientation_coeff[105] = Scalar(0);
-    _orientation_coeff[106] = Scalar(0);
-    _orientation_coeff[107] = Scalar(0);
-    _orientation_coeff[108] = Scalar(0);
-    _orientation_coeff[109] = Scalar(0);
-    _orientation_coeff[110] = Scalar(0);
-    _orientation_coeff[111] = Scalar(0);
-    _orientation_coeff[112] = Scalar(1);
-    _orientation_coeff[113] = Scalar(0);
-    _orientation_coeff[114] = Scalar(0);
-    _orientation_coeff[115] = Scalar(0);
-    _orientation_coeff[116] = Scalar(0);
-    _orientation_coeff[117] = Scalar(1);
-    _orientation_coeff[118] = Scalar(0);
-    _orientation_coeff[119] = Scalar(0);
-    _orientation_coeff[120] = Scalar(0);
-    _orientation_coeff[121] = -sin_B;
-    _orientation_coeff[122] = Scalar(0);
-    _orientation_coeff[123] = cos_B;
-    _orientation_coeff[124] = Scalar(0);
-    _orientation_coeff[125] = Scalar(0);
-    _orientation_coeff[126] = sin_B;
-    _orientation_coeff[127] = -_coef23;
+    StorePair(_orientation_coeff.data(), Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 2, Scalar(0), Scalar(1));
+    StorePair(_orientation_coeff.data() + 4, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 6, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 8, Scalar(0), Scalar(1));
+    StorePair(_orientation_coeff.data() + 10, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 12, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 14, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 16, Scalar(1), Scalar(0));
+    StorePair(_orientation_coeff.data() + 18, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 20, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 22, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 24, cos_C, -sin_C);
+    StorePair(_orientation_coeff.data() + 26, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 28, Scalar(0), -_coef5);
+    StorePair(_orientation_coeff.data() + 30, sin_C, Scalar(0));
+    StorePair(_orientation_coeff.data() + 32, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 34, Scalar(0), _coef7);
+    StorePair(_orientation_coeff.data() + 36, -sin_C, _coef8);
+    StorePair(_orientation_coeff.data() + 38, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 40, _coef11, -_coef8);
+    StorePair(_orientation_coeff.data() + 42, -sin_C, Scalar(0));
+    StorePair(_orientation_coeff.data() + 44, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 46, Scalar(0), Scalar(1));
+    StorePair(_orientation_coeff.data() + 48, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 50, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 52, Scalar(0), Scalar(1));
+    StorePair(_orientation_coeff.data() + 54, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 56, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 58, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 60, Scalar(1), Scalar(0));
+    StorePair(_orientation_coeff.data() + 62, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 64, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 66, Scalar(0), sin_C);
+    StorePair(_orientation_coeff.data() + 68, cos_C, Scalar(0));
+    StorePair(_orientation_coeff.data() + 70, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 72, -sin_C, -_coef5);
+    StorePair(_orientation_coeff.data() + 74, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 76, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 78, _coef15, cos_C);
+    StorePair(_orientation_coeff.data() + 80, _coef16, Scalar(0));
+    StorePair(_orientation_coeff.data() + 82, Scalar(0), _coef19);
+    StorePair(_orientation_coeff.data() + 84, -_coef16, cos_C);
+    StorePair(_orientation_coeff.data() + 86, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 88, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 90, Scalar(0), Scalar(1));
+    StorePair(_orientation_coeff.data() + 92, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 94, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 96, Scalar(0), Scalar(1));
+    StorePair(_orientation_coeff.data() + 98, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 100, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 102, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 104, Scalar(1), Scalar(0));
+    StorePair(_orientation_coeff.data() + 106, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 108, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 110, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 112, Scalar(1), Scalar(0));
+    StorePair(_orientation_coeff.data() + 114, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 116, Scalar(0), Scalar(1));
+    StorePair(_orientation_coeff.data() + 118, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 120, Scalar(0), -sin_B);
+    StorePair(_orientation_coeff.data() + 122, Scalar(0), cos_B);
+    StorePair(_orientation_coeff.data() + 124, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 126, sin_B, -_coef23);
     _orientation_coeff[128] = Scalar(0);
   }
 }
@@ -1080,20 +846,15 @@ void NominalPose([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
   // Outputs
   if (position != nullptr) {
     auto& _position = *position;
-    _position[0] = X - cos_C * pivot_length * sin_B - cos_C * sin_B * tool_length;
-    _position[1] = Y - pivot_length * sin_B * sin_C - sin_B * sin_C * tool_length;
+    StorePair(_position.data(), X - cos_C * pivot_length * sin_B - cos_C * sin_B * tool_length, Y - pivot_length * sin_B * sin_C - sin_B * sin_C * tool_length);
     _position[2] = Z - c_to_b - cos_B * pivot_length - cos_B * tool_length;
   }
   if (rotation != nullptr) {
     auto& _rotation = *rotation;
-    _rotation[0] = cos_B * cos_C;
-    _rotation[1] = -sin_C;
-    _rotation[2] = cos_C * sin_B;
-    _rotation[3] = cos_B * sin_C;
-    _rotation[4] = cos_C;
-    _rotation[5] = sin_B * sin_C;
-    _rotation[6] = -sin_B;
-    _rotation[7] = Scalar(0);
+    StorePair(_rotation.data(), cos_B * cos_C, -sin_C);
+    StorePair(_rotation.data() + 2, cos_C * sin_B, cos_B * sin_C);
+    StorePair(_rotation.data() + 4, cos_C, sin_B * sin_C);
+    StorePair(_rotation.data() + 6, -sin_B, Scalar(0));
     _rotation[8] = cos_B;
   }
 }
@@ -1124,36 +885,21 @@ void NominalJacobian([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
   // Outputs
   if (jacobian != nullptr) {
     auto& _jacobian = *jacobian;
-    _jacobian[0] = Scalar(0);
-    _jacobian[1] = Scalar(1);
-    _jacobian[2] = Scalar(0);
-    _jacobian[3] = -_to_base0 * (-pivot_length * sin_B * sin_C - sin_B * sin_C * tool_length);
-    _jacobian[4] = _to_base0 * (-cos_B * cos_C * pivot_length - cos_B * cos_C * tool_length);
-    _jacobian[5] = Scalar(1);
-    _jacobian[6] = Scalar(0);
-    _jacobian[7] = Scalar(0);
-    _jacobian[8] = _to_base0 * (-cos_C * pivot_length * sin_B - cos_C * sin_B * tool_length);
-    _jacobian[9] = _to_base0 * (-cos_B * pivot_length * sin_C - cos_B * sin_C * tool_length);
-    _jacobian[10] = Scalar(0);
-    _jacobian[11] = Scalar(0);
-    _jacobian[12] = Scalar(1);
-    _jacobian[13] = Scalar(0);
-    _jacobian[14] = -_to_base0 * (-pivot_length * sin_B - sin_B * tool_length);
-    _jacobian[15] = Scalar(0);
-    _jacobian[16] = Scalar(0);
-    _jacobian[17] = Scalar(0);
-    _jacobian[18] = Scalar(0);
-    _jacobian[19] = -_to_base0 * sin_C;
-    _jacobian[20] = Scalar(0);
-    _jacobian[21] = Scalar(0);
-    _jacobian[22] = Scalar(0);
-    _jacobian[23] = Scalar(0);
-    _jacobian[24] = _to_base0 * cos_C;
-    _jacobian[25] = Scalar(0);
-    _jacobian[26] = Scalar(0);
-    _jacobian[27] = Scalar(0);
-    _jacobian[28] = _to_base0;
-    _jacobian[29] = Scalar(0);
+    StorePair(_jacobian.data(), Scalar(0), Scalar(1));
+    StorePair(_jacobian.data() + 2, Scalar(0), -_to_base0 * (-pivot_length * sin_B * sin_C - sin_B * sin_C * tool_length));
+    StorePair(_jacobian.data() + 4, _to_base0 * (-cos_B * cos_C * pivot_length - cos_B * cos_C * tool_length), Scalar(1));
+    StorePair(_jacobian.data() + 6, Scalar(0), Scalar(0));
+    StorePair(_jacobian.data() + 8, _to_base0 * (-cos_C * pivot_length * sin_B - cos_C * sin_B * tool_length), _to_base0 * (-cos_B * pivot_length * sin_C - cos_B * sin_C * tool_length));
+    StorePair(_jacobian.data() + 10, Scalar(0), Scalar(0));
+    StorePair(_jacobian.data() + 12, Scalar(1), Scalar(0));
+    StorePair(_jacobian.data() + 14, -_to_base0 * (-pivot_length * sin_B - sin_B * tool_length), Scalar(0));
+    StorePair(_jacobian.data() + 16, Scalar(0), Scalar(0));
+    StorePair(_jacobian.data() + 18, Scalar(0), -_to_base0 * sin_C);
+    StorePair(_jacobian.data() + 20, Scalar(0), Scalar(0));
+    StorePair(_jacobian.data() + 22, Scalar(0), Scalar(0));
+    StorePair(_jacobian.data() + 24, _to_base0 * cos_C, Scalar(0));
+    StorePair(_jacobian.data() + 26, Scalar(0), Scalar(0));
+    StorePair(_jacobian.data() + 28, _to_base0, Scalar(0));
   }
 }
 

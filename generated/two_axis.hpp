@@ -15,6 +15,10 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <type_traits>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace weilgen_models {
 namespace two_axis {
@@ -118,6 +122,24 @@ inline constexpr std::size_t tool_length = 0;
 inline constexpr std::array<std::array<int, 1>, kNumHigherTerms> kHigherTerms = {{
 }};
 
+// out[0] = first, out[1] = second: two neighbouring outputs. With SSE2, a double pair is one
+// 16-byte store; compilers store mixed pairs (a constant and a symbol) one by one otherwise, and
+// the stores, not the arithmetic, bound the generated functions (docs/performance.md). The values
+// convert to Scalar (expression-template scalars). Deviation, Coefficients and
+// DeviationAndCoefficients are declared inline (a hint that raises the compiler's size limit):
+// a small model's function then becomes part of the caller's loop, without the call.
+template <typename Scalar>
+inline void StorePair(Scalar* const out, const std::common_type_t<Scalar>& first,
+                      const std::common_type_t<Scalar>& second) {
+  out[0] = first;
+  out[1] = second;
+}
+#if defined(__SSE2__)
+inline void StorePair(double* const out, const double first, const double second) {
+  _mm_storeu_pd(out, _mm_set_pd(second, first));
+}
+#endif
+
 // Deviation of the tool point relative to the workpiece, in the workpiece frame:
 // position = (dx, dy, dz) in mm, orientation = (da, db, dc) in rad. Null outputs are
 // skipped. Exact in the algebra of order kOrder.
@@ -125,11 +147,11 @@ inline constexpr std::array<std::array<int, 1>, kNumHigherTerms> kHigherTerms = 
 //   errors: E_XY, E_YY, E_ZY, E_AY, E_BY, E_CY, E_XA, E_YA, E_ZA, E_AA, E_BA, E_CA
 //   params: tool_length
 template <typename Scalar>
-void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
-               [[maybe_unused]] const std::array<Scalar, kNumErrors>& errors,
-               [[maybe_unused]] const std::array<Scalar, kNumParams>& params,
-               std::array<Scalar, 3>* const position,
-               std::array<Scalar, 3>* const orientation = nullptr) {
+inline void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
+                      [[maybe_unused]] const std::array<Scalar, kNumErrors>& errors,
+                      [[maybe_unused]] const std::array<Scalar, kNumParams>& params,
+                      std::array<Scalar, 3>* const position,
+                      std::array<Scalar, 3>* const orientation = nullptr) {
   using std::cos;
   using std::sin;
   using std::sqrt;
@@ -161,14 +183,12 @@ void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
   // Outputs
   if (position != nullptr) {
     auto& _position = *position;
-    _position[0] = E_XA + E_XY + E_BA * tool_length + E_BY * _coef0 + E_CY * _coef1;
-    _position[1] = E_YY + E_YA * cos_A - E_ZA * sin_A - _coef0 * _tmp0;
+    StorePair(_position.data(), E_XA + E_XY + E_BA * tool_length + E_BY * _coef0 + E_CY * _coef1, E_YY + E_YA * cos_A - E_ZA * sin_A - _coef0 * _tmp0);
     _position[2] = E_ZY + E_YA * sin_A + E_ZA * cos_A - _coef1 * _tmp0;
   }
   if (orientation != nullptr) {
     auto& _orientation = *orientation;
-    _orientation[0] = _tmp0;
-    _orientation[1] = E_BY + E_BA * cos_A - E_CA * sin_A;
+    StorePair(_orientation.data(), _tmp0, E_BY + E_BA * cos_A - E_CA * sin_A);
     _orientation[2] = E_CY + E_BA * sin_A + E_CA * cos_A;
   }
 }
@@ -177,10 +197,10 @@ void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
 // position_coeff rows dx, dy, dz (mm per base unit of the error), orientation_coeff rows
 // da, db, dc (rad per base unit).
 template <typename Scalar>
-void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
-                  [[maybe_unused]] const std::array<Scalar, kNumParams>& params,
-                  std::array<Scalar, 3 * kNumErrors>* const position_coeff,
-                  std::array<Scalar, 3 * kNumErrors>* const orientation_coeff = nullptr) {
+inline void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
+                         [[maybe_unused]] const std::array<Scalar, kNumParams>& params,
+                         std::array<Scalar, 3 * kNumErrors>* const position_coeff,
+                         std::array<Scalar, 3 * kNumErrors>* const orientation_coeff = nullptr) {
   using std::cos;
   using std::sin;
   using std::sqrt;
@@ -197,81 +217,45 @@ void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
   // Outputs
   if (position_coeff != nullptr) {
     auto& _position_coeff = *position_coeff;
-    _position_coeff[0] = Scalar(1);
-    _position_coeff[1] = Scalar(0);
-    _position_coeff[2] = Scalar(0);
-    _position_coeff[3] = Scalar(0);
-    _position_coeff[4] = _tmp0;
-    _position_coeff[5] = _tmp1;
-    _position_coeff[6] = Scalar(1);
-    _position_coeff[7] = Scalar(0);
-    _position_coeff[8] = Scalar(0);
-    _position_coeff[9] = Scalar(0);
-    _position_coeff[10] = tool_length;
-    _position_coeff[11] = Scalar(0);
-    _position_coeff[12] = Scalar(0);
-    _position_coeff[13] = Scalar(1);
-    _position_coeff[14] = Scalar(0);
-    _position_coeff[15] = -_tmp0;
-    _position_coeff[16] = Scalar(0);
-    _position_coeff[17] = Scalar(0);
-    _position_coeff[18] = Scalar(0);
-    _position_coeff[19] = cos_A;
-    _position_coeff[20] = -sin_A;
-    _position_coeff[21] = -_tmp0;
-    _position_coeff[22] = Scalar(0);
-    _position_coeff[23] = Scalar(0);
-    _position_coeff[24] = Scalar(0);
-    _position_coeff[25] = Scalar(0);
-    _position_coeff[26] = Scalar(1);
-    _position_coeff[27] = -_tmp1;
-    _position_coeff[28] = Scalar(0);
-    _position_coeff[29] = Scalar(0);
-    _position_coeff[30] = Scalar(0);
-    _position_coeff[31] = sin_A;
-    _position_coeff[32] = cos_A;
-    _position_coeff[33] = -_tmp1;
-    _position_coeff[34] = Scalar(0);
-    _position_coeff[35] = Scalar(0);
+    StorePair(_position_coeff.data(), Scalar(1), Scalar(0));
+    StorePair(_position_coeff.data() + 2, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 4, _tmp0, _tmp1);
+    StorePair(_position_coeff.data() + 6, Scalar(1), Scalar(0));
+    StorePair(_position_coeff.data() + 8, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 10, tool_length, Scalar(0));
+    StorePair(_position_coeff.data() + 12, Scalar(0), Scalar(1));
+    StorePair(_position_coeff.data() + 14, Scalar(0), -_tmp0);
+    StorePair(_position_coeff.data() + 16, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 18, Scalar(0), cos_A);
+    StorePair(_position_coeff.data() + 20, -sin_A, -_tmp0);
+    StorePair(_position_coeff.data() + 22, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 24, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 26, Scalar(1), -_tmp1);
+    StorePair(_position_coeff.data() + 28, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 30, Scalar(0), sin_A);
+    StorePair(_position_coeff.data() + 32, cos_A, -_tmp1);
+    StorePair(_position_coeff.data() + 34, Scalar(0), Scalar(0));
   }
   if (orientation_coeff != nullptr) {
     auto& _orientation_coeff = *orientation_coeff;
-    _orientation_coeff[0] = Scalar(0);
-    _orientation_coeff[1] = Scalar(0);
-    _orientation_coeff[2] = Scalar(0);
-    _orientation_coeff[3] = Scalar(1);
-    _orientation_coeff[4] = Scalar(0);
-    _orientation_coeff[5] = Scalar(0);
-    _orientation_coeff[6] = Scalar(0);
-    _orientation_coeff[7] = Scalar(0);
-    _orientation_coeff[8] = Scalar(0);
-    _orientation_coeff[9] = Scalar(1);
-    _orientation_coeff[10] = Scalar(0);
-    _orientation_coeff[11] = Scalar(0);
-    _orientation_coeff[12] = Scalar(0);
-    _orientation_coeff[13] = Scalar(0);
-    _orientation_coeff[14] = Scalar(0);
-    _orientation_coeff[15] = Scalar(0);
-    _orientation_coeff[16] = Scalar(1);
-    _orientation_coeff[17] = Scalar(0);
-    _orientation_coeff[18] = Scalar(0);
-    _orientation_coeff[19] = Scalar(0);
-    _orientation_coeff[20] = Scalar(0);
-    _orientation_coeff[21] = Scalar(0);
-    _orientation_coeff[22] = cos_A;
-    _orientation_coeff[23] = -sin_A;
-    _orientation_coeff[24] = Scalar(0);
-    _orientation_coeff[25] = Scalar(0);
-    _orientation_coeff[26] = Scalar(0);
-    _orientation_coeff[27] = Scalar(0);
-    _orientation_coeff[28] = Scalar(0);
-    _orientation_coeff[29] = Scalar(1);
-    _orientation_coeff[30] = Scalar(0);
-    _orientation_coeff[31] = Scalar(0);
-    _orientation_coeff[32] = Scalar(0);
-    _orientation_coeff[33] = Scalar(0);
-    _orientation_coeff[34] = sin_A;
-    _orientation_coeff[35] = cos_A;
+    StorePair(_orientation_coeff.data(), Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 2, Scalar(0), Scalar(1));
+    StorePair(_orientation_coeff.data() + 4, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 6, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 8, Scalar(0), Scalar(1));
+    StorePair(_orientation_coeff.data() + 10, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 12, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 14, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 16, Scalar(1), Scalar(0));
+    StorePair(_orientation_coeff.data() + 18, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 20, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 22, cos_A, -sin_A);
+    StorePair(_orientation_coeff.data() + 24, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 26, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 28, Scalar(0), Scalar(1));
+    StorePair(_orientation_coeff.data() + 30, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 32, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 34, sin_A, cos_A);
   }
 }
 
@@ -279,7 +263,7 @@ void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
 // the terms common to both (one common-subexpression pass over both). The same outputs
 // as the two functions, equal to rounding; null outputs are skipped.
 template <typename Scalar>
-void DeviationAndCoefficients(
+inline void DeviationAndCoefficients(
     [[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
     [[maybe_unused]] const std::array<Scalar, kNumErrors>& errors,
     [[maybe_unused]] const std::array<Scalar, kNumParams>& params,
@@ -317,93 +301,55 @@ void DeviationAndCoefficients(
   // Outputs
   if (position != nullptr) {
     auto& _position = *position;
-    _position[0] = E_XA + E_XY + E_BA * tool_length + E_BY * _coef0 + E_CY * _coef1;
-    _position[1] = E_YY + E_YA * cos_A - E_ZA * sin_A - _coef0 * _tmp0;
+    StorePair(_position.data(), E_XA + E_XY + E_BA * tool_length + E_BY * _coef0 + E_CY * _coef1, E_YY + E_YA * cos_A - E_ZA * sin_A - _coef0 * _tmp0);
     _position[2] = E_ZY + E_YA * sin_A + E_ZA * cos_A - _coef1 * _tmp0;
   }
   if (orientation != nullptr) {
     auto& _orientation = *orientation;
-    _orientation[0] = _tmp0;
-    _orientation[1] = E_BY + E_BA * cos_A - E_CA * sin_A;
+    StorePair(_orientation.data(), _tmp0, E_BY + E_BA * cos_A - E_CA * sin_A);
     _orientation[2] = E_CY + E_BA * sin_A + E_CA * cos_A;
   }
   if (position_coeff != nullptr) {
     auto& _position_coeff = *position_coeff;
-    _position_coeff[0] = Scalar(1);
-    _position_coeff[1] = Scalar(0);
-    _position_coeff[2] = Scalar(0);
-    _position_coeff[3] = Scalar(0);
-    _position_coeff[4] = _coef0;
-    _position_coeff[5] = _coef1;
-    _position_coeff[6] = Scalar(1);
-    _position_coeff[7] = Scalar(0);
-    _position_coeff[8] = Scalar(0);
-    _position_coeff[9] = Scalar(0);
-    _position_coeff[10] = tool_length;
-    _position_coeff[11] = Scalar(0);
-    _position_coeff[12] = Scalar(0);
-    _position_coeff[13] = Scalar(1);
-    _position_coeff[14] = Scalar(0);
-    _position_coeff[15] = -_coef0;
-    _position_coeff[16] = Scalar(0);
-    _position_coeff[17] = Scalar(0);
-    _position_coeff[18] = Scalar(0);
-    _position_coeff[19] = cos_A;
-    _position_coeff[20] = -sin_A;
-    _position_coeff[21] = -_coef0;
-    _position_coeff[22] = Scalar(0);
-    _position_coeff[23] = Scalar(0);
-    _position_coeff[24] = Scalar(0);
-    _position_coeff[25] = Scalar(0);
-    _position_coeff[26] = Scalar(1);
-    _position_coeff[27] = -_coef1;
-    _position_coeff[28] = Scalar(0);
-    _position_coeff[29] = Scalar(0);
-    _position_coeff[30] = Scalar(0);
-    _position_coeff[31] = sin_A;
-    _position_coeff[32] = cos_A;
-    _position_coeff[33] = -_coef1;
-    _position_coeff[34] = Scalar(0);
-    _position_coeff[35] = Scalar(0);
+    StorePair(_position_coeff.data(), Scalar(1), Scalar(0));
+    StorePair(_position_coeff.data() + 2, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 4, _coef0, _coef1);
+    StorePair(_position_coeff.data() + 6, Scalar(1), Scalar(0));
+    StorePair(_position_coeff.data() + 8, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 10, tool_length, Scalar(0));
+    StorePair(_position_coeff.data() + 12, Scalar(0), Scalar(1));
+    StorePair(_position_coeff.data() + 14, Scalar(0), -_coef0);
+    StorePair(_position_coeff.data() + 16, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 18, Scalar(0), cos_A);
+    StorePair(_position_coeff.data() + 20, -sin_A, -_coef0);
+    StorePair(_position_coeff.data() + 22, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 24, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 26, Scalar(1), -_coef1);
+    StorePair(_position_coeff.data() + 28, Scalar(0), Scalar(0));
+    StorePair(_position_coeff.data() + 30, Scalar(0), sin_A);
+    StorePair(_position_coeff.data() + 32, cos_A, -_coef1);
+    StorePair(_position_coeff.data() + 34, Scalar(0), Scalar(0));
   }
   if (orientation_coeff != nullptr) {
     auto& _orientation_coeff = *orientation_coeff;
-    _orientation_coeff[0] = Scalar(0);
-    _orientation_coeff[1] = Scalar(0);
-    _orientation_coeff[2] = Scalar(0);
-    _orientation_coeff[3] = Scalar(1);
-    _orientation_coeff[4] = Scalar(0);
-    _orientation_coeff[5] = Scalar(0);
-    _orientation_coeff[6] = Scalar(0);
-    _orientation_coeff[7] = Scalar(0);
-    _orientation_coeff[8] = Scalar(0);
-    _orientation_coeff[9] = Scalar(1);
-    _orientation_coeff[10] = Scalar(0);
-    _orientation_coeff[11] = Scalar(0);
-    _orientation_coeff[12] = Scalar(0);
-    _orientation_coeff[13] = Scalar(0);
-    _orientation_coeff[14] = Scalar(0);
-    _orientation_coeff[15] = Scalar(0);
-    _orientation_coeff[16] = Scalar(1);
-    _orientation_coeff[17] = Scalar(0);
-    _orientation_coeff[18] = Scalar(0);
-    _orientation_coeff[19] = Scalar(0);
-    _orientation_coeff[20] = Scalar(0);
-    _orientation_coeff[21] = Scalar(0);
-    _orientation_coeff[22] = cos_A;
-    _orientation_coeff[23] = -sin_A;
-    _orientation_coeff[24] = Scalar(0);
-    _orientation_coeff[25] = Scalar(0);
-    _orientation_coeff[26] = Scalar(0);
-    _orientation_coeff[27] = Scalar(0);
-    _orientation_coeff[28] = Scalar(0);
-    _orientation_coeff[29] = Scalar(1);
-    _orientation_coeff[30] = Scalar(0);
-    _orientation_coeff[31] = Scalar(0);
-    _orientation_coeff[32] = Scalar(0);
-    _orientation_coeff[33] = Scalar(0);
-    _orientation_coeff[34] = sin_A;
-    _orientation_coeff[35] = cos_A;
+    StorePair(_orientation_coeff.data(), Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 2, Scalar(0), Scalar(1));
+    StorePair(_orientation_coeff.data() + 4, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 6, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 8, Scalar(0), Scalar(1));
+    StorePair(_orientation_coeff.data() + 10, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 12, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 14, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 16, Scalar(1), Scalar(0));
+    StorePair(_orientation_coeff.data() + 18, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 20, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 22, cos_A, -sin_A);
+    StorePair(_orientation_coeff.data() + 24, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 26, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 28, Scalar(0), Scalar(1));
+    StorePair(_orientation_coeff.data() + 30, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 32, Scalar(0), Scalar(0));
+    StorePair(_orientation_coeff.data() + 34, sin_A, cos_A);
   }
 }
 
@@ -429,20 +375,15 @@ void NominalPose([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
   // Outputs
   if (position != nullptr) {
     auto& _position = *position;
-    _position[0] = Scalar(0);
-    _position[1] = Y - sin_A * tool_length;
+    StorePair(_position.data(), Scalar(0), Y - sin_A * tool_length);
     _position[2] = cos_A * tool_length;
   }
   if (rotation != nullptr) {
     auto& _rotation = *rotation;
-    _rotation[0] = Scalar(1);
-    _rotation[1] = Scalar(0);
-    _rotation[2] = Scalar(0);
-    _rotation[3] = Scalar(0);
-    _rotation[4] = cos_A;
-    _rotation[5] = -sin_A;
-    _rotation[6] = Scalar(0);
-    _rotation[7] = sin_A;
+    StorePair(_rotation.data(), Scalar(1), Scalar(0));
+    StorePair(_rotation.data() + 2, Scalar(0), Scalar(0));
+    StorePair(_rotation.data() + 4, cos_A, -sin_A);
+    StorePair(_rotation.data() + 6, Scalar(0), sin_A);
     _rotation[8] = cos_A;
   }
 }
@@ -469,18 +410,12 @@ void NominalJacobian([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
   // Outputs
   if (jacobian != nullptr) {
     auto& _jacobian = *jacobian;
-    _jacobian[0] = Scalar(0);
-    _jacobian[1] = Scalar(0);
-    _jacobian[2] = Scalar(1);
-    _jacobian[3] = -_to_base0 * cos_A * tool_length;
-    _jacobian[4] = Scalar(0);
-    _jacobian[5] = -_to_base0 * sin_A * tool_length;
-    _jacobian[6] = Scalar(0);
-    _jacobian[7] = _to_base0;
-    _jacobian[8] = Scalar(0);
-    _jacobian[9] = Scalar(0);
-    _jacobian[10] = Scalar(0);
-    _jacobian[11] = Scalar(0);
+    StorePair(_jacobian.data(), Scalar(0), Scalar(0));
+    StorePair(_jacobian.data() + 2, Scalar(1), -_to_base0 * cos_A * tool_length);
+    StorePair(_jacobian.data() + 4, Scalar(0), -_to_base0 * sin_A * tool_length);
+    StorePair(_jacobian.data() + 6, Scalar(0), _to_base0);
+    StorePair(_jacobian.data() + 8, Scalar(0), Scalar(0));
+    StorePair(_jacobian.data() + 10, Scalar(0), Scalar(0));
   }
 }
 

@@ -194,6 +194,18 @@ struct Coefficients {
       }
   }
 
+  // c = factor · symbol (an axis, a parameter, sin/cos of an axis), or nullopt: the monomials
+  // with such a coefficient are grouped like those of a placeholder, Y·(E_C0X + E_CX − E_CZ),
+  // one multiplication for the group instead of one per error.
+  static std::optional<std::pair<ex, GiNaC::symbol>> symbol_times_number(const ex& c) {
+    if (GiNaC::is_a<GiNaC::symbol>(c)) return std::make_pair(ex(1), GiNaC::ex_to<GiNaC::symbol>(c));
+    if (!GiNaC::is_a<GiNaC::mul>(c) || c.nops() != 2) return std::nullopt;
+    for (std::size_t i = 0; i < 2; ++i)
+      if (GiNaC::is_a<GiNaC::numeric>(c.op(i)) && GiNaC::is_a<GiNaC::symbol>(c.op(1 - i)))
+        return std::make_pair(c.op(i), GiNaC::ex_to<GiNaC::symbol>(c.op(1 - i)));
+    return std::nullopt;
+  }
+
   // Σ c_m · monomial_m of one output, grouped by placeholder, each group's monomials (and those
   // with an inline coefficient) in nested form (factored_sum).
   // With max_degree > 0, only the monomials up to that degree.
@@ -203,7 +215,9 @@ struct Coefficients {
     std::map<std::string, std::pair<GiNaC::symbol, Terms>> grouped;
     for (const auto& [mono, c] : p.terms()) {
       if (max_degree > 0 && static_cast<int>(mono.size()) > max_degree) continue;
-      if (auto s = split(c)) {
+      std::optional<std::pair<ex, GiNaC::symbol>> s = split(c);
+      if (!s) s = symbol_times_number(c);
+      if (s) {
         auto& g = grouped[s->second.get_name()];
         g.first = s->second;
         g.second.emplace_back(mono, s->first);
@@ -289,6 +303,15 @@ FunctionCode function_body(const InputTable& inputs, const std::vector<OutputGro
     if (g.fill_zeros) os << "    " << alias << ".fill(Scalar(0));\n";
     for (std::size_t i = 0; i < g.values.size(); ++i, ++k) {
       if (g.fill_zeros && cse.outputs[k].is_zero()) continue;
+      // Neighbours 2j, 2j + 1 by one StorePair (model.hpp: a 16-byte store for double); compilers
+      // store them one by one otherwise, and the stores bound these functions.
+      if (!g.fill_zeros && i % 2 == 0 && i + 1 < g.values.size()) {
+        os << "    StorePair(" << alias << ".data()" << (i ? " + " + std::to_string(i) : "") << ", "
+           << printer.print(cse.outputs[k]) << ", " << printer.print(cse.outputs[k + 1]) << ");\n";
+        ++i;
+        ++k;
+        continue;
+      }
       os << "    " << alias << "[" << i << "] = " << printer.print(cse.outputs[k]) << ";\n";
     }
     os << "  }\n";

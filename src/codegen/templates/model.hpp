@@ -25,6 +25,10 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <type_traits>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 // ---- weilgen template: higher_includes begin ----
 #include <cstdint>
 // ---- weilgen template: higher_includes end ----
@@ -118,6 +122,24 @@ inline constexpr std::array<std::array<int, 1>, kNumHigherTerms> kHigherTerms = 
 inline constexpr std::size_t kNumMonomialCoefficients = 0;
 // ---- weilgen template: monomial_count end ----
 // ---- weilgen template: monomial_tables end ----
+// out[0] = first, out[1] = second: two neighbouring outputs. With SSE2, a double pair is one
+// 16-byte store; compilers store mixed pairs (a constant and a symbol) one by one otherwise, and
+// the stores, not the arithmetic, bound the generated functions (docs/performance.md). The values
+// convert to Scalar (expression-template scalars). Deviation, Coefficients and
+// DeviationAndCoefficients are declared inline (a hint that raises the compiler's size limit):
+// a small model's function then becomes part of the caller's loop, without the call.
+template <typename Scalar>
+inline void StorePair(Scalar* const out, const std::common_type_t<Scalar>& first,
+                      const std::common_type_t<Scalar>& second) {
+  out[0] = first;
+  out[1] = second;
+}
+#if defined(__SSE2__)
+inline void StorePair(double* const out, const double first, const double second) {
+  _mm_storeu_pd(out, _mm_set_pd(second, first));
+}
+#endif
+
 // ---- weilgen template: functions begin ----
 // ---- weilgen template: deviation begin ----
 // ---- weilgen template: deviation_subject begin ----
@@ -131,11 +153,11 @@ inline constexpr std::size_t kNumMonomialCoefficients = 0;
 //   params: tool_length
 // ---- weilgen template: inputs end ----
 template <typename Scalar>
-void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
-               [[maybe_unused]] const std::array<Scalar, kNumErrors>& errors,
-               [[maybe_unused]] const std::array<Scalar, kNumParams>& params,
-               std::array<Scalar, 3>* const position,
-               std::array<Scalar, 3>* const orientation = nullptr) {
+inline void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
+                      [[maybe_unused]] const std::array<Scalar, kNumErrors>& errors,
+                      [[maybe_unused]] const std::array<Scalar, kNumParams>& params,
+                      std::array<Scalar, 3>* const position,
+                      std::array<Scalar, 3>* const orientation = nullptr) {
   using std::cos;
   using std::sin;
   using std::sqrt;
@@ -149,10 +171,10 @@ void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
 // position_coeff rows dx, dy, dz (mm per base unit of the error), orientation_coeff rows
 // da, db, dc (rad per base unit).
 template <typename Scalar>
-void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
-                  [[maybe_unused]] const std::array<Scalar, kNumParams>& params,
-                  std::array<Scalar, 3 * kNumErrors>* const position_coeff,
-                  std::array<Scalar, 3 * kNumErrors>* const orientation_coeff = nullptr) {
+inline void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
+                         [[maybe_unused]] const std::array<Scalar, kNumParams>& params,
+                         std::array<Scalar, 3 * kNumErrors>* const position_coeff,
+                         std::array<Scalar, 3 * kNumErrors>* const orientation_coeff = nullptr) {
   using std::cos;
   using std::sin;
   using std::sqrt;
@@ -166,7 +188,7 @@ void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
 // the terms common to both (one common-subexpression pass over both). The same outputs
 // as the two functions, equal to rounding; null outputs are skipped.
 template <typename Scalar>
-void DeviationAndCoefficients(
+inline void DeviationAndCoefficients(
     [[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
     [[maybe_unused]] const std::array<Scalar, kNumErrors>& errors,
     [[maybe_unused]] const std::array<Scalar, kNumParams>& params,
