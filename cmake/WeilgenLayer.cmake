@@ -1,13 +1,14 @@
-# weilgen_add_layer(<name> [COLD] [DIRS sub...] [DEPENDS lib...] [PRIVATE lib...])
+# weilgen_add_layer(<name> [COLD|TEXT] [DIRS sub...] [DEPENDS lib...] [PRIVATE lib...])
 #
 # One static library per layer, weilgen_<name> (alias weilgen::<name>), from the layer folder's
 # *.cpp (and those of DIRS). Its public headers are <folder>/include/weilgen/<name>/*.hpp and are
 # seen only by targets that link it: a layer can include a header of another layer only when it
 # lists that layer in DEPENDS, so the compiler enforces the arrows of docs/architecture.md.
 # Headers beside the sources are the layer's internals, visible to the layer alone. COLD: no hot
-# loop in the layer, compiled with WEILGEN_COLD_OPTIONS (-O2 in Release).
+# loop in the layer, compiled with WEILGEN_COLD_OPTIONS (-O2 in Release); TEXT: it only writes
+# text, WEILGEN_TEXT_OPTIONS (-O1).
 function(weilgen_add_layer name)
-  cmake_parse_arguments(PARSE_ARGV 1 ARG "COLD" "" "DIRS;DEPENDS;PRIVATE")
+  cmake_parse_arguments(PARSE_ARGV 1 ARG "COLD;TEXT" "" "DIRS;DEPENDS;PRIVATE")
   set(globs ${CMAKE_CURRENT_SOURCE_DIR}/*.cpp)
   foreach(dir IN LISTS ARG_DIRS)
     list(APPEND globs ${CMAKE_CURRENT_SOURCE_DIR}/${dir}/*.cpp)
@@ -22,6 +23,8 @@ function(weilgen_add_layer name)
   target_compile_options(weilgen_${name} PRIVATE ${WEILGEN_WARNINGS})
   if(ARG_COLD)
     target_compile_options(weilgen_${name} PRIVATE ${WEILGEN_COLD_OPTIONS})
+  elseif(ARG_TEXT)
+    target_compile_options(weilgen_${name} PRIVATE ${WEILGEN_TEXT_OPTIONS})
   endif()
   weilgen_unity(weilgen_${name})
 endfunction()
