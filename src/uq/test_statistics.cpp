@@ -1,7 +1,6 @@
 #include "weilgen/uq/test_statistics.hpp"
 
 #include <boost/math/distributions/fisher_f.hpp>
-#include <boost/math/distributions/normal.hpp>
 #include <boost/math/distributions/students_t.hpp>
 
 namespace weilgen {
@@ -13,11 +12,6 @@ double fisher_f_sf(double f, double d1, double d2) {
 
 double students_t_quantile(double dof, double p) {
   return boost::math::quantile(boost::math::students_t_distribution<double>(dof), p);
-}
-
-double normal_upper_quantile(double p) {
-  return boost::math::quantile(
-      boost::math::complement(boost::math::normal_distribution<double>(), p));
 }
 
 }  // namespace weilgen

@@ -11,7 +11,7 @@
 #include <numeric>
 
 #include "internal.hpp"
-#include "weilgen/uq/test_statistics.hpp"
+#include "weilgen/uq/distribution.hpp"
 
 namespace weilgen::gap_detail {
 
@@ -61,7 +61,7 @@ std::vector<GapOutlier> find_outliers(const GapData& d, const VectorXd& res, con
     const double sigma = 1.4826 * median(v);
     if (!(sigma > 0)) continue;
     const double n = static_cast<double>(mine.size());
-    const double z = std::max(6.0, normal_upper_quantile(0.005 / n));
+    const double z = std::max(6.0, -normal_quantile(0.005 / n));  // P(Z > z) = 0.005 / n
     // Structure when neighbours share a good part of the deviation (a bump or a step moves them
     // by a similar amount); a spike's neighbours are at most pulled a little by the fit.
     auto shared = [&](const std::vector<std::size_t>& nb, double dev) {

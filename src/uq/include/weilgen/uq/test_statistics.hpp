@@ -1,6 +1,7 @@
-// Tail probabilities and quantiles of the test statistics the runtime reports (F, Student t,
-// normal): Boost.Math underneath, compiled once in uq/test_statistics.cpp rather than in each
-// file that tests a hypothesis (about 2 s of compile time per file).
+// Tail probabilities and quantiles of the test statistics the runtime reports (F, Student t):
+// Boost.Math underneath, compiled once in uq/test_statistics.cpp rather than in each file that
+// tests a hypothesis (about 2 s of compile time per file). The standard normal's are in
+// distribution.hpp (normal_cdf, normal_quantile).
 #pragma once
 
 namespace weilgen {
@@ -9,8 +10,5 @@ namespace weilgen {
 double fisher_f_sf(double f, double d1, double d2);
 // The p-quantile of Student's t with `dof` > 0 degrees of freedom, 0 < p < 1.
 double students_t_quantile(double dof, double p);
-// z with P(Z > z) = p for a standard normal Z, 0 < p < 1 (Boost.Math's complement quantile,
-// accurate for p far below 1e-16, where 1 - p rounds to 1).
-double normal_upper_quantile(double p);
 
 }  // namespace weilgen
