@@ -7,6 +7,13 @@
 //   generated_coeff         Coefficients (6 x n first-order coefficients)
 //   generated_dev+coeff     Deviation then Coefficients: two calls
 //   generated_combined      DeviationAndCoefficients: the same outputs in one call
+//   generated_pack          DeviationAndCoefficients<Pack<kLanes>>: kLanes poses per call, one per
+//                           SIMD lane (kLanes = 8 with AVX-512, 4 with AVX, else 2: what the
+//                           build's flags give); one iteration = kLanes poses, the summary divides
+//                           by kLanes
+//   output_floor_pack       its store floor: the same number of packs stored, one full-width store
+//                           each (no loads: a table of the pipe cutter's would not stay in L1)
+//   output_floor_pack+sincos  the same plus Pack's sin and cos of every rotary axis
 //   output_floor            the load/store floor of those outputs: their 6 + 6n values, computed
 //                           before timing, copied from an L1-resident table into the same arrays
 //                           by 16-byte loads and stores (no code producing them can be faster)
@@ -63,7 +70,15 @@
 namespace {
 
 constexpr std::size_t kNumPoses = 1024;  // power of two: the pose index wraps with a mask
-constexpr double kFdStep = 1e-6;         // central-difference step, base units (mm, rad)
+#if defined(__AVX512F__)
+constexpr std::size_t kLanes = 8;  // doubles per SIMD register of the build's target
+#elif defined(__AVX__)
+constexpr std::size_t kLanes = 4;
+#else
+constexpr std::size_t kLanes = 2;
+#endif
+using Lanes = weilgen_models::Pack<kLanes>;
+constexpr double kFdStep = 1e-6;  // central-difference step, base units (mm, rad)
 
 using Eigen::Matrix3d;
 using Eigen::Vector3d;
@@ -315,6 +330,10 @@ class FixedChain {
     static void DeviationAndCoefficients(const Args&... args) {               \
       weilgen_models::NS::DeviationAndCoefficients<double>(args...);          \
     }                                                                         \
+    template <typename... Args>                                               \
+    static void DeviationAndCoefficientsPack(const Args&... args) {           \
+      weilgen_models::NS::DeviationAndCoefficients<Lanes>(args...);           \
+    }                                                                         \
   }
 
 WEILGEN_BENCH_MODEL(gantry_grinder, FixedChain);
@@ -332,6 +351,10 @@ struct PoseSet {
   std::vector<std::array<double, M::kNumAxes>> axes;
   std::vector<std::array<double, M::kNumErrors>> errors;
   std::array<double, M::kNumParams> params{};
+  // The same poses kLanes at a time, pose p in lane p % kLanes of pack p / kLanes.
+  std::vector<std::array<Lanes, M::kNumAxes>> pack_axes;
+  std::vector<std::array<Lanes, M::kNumErrors>> pack_errors;
+  std::array<Lanes, M::kNumParams> pack_params{};
   std::vector<std::vector<double>> chain_axes;
   std::vector<std::vector<double>> chain_errors;
   weilgen::NumericChain chain;
@@ -354,6 +377,15 @@ struct PoseSet {
       chain_axes.emplace_back(axes[p].begin(), axes[p].end());
       chain_errors.emplace_back(errors[p].begin(), errors[p].end());
     }
+    pack_axes.resize(kNumPoses / kLanes);
+    pack_errors.resize(kNumPoses / kLanes);
+    for (std::size_t p = 0; p < kNumPoses; ++p) {
+      for (std::size_t k = 0; k < M::kNumAxes; ++k)
+        pack_axes[p / kLanes][k].Set(p % kLanes, axes[p][k]);
+      for (std::size_t k = 0; k < M::kNumErrors; ++k)
+        pack_errors[p / kLanes][k].Set(p % kLanes, errors[p][k]);
+    }
+    for (std::size_t k = 0; k < M::kNumParams; ++k) pack_params[k] = Lanes(params[k]);
   }
 };
 
@@ -457,6 +489,26 @@ void BM_GeneratedCombined(benchmark::State& state) {
   state.SetItemsProcessed(static_cast<int64_t>(state.iterations()));
 }
 
+// kLanes poses per iteration, in the layout Pack wants (built before timing, as the per-pose
+// benchmarks' inputs are): the outputs stay in packs, lane l the pose of lane l.
+template <typename M>
+void BM_GeneratedPack(benchmark::State& state) {
+  const PoseSet<M>& s = poses<M>();
+  std::array<Lanes, 3> position{}, orientation{};
+  std::array<Lanes, 3 * M::kNumErrors> position_coeff{}, orientation_coeff{};
+  std::size_t p = 0;
+  for (auto _ : state) {
+    M::DeviationAndCoefficientsPack(s.pack_axes[p], s.pack_errors[p], s.pack_params, &position,
+                                    &orientation, &position_coeff, &orientation_coeff);
+    benchmark::DoNotOptimize(position);
+    benchmark::DoNotOptimize(orientation);
+    benchmark::DoNotOptimize(position_coeff);
+    benchmark::DoNotOptimize(orientation_coeff);
+    p = (p + 1) & (kNumPoses / kLanes - 1);
+  }
+  state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * kLanes));
+}
+
 // The load/store floor of DeviationAndCoefficients' outputs: per pose, its 6 + 6n outputs
 // (computed before timing) copied from a table into the same four arrays the generated function
 // writes. No code that computes these outputs can store them faster; the table's loads are what
@@ -494,6 +546,51 @@ struct OutputTable {
                                   &rows[p].orientation_coeff);
   }
 };
+
+// The same floor for Pack<kLanes>: kLanes poses' outputs stored as packs, one full-width store
+// each, of a value that changes per iteration (one iteration = kLanes poses). A copy from a table
+// would measure the cache instead: the pipe cutter's outputs are 27 KiB per call at 8 lanes, a
+// table of them and the destination do not fit in L1 together. No code writing these outputs as
+// packs can store them faster.
+template <std::size_t N>
+void fill_packs(std::array<Lanes, N>& dst, const Lanes& value) {
+#pragma GCC unroll 256
+  for (std::size_t i = 0; i < N; ++i) dst[i] = value;
+}
+
+// kSinCos: plus Pack's sin and cos of every revolute axis (in rad), as the generated code calls
+// them, over the same packs of poses as generated_pack.
+template <typename M, bool kSinCos>
+void BM_OutputFloorPack(benchmark::State& state) {
+  [[maybe_unused]] const PoseSet<M>& s = poses<M>();
+  std::array<Lanes, 3> position{}, orientation{};
+  std::array<Lanes, 3 * M::kNumErrors> position_coeff{}, orientation_coeff{};
+  double p = 0;
+  std::size_t pack = 0;
+  for (auto _ : state) {
+    Lanes value(p);
+    if constexpr (kSinCos) {
+      using std::cos;
+      using std::sin;
+      for (std::size_t k = 0; k < M::kNumAxes; ++k)
+        if (M::kAxes[k].revolute) {
+          const Lanes angle = s.pack_axes[pack][k] * Lanes(M::kAxes[k].to_base);
+          value += cos(angle) + sin(angle);
+        }
+      pack = (pack + 1) & (kNumPoses / kLanes - 1);
+    }
+    fill_packs(position, value);
+    fill_packs(orientation, value);
+    fill_packs(position_coeff, value);
+    fill_packs(orientation_coeff, value);
+    benchmark::DoNotOptimize(position);
+    benchmark::DoNotOptimize(orientation);
+    benchmark::DoNotOptimize(position_coeff);
+    benchmark::DoNotOptimize(orientation_coeff);
+    p += 1;
+  }
+  state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * kLanes));
+}
 
 // kSinCos: the output floor plus what no code can skip on a machine with rotary axes, sin and
 // cos of every revolute axis value of the pose (in rad), called as the generated code calls them
@@ -609,8 +706,10 @@ bool check_agreement() {
   }
   constexpr std::size_t n = M::kNumErrors;
   double eigen_diff = 0, dev_max = 0, gen_diff = 0, coeff_diff = 0, coeff_max = 0, fd_diff = 0,
-         combined_diff = 0;
+         combined_diff = 0, pack_diff = 0;
   auto ws = s.fixed.workspace();
+  std::array<Lanes, 3> pack_position{}, pack_orientation{};
+  std::array<Lanes, 3 * n> pack_pc{}, pack_oc{};
   std::vector<double> scratch(n, 0.0), fd(6 * n, 0.0);
   for (std::size_t p = 0; p < 64; ++p) {
     std::array<double, 3> position{}, orientation{}, position2{}, orientation2{};
@@ -619,6 +718,11 @@ bool check_agreement() {
     M::Coefficients(s.axes[p], s.params, &pc, &oc);
     M::DeviationAndCoefficients(s.axes[p], s.errors[p], s.params, &position2, &orientation2, &pc2,
                                 &oc2);
+    const std::size_t lane = p % kLanes;
+    if (lane == 0)
+      M::DeviationAndCoefficientsPack(s.pack_axes[p / kLanes], s.pack_errors[p / kLanes],
+                                      s.pack_params, &pack_position, &pack_orientation, &pack_pc,
+                                      &pack_oc);
     std::array<double, 6> eigen{}, eigen2{};
     std::array<double, 6 * n> analytic{}, analytic2{};
     s.fixed.deviation(s.axes[p].data(), s.errors[p].data(), eigen.data());
@@ -635,6 +739,8 @@ bool check_agreement() {
           std::max({eigen_diff, std::abs(eigen[o] - chain[o]), std::abs(eigen2[o] - eigen[o])});
       gen_diff = std::max(gen_diff, std::abs(g - chain[o]));
       combined_diff = std::max(combined_diff, std::abs(g2 - g));
+      pack_diff = std::max(
+          pack_diff, std::abs((o < 3 ? pack_position[o] : pack_orientation[o - 3]).Get(lane) - g2));
       for (std::size_t j = 0; j < n; ++j) {
         const std::size_t r = (o % 3) * n + j;
         const double c = o < 3 ? pc[r] : oc[r], c2 = o < 3 ? pc2[r] : oc2[r];
@@ -642,20 +748,22 @@ bool check_agreement() {
         coeff_diff = std::max({coeff_diff, std::abs(c - analytic[o * n + j]),
                                std::abs(analytic2[o * n + j] - analytic[o * n + j])});
         combined_diff = std::max(combined_diff, std::abs(c2 - c));
+        pack_diff = std::max(pack_diff, std::abs((o < 3 ? pack_pc[r] : pack_oc[r]).Get(lane) - c2));
         if (p < 8) fd_diff = std::max(fd_diff, std::abs(c - fd[o * n + j]));
       }
     }
   }
   // Exact sides to rounding; the order-1 model against the exact chain to O(e^2).
   ok = eigen_diff <= 1e-12 * std::max(1.0, dev_max) && coeff_diff <= 1e-12 * coeff_max &&
-       combined_diff <= 1e-12 * std::max(coeff_max, dev_max) && gen_diff <= 1e-3 * dev_max &&
+       combined_diff <= 1e-12 * std::max(coeff_max, dev_max) &&
+       pack_diff <= 1e-12 * std::max(coeff_max, dev_max) && gen_diff <= 1e-3 * dev_max &&
        fd_diff <= 1e-6 * std::max(1.0, coeff_max);
   std::fprintf(stderr,
                "check %-15s |eigen - NumericChain| %.1e, |analytic - Coefficients| %.1e (max "
-               "|coeff| %.3g), |combined - separate| %.1e, |Deviation - exact| %.1e (max |dev| "
-               "%.3g, O(e^2)), |Coefficients - FD| %.1e: %s\n",
-               M::kName, eigen_diff, coeff_diff, coeff_max, combined_diff, gen_diff, dev_max,
-               fd_diff, ok ? "ok" : "MISMATCH");
+               "|coeff| %.3g), |combined - separate| %.1e, |Pack<%zu> lane - combined| %.1e, "
+               "|Deviation - exact| %.1e (max |dev| %.3g, O(e^2)), |Coefficients - FD| %.1e: %s\n",
+               M::kName, eigen_diff, coeff_diff, coeff_max, combined_diff, kLanes, pack_diff,
+               gen_diff, dev_max, fd_diff, ok ? "ok" : "MISMATCH");
   return ok;
 }
 
@@ -667,6 +775,10 @@ void register_machine() {
   benchmark::RegisterBenchmark((m + "/generated_dev+coeff").c_str(),
                                BM_GeneratedDeviationCoefficients<M>);
   benchmark::RegisterBenchmark((m + "/generated_combined").c_str(), BM_GeneratedCombined<M>);
+  benchmark::RegisterBenchmark((m + "/generated_pack").c_str(), BM_GeneratedPack<M>);
+  benchmark::RegisterBenchmark((m + "/output_floor_pack").c_str(), BM_OutputFloorPack<M, false>);
+  benchmark::RegisterBenchmark((m + "/output_floor_pack+sincos").c_str(),
+                               BM_OutputFloorPack<M, true>);
   benchmark::RegisterBenchmark((m + "/output_floor").c_str(), BM_OutputFloor<M, false>);
   benchmark::RegisterBenchmark((m + "/output_floor+sincos").c_str(), BM_OutputFloor<M, true>);
   benchmark::RegisterBenchmark((m + "/eigen_dev").c_str(), BM_EigenDeviation<M>);
@@ -702,7 +814,7 @@ class SummaryReporter : public benchmark::ConsoleReporter {
 
   void Finalize() override {
     ConsoleReporter::Finalize();
-    std::ostringstream main, extra, floors;
+    std::ostringstream main, extra, floors, packs;
     for (const auto& [machine, n] : machines_) {
       const std::string& key = machine;  // clang < 16 cannot capture a structured binding
       const auto get = [&](const std::string& what) {
@@ -713,7 +825,10 @@ class SummaryReporter : public benchmark::ConsoleReporter {
                    two = get("generated_dev+coeff"), one = get("generated_combined"),
                    a = get("eigen_dev"), b = get("analytic_coeff"),
                    ab = get("eigen_dev+analytic_coeff"), fd = get("extra_chain_dev+fd_coeff"),
-                   floor = get("output_floor"), trig = get("output_floor+sincos");
+                   floor = get("output_floor"), trig = get("output_floor+sincos"),
+                   pack = get("generated_pack") / kLanes,
+                   pack_floor = get("output_floor_pack") / kLanes,
+                   pack_trig = get("output_floor_pack+sincos") / kLanes;
       if (dev == 0 || coeff == 0 || two == 0 || one == 0 || a == 0 || b == 0 || ab == 0)
         continue;  // filtered out
       main << std::fixed << std::setprecision(1) << "| " << machine << " | " << n << " | " << dev
@@ -724,6 +839,12 @@ class SummaryReporter : public benchmark::ConsoleReporter {
         floors << std::fixed << std::setprecision(1) << "| " << machine << " | " << one << " | "
                << ab << " | " << floor << " | " << one / floor << "x | " << trig << " | "
                << one / trig << "x | " << ab / trig << "x |\n";
+      if (pack > 0)
+        packs << std::fixed << std::setprecision(1) << "| " << machine << " | " << one << " | "
+              << pack << " | " << ab << " | " << ab / one << "x | **" << ab / pack << "x** | "
+              << pack_floor << " | " << (pack_floor > 0 ? pack / pack_floor : 0.0) << "x | "
+              << pack_trig << " | " << (pack_trig > 0 ? pack / pack_trig : 0.0) << "x | " << trig
+              << " |\n";
       if (fd != 0)
         extra << std::fixed << "| " << machine << " | " << std::setprecision(1) << one << " | "
               << std::setprecision(0) << fd << " | " << fd / one << "x |\n";
@@ -747,6 +868,15 @@ class SummaryReporter : public benchmark::ConsoleReporter {
              "generated / floor | floor + sin/cos | generated / (floor + sin/cos) | (a + b) / "
              "(floor + sin/cos) |\n| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n"
           << floors.str();
+    if (!packs.str().empty())
+      out << "\nSeveral poses at once: DeviationAndCoefficients<Pack<" << kLanes
+          << ">>, one pose per lane (CPU ns per pose = per call / " << kLanes << ")\n\n"
+          << "| machine | generated DeviationAndCoefficients | Pack<" << kLanes
+          << "> per pose | (a) + (b) | (a + b) / generated | (a + b) / Pack | output floor as "
+             "packs | Pack / its floor | that floor + Pack sin/cos | Pack / (floor + sin/cos) | "
+             "floor + sin/cos (one pose at a time) |\n| --- | ---: | ---: | ---: | ---: | ---: | "
+             "---: | ---: | ---: | ---: | ---: |\n"
+          << packs.str();
     if (!extra.str().empty())
       out << "\nExtra (not a competent baseline): the numeric chain with finite-difference "
              "coefficients\n\n"

@@ -33,7 +33,9 @@ tmp="$(mktemp -d)"
 trap 'rm -rf "$tmp"' EXIT
 echo "start: $(uptime)"
 for h in "${headers[@]}"; do
-  ns=$(grep -m1 -A1 '^namespace weilgen_models {' "$h" | tail -1 | sed 's/namespace \(.*\) {/\1/')
+  # The model's namespace: the first one opened inside weilgen_models (Pack comes before it).
+  ns=$(grep -E '^namespace [A-Za-z_][A-Za-z0-9_]* \{$' "$h" | grep -v -m1 '^namespace weilgen_models {' |
+    sed 's/namespace \(.*\) {/\1/')
   higher=0
   grep -q '^void HigherOrder' "$h" && higher=1
   n="weilgen_models::$ns"

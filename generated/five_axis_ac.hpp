@@ -5,7 +5,7 @@
 //        position outputs dx, dy, dz in mm, orientation outputs da, db, dc in rad.
 // Operation counts (after common-subexpression elimination):
 //   Deviation:    331 (adds 193, muls 134, divs 0, functions 4), 39 temporaries
-//   Coefficients: 151 (adds 89, muls 58, divs 0, functions 4), 47 temporaries
+//   Coefficients: 133 (adds 71, muls 58, divs 0, functions 4), 48 temporaries
 //   DeviationAndCoefficients: 331 (adds 193, muls 134, divs 0, functions 4), 39 temporaries
 //   NominalPose:  38 (adds 9, muls 25, divs 0, functions 4), 0 temporaries
 //   NominalJacobian: 60 (adds 12, muls 44, divs 0, functions 4), 0 temporaries
@@ -21,6 +21,199 @@
 #endif
 
 namespace weilgen_models {
+
+// Pack<Lanes>: `Lanes` doubles evaluated together, one pose (or one error sample) per lane, as the
+// Scalar of the evaluation functions: DeviationAndCoefficients<Pack<4>> evaluates 4 poses with one
+// instruction per operation where the target has registers of 4 doubles (AVX2; 8 with AVX-512).
+// Each lane is the double function's result for that lane's inputs: the same operations in the
+// same order, sin/cos/sqrt from the C library lane by lane (docs/generator.md, "Several poses at
+// once"). Compensate needs comparisons and takes double only. Defined once per translation unit,
+// however many model headers it includes.
+#ifndef WEILGEN_MODELS_PACK_DEFINED
+#define WEILGEN_MODELS_PACK_DEFINED
+// GCC's and Clang's vector extension; elsewhere (or with WEILGEN_MODELS_PACK_PORTABLE defined) a
+// plain array, lane by lane, which the optimiser may vectorise.
+#if (defined(__GNUC__) || defined(__clang__)) && !defined(WEILGEN_MODELS_PACK_PORTABLE)
+#define WEILGEN_MODELS_PACK_VECTOR 1
+#else
+#define WEILGEN_MODELS_PACK_VECTOR 0
+#endif
+#if WEILGEN_MODELS_PACK_VECTOR
+// GCC takes no vector_size that depends on a template parameter: one type per lane count.
+template <std::size_t Lanes>
+struct PackVector;
+template <>
+struct PackVector<2> {
+  typedef double type __attribute__((vector_size(16)));
+  typedef long long bits __attribute__((vector_size(16)));
+};
+template <>
+struct PackVector<4> {
+  typedef double type __attribute__((vector_size(32)));
+  typedef long long bits __attribute__((vector_size(32)));
+};
+template <>
+struct PackVector<8> {
+  typedef double type __attribute__((vector_size(64)));
+  typedef long long bits __attribute__((vector_size(64)));
+};
+#endif
+// Each operation lane by lane, as a hidden friend (found by argument-dependent lookup, a double
+// converts to every lane): with the vector extension one instruction where the target has the
+// registers, else a loop.
+#if WEILGEN_MODELS_PACK_VECTOR
+#define WEILGEN_MODELS_PACK_LANES(EXPR) Pack(EXPR)
+#else
+#define WEILGEN_MODELS_PACK_LANES(EXPR) Pack::Map([&](const std::size_t i) { return EXPR; })
+#endif
+template <std::size_t Lanes>
+struct Pack {
+  static_assert(Lanes == 2 || Lanes == 4 || Lanes == 8, "2, 4 or 8 lanes");
+#if WEILGEN_MODELS_PACK_VECTOR
+  using Vector = typename PackVector<Lanes>::type;
+  Vector v;
+  Pack() = default;
+  Pack(const double x) : v(Vector{} + x) {}  // every lane x (implicit: Scalar(0.5) in the code)
+  explicit Pack(const Vector& x) : v(x) {}
+  double Get(const std::size_t i) const { return v[i]; }
+  void Set(const std::size_t i, const double x) { v[i] = x; }
+#define WEILGEN_MODELS_PACK_LANE(P) (P).v
+#else
+  double v[Lanes];
+  Pack() = default;
+  Pack(const double x) {
+    for (std::size_t i = 0; i < Lanes; ++i) v[i] = x;
+  }
+  double Get(const std::size_t i) const { return v[i]; }
+  void Set(const std::size_t i, const double x) { v[i] = x; }
+  template <typename F>
+  static Pack Map(const F& f) {
+    Pack r;
+    for (std::size_t i = 0; i < Lanes; ++i) r.v[i] = f(i);
+    return r;
+  }
+#define WEILGEN_MODELS_PACK_LANE(P) (P).v[i]
+#endif
+  static Pack Load(const double* const from) {  // from[0 .. Lanes)
+    Pack p;
+    for (std::size_t i = 0; i < Lanes; ++i) p.Set(i, from[i]);
+    return p;
+  }
+  void Store(double* const to) const {  // to[0 .. Lanes)
+    for (std::size_t i = 0; i < Lanes; ++i) to[i] = Get(i);
+  }
+
+  friend Pack operator+(const Pack& a, const Pack& b) {
+    return WEILGEN_MODELS_PACK_LANES(WEILGEN_MODELS_PACK_LANE(a) + WEILGEN_MODELS_PACK_LANE(b));
+  }
+  friend Pack operator-(const Pack& a, const Pack& b) {
+    return WEILGEN_MODELS_PACK_LANES(WEILGEN_MODELS_PACK_LANE(a) - WEILGEN_MODELS_PACK_LANE(b));
+  }
+  friend Pack operator*(const Pack& a, const Pack& b) {
+    return WEILGEN_MODELS_PACK_LANES(WEILGEN_MODELS_PACK_LANE(a) * WEILGEN_MODELS_PACK_LANE(b));
+  }
+  friend Pack operator/(const Pack& a, const Pack& b) {
+    return WEILGEN_MODELS_PACK_LANES(WEILGEN_MODELS_PACK_LANE(a) / WEILGEN_MODELS_PACK_LANE(b));
+  }
+  friend Pack operator-(const Pack& a) { return WEILGEN_MODELS_PACK_LANES(-WEILGEN_MODELS_PACK_LANE(a)); }
+  friend Pack& operator+=(Pack& a, const Pack& b) { return a = a + b; }
+  friend Pack& operator-=(Pack& a, const Pack& b) { return a = a - b; }
+  friend Pack& operator*=(Pack& a, const Pack& b) { return a = a * b; }
+  // With 4 or 8 lanes, sin and cos of every lane at once (SinCos below, within 1 ulp of the C
+  // library's); with 2 (no faster than two library calls, measured) or without the vector
+  // extension, the C library's lane by lane, as the double functions call it.
+  friend Pack sin(const Pack& a) {
+#if WEILGEN_MODELS_PACK_VECTOR
+    if constexpr (Lanes >= 4) {
+      Pack s, c;
+      SinCos(a, &s, &c);
+      return s;
+    }
+#endif
+    return Apply(a, [](const double x) { return std::sin(x); });
+  }
+  friend Pack cos(const Pack& a) {
+#if WEILGEN_MODELS_PACK_VECTOR
+    if constexpr (Lanes >= 4) {
+      Pack s, c;
+      SinCos(a, &s, &c);
+      return c;
+    }
+#endif
+    return Apply(a, [](const double x) { return std::cos(x); });
+  }
+  friend Pack sqrt(const Pack& a) { return Apply(a, [](const double x) { return std::sqrt(x); }); }
+
+ private:
+#if WEILGEN_MODELS_PACK_VECTOR
+  // sin and cos of all lanes in vector arithmetic: the lane-by-lane C library calls would be
+  // most of a rotary machine's time. fdlibm's method (e_rem_pio2.c, k_sin.c, k_cos.c): x - n*pi/2
+  // with pi/2 in three 33-bit parts and their tails (good to 151 bits, so x near a multiple of
+  // pi/2 keeps its digits), then the kernels on [-pi/4, pi/4] with the reduced argument's tail,
+  // the quadrant n mod 4 choosing and negating. Within 1 ulp of glibc (correctly rounded) for
+  // |x| <= 1e6 rad; about 15 % of arguments differ by that 1 ulp (tests/test_generated_headers.cpp).
+  // A lane beyond 1e6 rad (n * pi/2 no longer exact), infinite or NaN: the C library, lane by
+  // lane, for the whole pack.
+  static void SinCos(const Pack& a, Pack* const sin_a, Pack* const cos_a) {
+    using Bits = typename PackVector<Lanes>::bits;
+    const Vector x = a.v;
+    const Bits sign = (Bits)(-Vector{});  // -0.0: the sign bit of every lane
+    const double magic = 6755399441055744.0;  // 1.5 * 2^52: (t + magic) - magic rounds t
+    const Vector shifted = x * 6.36619772367581382433e-01 + magic;  // x * 2/pi + magic
+    const Vector n = shifted - magic;
+    const Bits quadrant = (Bits)shifted;  // its low bits are n mod 4
+    Vector r = x - n * 1.57079632673412561417e+00;
+    Vector t = r;
+    Vector w = n * 6.07710050630396597660e-11;
+    r = t - w;
+    w = n * 2.02226624879595063154e-21 - ((t - r) - w);
+    t = r;
+    w = n * 2.02226624871116645580e-21;
+    r = t - w;
+    w = n * 8.47842766036889956997e-32 - ((t - r) - w);
+    const Vector y0 = r - w;         // the reduced argument, |y0| <= pi/4 (about)
+    const Vector y1 = (r - y0) - w;  // and its tail
+    const Vector z = y0 * y0, zz = z * z, v = z * y0;
+    const Vector sr = 8.33333333332248946124e-03 + z * (-1.98412698298579493134e-04 +
+                                                          z * 2.75573137070700676789e-06) +
+                      z * zz * (-2.50507602534068634195e-08 + z * 1.58969099521155010221e-10);
+    const Vector s = y0 - ((z * (0.5 * y1 - v * sr) - y1) - v * -1.66666666666666324348e-01);
+    const Vector cr = z * (4.16666666666666019037e-02 + z * (-1.38888888888741095749e-03 +
+                                                              z * 2.48015872894767294178e-05)) +
+                      zz * zz *
+                          (-2.75573143513906633035e-07 +
+                           z * (2.08757232129817482790e-09 + z * -1.13596475577881948265e-11));
+    const Vector hz = 0.5 * z, w1 = 1.0 - hz;
+    const Vector c = w1 + (((1.0 - w1) - hz) + (z * cr - y0 * y1));
+    // sin x = s, c, -s, -c and cos x = c, -s, -c, s for n mod 4 = 0, 1, 2, 3.
+    const Bits odd = (quadrant & 1) != 0;
+    const Bits s_bits = ((Bits)s & ~odd) | ((Bits)c & odd);
+    const Bits c_bits = ((Bits)c & ~odd) | ((Bits)s & odd);
+    sin_a->v = (Vector)(s_bits ^ (sign & ((quadrant & 2) != 0)));
+    cos_a->v = (Vector)(c_bits ^ (sign & (((quadrant + 1) & 2) != 0)));
+    // The check after the arithmetic, not before: sin(x) and cos(x) of one angle then share all
+    // of it once both are inlined.
+    // |x| > 1e6, inf or NaN: their bits, sign cleared, compare as integers above 1e6's.
+    const Bits outside = ((Bits)x & ~sign) > 0x412E848000000000LL;
+    long long any = 0;
+    for (std::size_t i = 0; i < Lanes; ++i) any |= outside[i];
+    if (any != 0) {
+      *sin_a = Apply(a, [](const double y) { return std::sin(y); });
+      *cos_a = Apply(a, [](const double y) { return std::cos(y); });
+    }
+  }
+#endif
+  template <typename F>
+  static Pack Apply(const Pack& a, const F& f) {
+    Pack r;
+    for (std::size_t i = 0; i < Lanes; ++i) r.Set(i, f(a.Get(i)));
+    return r;
+  }
+};
+#undef WEILGEN_MODELS_PACK_LANE
+#undef WEILGEN_MODELS_PACK_LANES
+#endif  // WEILGEN_MODELS_PACK_DEFINED
+
 namespace five_axis_ac {
 
 inline constexpr const char* kMachineName = "five_axis_ac";
@@ -407,7 +600,7 @@ inline void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& ax
   const Scalar tool_length = params[0];
   const Scalar c_above_a = params[1];
 
-  // Intermediate terms (47)
+  // Intermediate terms (48)
   const Scalar _tmp0 = cos_A * sin_C;
   const Scalar _tmp1 = sin_A * sin_C;
   const Scalar _tmp2 = cos_A * sin_C * tool_length;
@@ -422,39 +615,40 @@ inline void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& ax
   const Scalar _tmp11 = cos_A * cos_C * tool_length;
   const Scalar _tmp12 = cos_A * cos_C * Z;
   const Scalar _tmp13 = cos_C * sin_A * Y;
-  const Scalar _tmp14 = cos_A * cos_C * Y;
-  const Scalar _tmp15 = cos_C * sin_A * tool_length;
-  const Scalar _tmp16 = cos_C * sin_A * Z;
-  const Scalar _tmp17 = sin_C * X;
-  const Scalar _tmp18 = _tmp14 + _tmp15 + _tmp17 - _tmp16;
-  const Scalar _tmp19 = _tmp0 - sin_C;
-  const Scalar _tmp20 = cos_A * tool_length;
-  const Scalar _tmp21 = cos_A * Z;
-  const Scalar _tmp22 = sin_A * Y;
-  const Scalar _tmp23 = cos_C - Scalar(1);
-  const Scalar _tmp24 = _tmp2 + c_above_a * sin_C - _tmp3 - _tmp6;
-  const Scalar _tmp25 = c_above_a * cos_C;
-  const Scalar _tmp26 = cos_A * cos_C;
-  const Scalar _tmp27 = cos_C * sin_A;
-  const Scalar _tmp28 = sin_C * tool_length;
-  const Scalar _tmp29 = sin_C * Z;
-  const Scalar _tmp30 = _tmp11 - _tmp12 - _tmp13;
-  const Scalar _tmp31 = cos_C * sin_A * X;
-  const Scalar _tmp32 = cos_A * cos_C * X;
-  const Scalar _tmp33 = sin_C * Y;
-  const Scalar _tmp34 = cos_A * sin_C * Y;
-  const Scalar _tmp35 = cos_C * X;
-  const Scalar _tmp36 = sin_A * sin_C * tool_length;
-  const Scalar _tmp37 = sin_A * sin_C * Z;
-  const Scalar _tmp38 = _tmp34 + _tmp36 - _tmp35 - _tmp37;
-  const Scalar _tmp39 = _tmp26 - cos_C;
-  const Scalar _tmp40 = sin_A * tool_length;
-  const Scalar _tmp41 = sin_A * Z;
-  const Scalar _tmp42 = cos_A * Y;
-  const Scalar _tmp43 = _tmp40 + _tmp42 - _tmp41;
-  const Scalar _tmp44 = cos_A * X;
-  const Scalar _tmp45 = sin_A * X;
-  const Scalar _tmp46 = cos_A - Scalar(1);
+  const Scalar _tmp14 = _tmp11 - _tmp12 - _tmp13;
+  const Scalar _tmp15 = cos_A * cos_C * Y;
+  const Scalar _tmp16 = cos_C * sin_A * tool_length;
+  const Scalar _tmp17 = cos_C * sin_A * Z;
+  const Scalar _tmp18 = sin_C * X;
+  const Scalar _tmp19 = _tmp15 + _tmp16 + _tmp18 - _tmp17;
+  const Scalar _tmp20 = _tmp0 - sin_C;
+  const Scalar _tmp21 = cos_A * tool_length;
+  const Scalar _tmp22 = cos_A * Z;
+  const Scalar _tmp23 = sin_A * Y;
+  const Scalar _tmp24 = _tmp21 + c_above_a - _tmp22 - _tmp23;
+  const Scalar _tmp25 = cos_C - Scalar(1);
+  const Scalar _tmp26 = _tmp2 + c_above_a * sin_C - _tmp3 - _tmp6;
+  const Scalar _tmp27 = _tmp11 + _tmp22 + _tmp23 + c_above_a * cos_C - _tmp12 - _tmp13 - _tmp21 - c_above_a;
+  const Scalar _tmp28 = cos_A * cos_C;
+  const Scalar _tmp29 = cos_C * sin_A;
+  const Scalar _tmp30 = sin_C * tool_length;
+  const Scalar _tmp31 = sin_C * Z;
+  const Scalar _tmp32 = cos_C * sin_A * X;
+  const Scalar _tmp33 = cos_A * cos_C * X;
+  const Scalar _tmp34 = sin_C * Y;
+  const Scalar _tmp35 = cos_A * sin_C * Y;
+  const Scalar _tmp36 = cos_C * X;
+  const Scalar _tmp37 = sin_A * sin_C * tool_length;
+  const Scalar _tmp38 = sin_A * sin_C * Z;
+  const Scalar _tmp39 = _tmp35 + _tmp37 - _tmp36 - _tmp38;
+  const Scalar _tmp40 = _tmp28 - cos_C;
+  const Scalar _tmp41 = sin_A * tool_length;
+  const Scalar _tmp42 = sin_A * Z;
+  const Scalar _tmp43 = cos_A * Y;
+  const Scalar _tmp44 = _tmp41 + _tmp43 - _tmp42;
+  const Scalar _tmp45 = cos_A * X;
+  const Scalar _tmp46 = sin_A * X;
+  const Scalar _tmp47 = cos_A - Scalar(1);
 
   // Outputs
   if (position_coeff != nullptr) {
@@ -471,58 +665,58 @@ inline void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& ax
     StorePair(_position_coeff.data() + 18, _tmp4 + _tmp8 - _tmp5, -_tmp10 - _tmp9);
     StorePair(_position_coeff.data() + 20, _tmp10, -cos_C);
     StorePair(_position_coeff.data() + 22, -sin_C, Scalar(0));
-    StorePair(_position_coeff.data() + 24, -_tmp7, _tmp11 - _tmp12 - _tmp13);
-    StorePair(_position_coeff.data() + 26, -_tmp18, -_tmp19);
+    StorePair(_position_coeff.data() + 24, -_tmp7, _tmp14);
+    StorePair(_position_coeff.data() + 26, -_tmp19, -_tmp20);
     StorePair(_position_coeff.data() + 28, -_tmp1, _tmp12 + _tmp13 + _tmp4 + _tmp8 - _tmp11 - _tmp5);
-    StorePair(_position_coeff.data() + 30, _tmp14 + _tmp15 + _tmp17 - _tmp10 - _tmp16 - _tmp9, -_tmp7);
+    StorePair(_position_coeff.data() + 30, _tmp15 + _tmp16 + _tmp18 - _tmp10 - _tmp17 - _tmp9, -_tmp7);
     StorePair(_position_coeff.data() + 32, -Scalar(1), Scalar(0));
     StorePair(_position_coeff.data() + 34, Scalar(0), Scalar(0));
-    StorePair(_position_coeff.data() + 36, _tmp20 + c_above_a - _tmp21 - _tmp22, -_tmp18);
-    StorePair(_position_coeff.data() + 38, -_tmp23, -sin_C);
-    StorePair(_position_coeff.data() + 40, -_tmp24, _tmp11 + _tmp21 + _tmp22 + _tmp25 - _tmp12 - _tmp13 - _tmp20 - c_above_a);
-    StorePair(_position_coeff.data() + 42, -_tmp18, -sin_C);
-    StorePair(_position_coeff.data() + 44, _tmp26, _tmp27);
-    StorePair(_position_coeff.data() + 46, _tmp11 - _tmp12, _tmp28 - _tmp29);
+    StorePair(_position_coeff.data() + 36, _tmp24, -_tmp19);
+    StorePair(_position_coeff.data() + 38, -_tmp25, -sin_C);
+    StorePair(_position_coeff.data() + 40, -_tmp26, _tmp27);
+    StorePair(_position_coeff.data() + 42, -_tmp19, -sin_C);
+    StorePair(_position_coeff.data() + 44, _tmp28, _tmp29);
+    StorePair(_position_coeff.data() + 46, _tmp11 - _tmp12, _tmp30 - _tmp31);
     StorePair(_position_coeff.data() + 48, Scalar(0), -sin_C);
-    StorePair(_position_coeff.data() + 50, _tmp26, _tmp27);
-    StorePair(_position_coeff.data() + 52, _tmp11, _tmp28);
-    StorePair(_position_coeff.data() + 54, Scalar(0), -_tmp29);
+    StorePair(_position_coeff.data() + 50, _tmp28, _tmp29);
+    StorePair(_position_coeff.data() + 52, _tmp11, _tmp30);
+    StorePair(_position_coeff.data() + 54, Scalar(0), -_tmp31);
     StorePair(_position_coeff.data() + 56, -_tmp12, sin_C);
-    StorePair(_position_coeff.data() + 58, -_tmp26, -_tmp27);
-    StorePair(_position_coeff.data() + 60, -_tmp30, _tmp29 + _tmp31 - _tmp28);
-    StorePair(_position_coeff.data() + 62, _tmp33 - _tmp32, -_tmp33);
+    StorePair(_position_coeff.data() + 58, -_tmp28, -_tmp29);
+    StorePair(_position_coeff.data() + 60, -_tmp14, _tmp31 + _tmp32 - _tmp30);
+    StorePair(_position_coeff.data() + 62, _tmp34 - _tmp33, -_tmp34);
     StorePair(_position_coeff.data() + 64, sin_C, -cos_C);
-    StorePair(_position_coeff.data() + 66, Scalar(0), -_tmp30);
-    StorePair(_position_coeff.data() + 68, -_tmp7, _tmp38);
-    StorePair(_position_coeff.data() + 70, -_tmp39, -_tmp27);
-    StorePair(_position_coeff.data() + 72, _tmp2 + _tmp29 + _tmp31 - _tmp28 - _tmp3 - _tmp6, _tmp33 + _tmp35 + _tmp37 - _tmp32 - _tmp34 - _tmp36);
-    StorePair(_position_coeff.data() + 74, -_tmp30, Scalar(0));
+    StorePair(_position_coeff.data() + 66, Scalar(0), -_tmp14);
+    StorePair(_position_coeff.data() + 68, -_tmp7, _tmp39);
+    StorePair(_position_coeff.data() + 70, -_tmp40, -_tmp29);
+    StorePair(_position_coeff.data() + 72, _tmp2 + _tmp31 + _tmp32 - _tmp3 - _tmp30 - _tmp6, _tmp34 + _tmp36 + _tmp38 - _tmp33 - _tmp35 - _tmp37);
+    StorePair(_position_coeff.data() + 74, -_tmp14, Scalar(0));
     StorePair(_position_coeff.data() + 76, -Scalar(1), Scalar(0));
-    StorePair(_position_coeff.data() + 78, _tmp21 + _tmp22 - _tmp20 - c_above_a, Scalar(0));
-    StorePair(_position_coeff.data() + 80, _tmp38, sin_C);
-    StorePair(_position_coeff.data() + 82, -_tmp23, _tmp12 + _tmp13 + _tmp20 + c_above_a - _tmp11 - _tmp21 - _tmp22 - _tmp25);
-    StorePair(_position_coeff.data() + 84, -_tmp24, _tmp38);
+    StorePair(_position_coeff.data() + 78, -_tmp24, Scalar(0));
+    StorePair(_position_coeff.data() + 80, _tmp39, sin_C);
+    StorePair(_position_coeff.data() + 82, -_tmp25, -_tmp27);
+    StorePair(_position_coeff.data() + 84, -_tmp26, _tmp39);
     StorePair(_position_coeff.data() + 86, Scalar(0), -sin_A);
-    StorePair(_position_coeff.data() + 88, cos_A, _tmp41 - _tmp40);
+    StorePair(_position_coeff.data() + 88, cos_A, _tmp42 - _tmp41);
     StorePair(_position_coeff.data() + 90, Scalar(0), Scalar(0));
     StorePair(_position_coeff.data() + 92, Scalar(0), -sin_A);
-    StorePair(_position_coeff.data() + 94, cos_A, -_tmp40);
+    StorePair(_position_coeff.data() + 94, cos_A, -_tmp41);
     StorePair(_position_coeff.data() + 96, Scalar(0), Scalar(0));
-    StorePair(_position_coeff.data() + 98, Scalar(0), _tmp41);
+    StorePair(_position_coeff.data() + 98, Scalar(0), _tmp42);
     StorePair(_position_coeff.data() + 100, Scalar(0), sin_A);
-    StorePair(_position_coeff.data() + 102, -cos_A, _tmp43);
-    StorePair(_position_coeff.data() + 104, _tmp44, _tmp45);
+    StorePair(_position_coeff.data() + 102, -cos_A, _tmp44);
+    StorePair(_position_coeff.data() + 104, _tmp45, _tmp46);
     StorePair(_position_coeff.data() + 106, Scalar(0), Scalar(0));
     StorePair(_position_coeff.data() + 108, Scalar(0), -Scalar(1));
-    StorePair(_position_coeff.data() + 110, _tmp43, X);
+    StorePair(_position_coeff.data() + 110, _tmp44, X);
     StorePair(_position_coeff.data() + 112, Scalar(0), sin_A);
-    StorePair(_position_coeff.data() + 114, -_tmp46, _tmp44 - X);
-    StorePair(_position_coeff.data() + 116, _tmp45, _tmp43);
+    StorePair(_position_coeff.data() + 114, -_tmp47, _tmp45 - X);
+    StorePair(_position_coeff.data() + 116, _tmp46, _tmp44);
     StorePair(_position_coeff.data() + 118, Scalar(0), Scalar(0));
-    StorePair(_position_coeff.data() + 120, -Scalar(1), _tmp14 + _tmp15 + _tmp17 - _tmp16);
-    StorePair(_position_coeff.data() + 122, _tmp35 + _tmp37 - _tmp34 - _tmp36, Scalar(0));
+    StorePair(_position_coeff.data() + 120, -Scalar(1), _tmp19);
+    StorePair(_position_coeff.data() + 122, -_tmp39, Scalar(0));
     StorePair(_position_coeff.data() + 124, Scalar(0), Scalar(0));
-    StorePair(_position_coeff.data() + 126, _tmp16 + _tmp40 + _tmp42 - _tmp14 - _tmp15 - _tmp17 - _tmp41, _tmp34 + _tmp36 + X - _tmp35 - _tmp37);
+    StorePair(_position_coeff.data() + 126, _tmp17 + _tmp41 + _tmp43 - _tmp15 - _tmp16 - _tmp18 - _tmp42, _tmp35 + _tmp37 + X - _tmp36 - _tmp38);
     _position_coeff[128] = Scalar(0);
   }
   if (orientation_coeff != nullptr) {
@@ -541,35 +735,35 @@ inline void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& ax
     StorePair(_orientation_coeff.data() + 22, Scalar(0), Scalar(0));
     StorePair(_orientation_coeff.data() + 24, -cos_C, -sin_C);
     StorePair(_orientation_coeff.data() + 26, Scalar(0), Scalar(0));
-    StorePair(_orientation_coeff.data() + 28, Scalar(0), -_tmp19);
+    StorePair(_orientation_coeff.data() + 28, Scalar(0), -_tmp20);
     StorePair(_orientation_coeff.data() + 30, -_tmp1, -cos_C);
     StorePair(_orientation_coeff.data() + 32, Scalar(0), Scalar(0));
     StorePair(_orientation_coeff.data() + 34, Scalar(0), -Scalar(1));
     StorePair(_orientation_coeff.data() + 36, Scalar(0), Scalar(0));
     StorePair(_orientation_coeff.data() + 38, Scalar(0), Scalar(0));
-    StorePair(_orientation_coeff.data() + 40, -_tmp23, -sin_C);
+    StorePair(_orientation_coeff.data() + 40, -_tmp25, -sin_C);
     StorePair(_orientation_coeff.data() + 42, Scalar(0), Scalar(0));
     StorePair(_orientation_coeff.data() + 44, Scalar(0), Scalar(0));
-    StorePair(_orientation_coeff.data() + 46, -sin_C, _tmp26);
-    StorePair(_orientation_coeff.data() + 48, _tmp27, Scalar(0));
+    StorePair(_orientation_coeff.data() + 46, -sin_C, _tmp28);
+    StorePair(_orientation_coeff.data() + 48, _tmp29, Scalar(0));
     StorePair(_orientation_coeff.data() + 50, Scalar(0), Scalar(0));
-    StorePair(_orientation_coeff.data() + 52, -sin_C, _tmp26);
-    StorePair(_orientation_coeff.data() + 54, _tmp27, Scalar(0));
+    StorePair(_orientation_coeff.data() + 52, -sin_C, _tmp28);
+    StorePair(_orientation_coeff.data() + 54, _tmp29, Scalar(0));
     StorePair(_orientation_coeff.data() + 56, Scalar(0), Scalar(0));
     StorePair(_orientation_coeff.data() + 58, Scalar(0), Scalar(0));
-    StorePair(_orientation_coeff.data() + 60, sin_C, -_tmp26);
-    StorePair(_orientation_coeff.data() + 62, -_tmp27, Scalar(0));
+    StorePair(_orientation_coeff.data() + 60, sin_C, -_tmp28);
+    StorePair(_orientation_coeff.data() + 62, -_tmp29, Scalar(0));
     StorePair(_orientation_coeff.data() + 64, Scalar(0), Scalar(0));
     StorePair(_orientation_coeff.data() + 66, Scalar(0), sin_C);
     StorePair(_orientation_coeff.data() + 68, -cos_C, Scalar(0));
     StorePair(_orientation_coeff.data() + 70, Scalar(0), Scalar(0));
-    StorePair(_orientation_coeff.data() + 72, -_tmp39, -_tmp27);
+    StorePair(_orientation_coeff.data() + 72, -_tmp40, -_tmp29);
     StorePair(_orientation_coeff.data() + 74, sin_C, Scalar(0));
     StorePair(_orientation_coeff.data() + 76, Scalar(0), Scalar(0));
     StorePair(_orientation_coeff.data() + 78, Scalar(0), -Scalar(1));
     StorePair(_orientation_coeff.data() + 80, Scalar(0), Scalar(0));
     StorePair(_orientation_coeff.data() + 82, Scalar(0), sin_C);
-    StorePair(_orientation_coeff.data() + 84, -_tmp23, Scalar(0));
+    StorePair(_orientation_coeff.data() + 84, -_tmp25, Scalar(0));
     StorePair(_orientation_coeff.data() + 86, Scalar(0), Scalar(0));
     StorePair(_orientation_coeff.data() + 88, Scalar(0), Scalar(0));
     StorePair(_orientation_coeff.data() + 90, -sin_A, cos_A);
@@ -585,7 +779,7 @@ inline void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& ax
     StorePair(_orientation_coeff.data() + 110, Scalar(0), Scalar(0));
     StorePair(_orientation_coeff.data() + 112, -Scalar(1), Scalar(0));
     StorePair(_orientation_coeff.data() + 114, Scalar(0), sin_A);
-    StorePair(_orientation_coeff.data() + 116, -_tmp46, Scalar(0));
+    StorePair(_orientation_coeff.data() + 116, -_tmp47, Scalar(0));
     StorePair(_orientation_coeff.data() + 118, Scalar(0), Scalar(0));
     StorePair(_orientation_coeff.data() + 120, Scalar(0), Scalar(0));
     StorePair(_orientation_coeff.data() + 122, Scalar(0), -Scalar(1));

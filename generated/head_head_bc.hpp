@@ -4,9 +4,9 @@
 // Units: axes as in kAxes (mm, deg), errors in base units (mm, rad), parameters in mm/deg;
 //        position outputs dx, dy, dz in mm, orientation outputs da, db, dc in rad.
 // Operation counts (after common-subexpression elimination):
-//   Deviation:    234 (adds 139, muls 91, divs 0, functions 4), 22 temporaries
-//   Coefficients: 92 (adds 54, muls 34, divs 0, functions 4), 37 temporaries
-//   DeviationAndCoefficients: 234 (adds 139, muls 91, divs 0, functions 4), 22 temporaries
+//   Deviation:    224 (adds 126, muls 94, divs 0, functions 4), 12 temporaries
+//   Coefficients: 64 (adds 23, muls 37, divs 0, functions 4), 23 temporaries
+//   DeviationAndCoefficients: 224 (adds 126, muls 94, divs 0, functions 4), 12 temporaries
 //   NominalPose:  29 (adds 7, muls 18, divs 0, functions 4), 0 temporaries
 //   NominalJacobian: 38 (adds 5, muls 29, divs 0, functions 4), 0 temporaries
 //   Compensate:   per iteration errors_at + Deviation + NominalPose + 6x5 least-squares step; once per call NominalJacobian + NominalPose + Cholesky
@@ -21,6 +21,199 @@
 #endif
 
 namespace weilgen_models {
+
+// Pack<Lanes>: `Lanes` doubles evaluated together, one pose (or one error sample) per lane, as the
+// Scalar of the evaluation functions: DeviationAndCoefficients<Pack<4>> evaluates 4 poses with one
+// instruction per operation where the target has registers of 4 doubles (AVX2; 8 with AVX-512).
+// Each lane is the double function's result for that lane's inputs: the same operations in the
+// same order, sin/cos/sqrt from the C library lane by lane (docs/generator.md, "Several poses at
+// once"). Compensate needs comparisons and takes double only. Defined once per translation unit,
+// however many model headers it includes.
+#ifndef WEILGEN_MODELS_PACK_DEFINED
+#define WEILGEN_MODELS_PACK_DEFINED
+// GCC's and Clang's vector extension; elsewhere (or with WEILGEN_MODELS_PACK_PORTABLE defined) a
+// plain array, lane by lane, which the optimiser may vectorise.
+#if (defined(__GNUC__) || defined(__clang__)) && !defined(WEILGEN_MODELS_PACK_PORTABLE)
+#define WEILGEN_MODELS_PACK_VECTOR 1
+#else
+#define WEILGEN_MODELS_PACK_VECTOR 0
+#endif
+#if WEILGEN_MODELS_PACK_VECTOR
+// GCC takes no vector_size that depends on a template parameter: one type per lane count.
+template <std::size_t Lanes>
+struct PackVector;
+template <>
+struct PackVector<2> {
+  typedef double type __attribute__((vector_size(16)));
+  typedef long long bits __attribute__((vector_size(16)));
+};
+template <>
+struct PackVector<4> {
+  typedef double type __attribute__((vector_size(32)));
+  typedef long long bits __attribute__((vector_size(32)));
+};
+template <>
+struct PackVector<8> {
+  typedef double type __attribute__((vector_size(64)));
+  typedef long long bits __attribute__((vector_size(64)));
+};
+#endif
+// Each operation lane by lane, as a hidden friend (found by argument-dependent lookup, a double
+// converts to every lane): with the vector extension one instruction where the target has the
+// registers, else a loop.
+#if WEILGEN_MODELS_PACK_VECTOR
+#define WEILGEN_MODELS_PACK_LANES(EXPR) Pack(EXPR)
+#else
+#define WEILGEN_MODELS_PACK_LANES(EXPR) Pack::Map([&](const std::size_t i) { return EXPR; })
+#endif
+template <std::size_t Lanes>
+struct Pack {
+  static_assert(Lanes == 2 || Lanes == 4 || Lanes == 8, "2, 4 or 8 lanes");
+#if WEILGEN_MODELS_PACK_VECTOR
+  using Vector = typename PackVector<Lanes>::type;
+  Vector v;
+  Pack() = default;
+  Pack(const double x) : v(Vector{} + x) {}  // every lane x (implicit: Scalar(0.5) in the code)
+  explicit Pack(const Vector& x) : v(x) {}
+  double Get(const std::size_t i) const { return v[i]; }
+  void Set(const std::size_t i, const double x) { v[i] = x; }
+#define WEILGEN_MODELS_PACK_LANE(P) (P).v
+#else
+  double v[Lanes];
+  Pack() = default;
+  Pack(const double x) {
+    for (std::size_t i = 0; i < Lanes; ++i) v[i] = x;
+  }
+  double Get(const std::size_t i) const { return v[i]; }
+  void Set(const std::size_t i, const double x) { v[i] = x; }
+  template <typename F>
+  static Pack Map(const F& f) {
+    Pack r;
+    for (std::size_t i = 0; i < Lanes; ++i) r.v[i] = f(i);
+    return r;
+  }
+#define WEILGEN_MODELS_PACK_LANE(P) (P).v[i]
+#endif
+  static Pack Load(const double* const from) {  // from[0 .. Lanes)
+    Pack p;
+    for (std::size_t i = 0; i < Lanes; ++i) p.Set(i, from[i]);
+    return p;
+  }
+  void Store(double* const to) const {  // to[0 .. Lanes)
+    for (std::size_t i = 0; i < Lanes; ++i) to[i] = Get(i);
+  }
+
+  friend Pack operator+(const Pack& a, const Pack& b) {
+    return WEILGEN_MODELS_PACK_LANES(WEILGEN_MODELS_PACK_LANE(a) + WEILGEN_MODELS_PACK_LANE(b));
+  }
+  friend Pack operator-(const Pack& a, const Pack& b) {
+    return WEILGEN_MODELS_PACK_LANES(WEILGEN_MODELS_PACK_LANE(a) - WEILGEN_MODELS_PACK_LANE(b));
+  }
+  friend Pack operator*(const Pack& a, const Pack& b) {
+    return WEILGEN_MODELS_PACK_LANES(WEILGEN_MODELS_PACK_LANE(a) * WEILGEN_MODELS_PACK_LANE(b));
+  }
+  friend Pack operator/(const Pack& a, const Pack& b) {
+    return WEILGEN_MODELS_PACK_LANES(WEILGEN_MODELS_PACK_LANE(a) / WEILGEN_MODELS_PACK_LANE(b));
+  }
+  friend Pack operator-(const Pack& a) { return WEILGEN_MODELS_PACK_LANES(-WEILGEN_MODELS_PACK_LANE(a)); }
+  friend Pack& operator+=(Pack& a, const Pack& b) { return a = a + b; }
+  friend Pack& operator-=(Pack& a, const Pack& b) { return a = a - b; }
+  friend Pack& operator*=(Pack& a, const Pack& b) { return a = a * b; }
+  // With 4 or 8 lanes, sin and cos of every lane at once (SinCos below, within 1 ulp of the C
+  // library's); with 2 (no faster than two library calls, measured) or without the vector
+  // extension, the C library's lane by lane, as the double functions call it.
+  friend Pack sin(const Pack& a) {
+#if WEILGEN_MODELS_PACK_VECTOR
+    if constexpr (Lanes >= 4) {
+      Pack s, c;
+      SinCos(a, &s, &c);
+      return s;
+    }
+#endif
+    return Apply(a, [](const double x) { return std::sin(x); });
+  }
+  friend Pack cos(const Pack& a) {
+#if WEILGEN_MODELS_PACK_VECTOR
+    if constexpr (Lanes >= 4) {
+      Pack s, c;
+      SinCos(a, &s, &c);
+      return c;
+    }
+#endif
+    return Apply(a, [](const double x) { return std::cos(x); });
+  }
+  friend Pack sqrt(const Pack& a) { return Apply(a, [](const double x) { return std::sqrt(x); }); }
+
+ private:
+#if WEILGEN_MODELS_PACK_VECTOR
+  // sin and cos of all lanes in vector arithmetic: the lane-by-lane C library calls would be
+  // most of a rotary machine's time. fdlibm's method (e_rem_pio2.c, k_sin.c, k_cos.c): x - n*pi/2
+  // with pi/2 in three 33-bit parts and their tails (good to 151 bits, so x near a multiple of
+  // pi/2 keeps its digits), then the kernels on [-pi/4, pi/4] with the reduced argument's tail,
+  // the quadrant n mod 4 choosing and negating. Within 1 ulp of glibc (correctly rounded) for
+  // |x| <= 1e6 rad; about 15 % of arguments differ by that 1 ulp (tests/test_generated_headers.cpp).
+  // A lane beyond 1e6 rad (n * pi/2 no longer exact), infinite or NaN: the C library, lane by
+  // lane, for the whole pack.
+  static void SinCos(const Pack& a, Pack* const sin_a, Pack* const cos_a) {
+    using Bits = typename PackVector<Lanes>::bits;
+    const Vector x = a.v;
+    const Bits sign = (Bits)(-Vector{});  // -0.0: the sign bit of every lane
+    const double magic = 6755399441055744.0;  // 1.5 * 2^52: (t + magic) - magic rounds t
+    const Vector shifted = x * 6.36619772367581382433e-01 + magic;  // x * 2/pi + magic
+    const Vector n = shifted - magic;
+    const Bits quadrant = (Bits)shifted;  // its low bits are n mod 4
+    Vector r = x - n * 1.57079632673412561417e+00;
+    Vector t = r;
+    Vector w = n * 6.07710050630396597660e-11;
+    r = t - w;
+    w = n * 2.02226624879595063154e-21 - ((t - r) - w);
+    t = r;
+    w = n * 2.02226624871116645580e-21;
+    r = t - w;
+    w = n * 8.47842766036889956997e-32 - ((t - r) - w);
+    const Vector y0 = r - w;         // the reduced argument, |y0| <= pi/4 (about)
+    const Vector y1 = (r - y0) - w;  // and its tail
+    const Vector z = y0 * y0, zz = z * z, v = z * y0;
+    const Vector sr = 8.33333333332248946124e-03 + z * (-1.98412698298579493134e-04 +
+                                                          z * 2.75573137070700676789e-06) +
+                      z * zz * (-2.50507602534068634195e-08 + z * 1.58969099521155010221e-10);
+    const Vector s = y0 - ((z * (0.5 * y1 - v * sr) - y1) - v * -1.66666666666666324348e-01);
+    const Vector cr = z * (4.16666666666666019037e-02 + z * (-1.38888888888741095749e-03 +
+                                                              z * 2.48015872894767294178e-05)) +
+                      zz * zz *
+                          (-2.75573143513906633035e-07 +
+                           z * (2.08757232129817482790e-09 + z * -1.13596475577881948265e-11));
+    const Vector hz = 0.5 * z, w1 = 1.0 - hz;
+    const Vector c = w1 + (((1.0 - w1) - hz) + (z * cr - y0 * y1));
+    // sin x = s, c, -s, -c and cos x = c, -s, -c, s for n mod 4 = 0, 1, 2, 3.
+    const Bits odd = (quadrant & 1) != 0;
+    const Bits s_bits = ((Bits)s & ~odd) | ((Bits)c & odd);
+    const Bits c_bits = ((Bits)c & ~odd) | ((Bits)s & odd);
+    sin_a->v = (Vector)(s_bits ^ (sign & ((quadrant & 2) != 0)));
+    cos_a->v = (Vector)(c_bits ^ (sign & (((quadrant + 1) & 2) != 0)));
+    // The check after the arithmetic, not before: sin(x) and cos(x) of one angle then share all
+    // of it once both are inlined.
+    // |x| > 1e6, inf or NaN: their bits, sign cleared, compare as integers above 1e6's.
+    const Bits outside = ((Bits)x & ~sign) > 0x412E848000000000LL;
+    long long any = 0;
+    for (std::size_t i = 0; i < Lanes; ++i) any |= outside[i];
+    if (any != 0) {
+      *sin_a = Apply(a, [](const double y) { return std::sin(y); });
+      *cos_a = Apply(a, [](const double y) { return std::cos(y); });
+    }
+  }
+#endif
+  template <typename F>
+  static Pack Apply(const Pack& a, const F& f) {
+    Pack r;
+    for (std::size_t i = 0; i < Lanes; ++i) r.Set(i, f(a.Get(i)));
+    return r;
+  }
+};
+#undef WEILGEN_MODELS_PACK_LANE
+#undef WEILGEN_MODELS_PACK_LANES
+#endif  // WEILGEN_MODELS_PACK_DEFINED
+
 namespace head_head_bc {
 
 inline constexpr const char* kMachineName = "head_head_bc";
@@ -283,65 +476,55 @@ inline void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
   const Scalar pivot_length = params[1];
   const Scalar c_to_b = params[2];
 
-  // Intermediate terms (22)
+  // Intermediate terms (12)
   const Scalar _tmp0 = cos_B * pivot_length;
   const Scalar _tmp1 = cos_B * tool_length;
-  const Scalar _tmp2 = cos_B * pivot_length * sin_C;
-  const Scalar _tmp3 = cos_B * sin_C * tool_length;
-  const Scalar _tmp4 = c_to_b * cos_C;
-  const Scalar _tmp5 = cos_B * cos_C * pivot_length;
-  const Scalar _tmp6 = cos_B * cos_C * tool_length;
-  const Scalar _tmp7 = cos_B * cos_C;
-  const Scalar _tmp8 = pivot_length * sin_C;
-  const Scalar _tmp9 = sin_C * tool_length;
-  const Scalar _tmp10 = cos_C * pivot_length * sin_B;
-  const Scalar _tmp11 = cos_C * sin_B * tool_length;
-  const Scalar _tmp12 = cos_B * sin_C;
-  const Scalar _tmp13 = cos_C * pivot_length;
-  const Scalar _tmp14 = cos_C * tool_length;
-  const Scalar _tmp15 = pivot_length * sin_B;
-  const Scalar _tmp16 = sin_B * tool_length;
-  const Scalar _tmp17 = E_B0B + E_BB;
-  const Scalar _tmp18 = E_A0C - E_AC;
-  const Scalar _tmp19 = E_Z0B - E_ZB;
-  const Scalar _tmp20 = E_B0B + E_BB + E_BC;
-  const Scalar _tmp21 = E_C0B - E_CB;
+  const Scalar _tmp2 = -pivot_length - tool_length;
+  const Scalar _tmp3 = _tmp0 + _tmp1 + c_to_b;
+  const Scalar _tmp4 = cos_B * cos_C;
+  const Scalar _tmp5 = _tmp0 + _tmp1 - pivot_length - tool_length;
+  const Scalar _tmp6 = cos_B * sin_C;
+  const Scalar _tmp7 = E_B0B + E_BB;
+  const Scalar _tmp8 = E_A0C - E_AC;
+  const Scalar _tmp9 = E_Z0B - E_ZB;
+  const Scalar _tmp10 = E_B0B + E_BB + E_BC;
+  const Scalar _tmp11 = E_C0B - E_CB;
 
   // Coefficients of the error monomials (24)
   const Scalar _coef0 = _tmp0 + _tmp1 + c_to_b - Z;
-  const Scalar _coef1 = -pivot_length * sin_B * sin_C - sin_B * sin_C * tool_length;
-  const Scalar _coef2 = _tmp0 + _tmp1 + c_to_b;
-  const Scalar _coef3 = -_tmp2 - _tmp3 - c_to_b * sin_C;
-  const Scalar _coef4 = -_tmp4 - _tmp5 - _tmp6;
+  const Scalar _coef1 = _tmp2 * sin_B * sin_C;
+  const Scalar _coef2 = _tmp3;
+  const Scalar _coef3 = -_tmp3 * sin_C;
+  const Scalar _coef4 = -_tmp3 * cos_C;
   const Scalar _coef5 = cos_C - Scalar(1);
-  const Scalar _coef6 = _tmp0 + _tmp1 + c_to_b - _tmp4 - _tmp5 - _tmp6;
-  const Scalar _coef7 = _tmp7;
+  const Scalar _coef6 = _tmp0 + _tmp1 + c_to_b - c_to_b * cos_C - cos_B * cos_C * pivot_length - cos_B * cos_C * tool_length;
+  const Scalar _coef7 = _tmp4;
   const Scalar _coef8 = cos_C * sin_B;
-  const Scalar _coef9 = -_tmp8 - _tmp9;
-  const Scalar _coef10 = -_tmp5 - _tmp6;
-  const Scalar _coef11 = cos_C - _tmp7;
-  const Scalar _coef12 = _tmp8 + _tmp9 - _tmp2 - _tmp3;
-  const Scalar _coef13 = X - _tmp10 - _tmp11;
-  const Scalar _coef14 = -_tmp10 - _tmp11;
-  const Scalar _coef15 = _tmp12;
+  const Scalar _coef9 = _tmp2 * sin_C;
+  const Scalar _coef10 = _tmp2 * cos_B * cos_C;
+  const Scalar _coef11 = cos_C - _tmp4;
+  const Scalar _coef12 = -_tmp5 * sin_C;
+  const Scalar _coef13 = X - cos_C * pivot_length * sin_B - cos_C * sin_B * tool_length;
+  const Scalar _coef14 = _tmp2 * cos_C * sin_B;
+  const Scalar _coef15 = _tmp6;
   const Scalar _coef16 = sin_B * sin_C;
-  const Scalar _coef17 = -_tmp13 - _tmp14;
-  const Scalar _coef18 = -_tmp2 - _tmp3;
-  const Scalar _coef19 = sin_C - _tmp12;
-  const Scalar _coef20 = _tmp13 + _tmp14 - _tmp5 - _tmp6;
-  const Scalar _coef21 = -_tmp15 - _tmp16;
-  const Scalar _coef22 = _tmp15 + _tmp16 - _tmp10 - _tmp11;
+  const Scalar _coef17 = _tmp2 * cos_C;
+  const Scalar _coef18 = _tmp2 * cos_B * sin_C;
+  const Scalar _coef19 = sin_C - _tmp6;
+  const Scalar _coef20 = -_tmp5 * cos_C;
+  const Scalar _coef21 = _tmp2 * sin_B;
+  const Scalar _coef22 = (pivot_length + tool_length - cos_C * pivot_length - cos_C * tool_length) * sin_B;
   const Scalar _coef23 = cos_B - Scalar(1);
 
   // Outputs
   if (position != nullptr) {
     auto& _position = *position;
-    StorePair(_position.data(), E_XX + E_XY + E_XZ + E_A0B * _coef12 + E_AB * _coef9 + E_B0Z * Z + E_BC * _coef4 + E_X0B * _coef11 + E_XB * _coef7 + E_XC * cos_C + _coef10 * _tmp17 + (E_Y0C - E_YB - E_YC) * sin_C - E_B0C * _coef6 - E_BZ * _coef2 - E_X0C * _coef5 - _coef0 * (E_BX + E_BY) - _coef1 * (E_C0B + E_C0C + E_CC + E_CX + E_CY + E_CZ) - _coef3 * _tmp18 - _coef8 * _tmp19, E_YX + E_YY + E_YZ + E_A0C * _coef6 + E_AZ * _coef2 + E_C0X * X + E_CY * _coef13 + E_X0B * _coef19 + E_XB * _coef15 + _coef0 * (E_AX + E_AY) + _coef14 * (E_C0B + E_C0C + E_CC + E_CX + E_CZ) + _coef18 * _tmp17 + (E_YB + E_YC) * cos_C - E_A0B * _coef20 - E_A0Z * Z - E_AB * _coef17 - E_AC * _coef4 - E_Y0C * _coef5 - _coef16 * _tmp19 - _coef3 * (E_B0C - E_BC) - (E_X0C - E_XC) * sin_C);
-    _position[2] = E_ZC + E_ZX + E_ZY + E_ZZ + E_ZB * cos_B + _coef1 * (E_A0C + E_AX + E_AY + E_AZ) + (E_X0B - E_XB) * sin_B - E_B0C * _coef22 - E_BY * _coef13 - E_Z0B * _coef23 - _coef14 * (E_BX + E_BZ) - _coef21 * _tmp20;
+    StorePair(_position.data(), E_XX + E_XY + E_XZ + E_A0B * _coef12 + E_AB * _coef9 + E_B0Z * Z + E_BC * _coef4 + E_X0B * _coef11 + E_XB * _coef7 + E_XC * cos_C + _coef10 * _tmp7 + (E_Y0C - E_YB - E_YC) * sin_C - E_B0C * _coef6 - E_BZ * _coef2 - E_X0C * _coef5 - _coef0 * (E_BX + E_BY) - _coef1 * (E_C0B + E_C0C + E_CC + E_CX + E_CY + E_CZ) - _coef3 * _tmp8 - _coef8 * _tmp9, E_YX + E_YY + E_YZ + E_A0C * _coef6 + E_AZ * _coef2 + E_C0X * X + E_CY * _coef13 + E_X0B * _coef19 + E_XB * _coef15 + _coef0 * (E_AX + E_AY) + _coef14 * (E_C0B + E_C0C + E_CC + E_CX + E_CZ) + _coef18 * _tmp7 + (E_YB + E_YC) * cos_C - E_A0B * _coef20 - E_A0Z * Z - E_AB * _coef17 - E_AC * _coef4 - E_Y0C * _coef5 - _coef16 * _tmp9 - _coef3 * (E_B0C - E_BC) - (E_X0C - E_XC) * sin_C);
+    _position[2] = E_ZC + E_ZX + E_ZY + E_ZZ + E_ZB * cos_B + _coef1 * (E_A0C + E_AX + E_AY + E_AZ) + (E_X0B - E_XB) * sin_B - E_B0C * _coef22 - E_BY * _coef13 - E_Z0B * _coef23 - _coef14 * (E_BX + E_BZ) - _coef21 * _tmp10;
   }
   if (orientation != nullptr) {
     auto& _orientation = *orientation;
-    StorePair(_orientation.data(), E_AX + E_AY + E_AZ + E_A0B * _coef11 + E_AB * _coef7 + E_AC * cos_C - E_A0C * _coef5 - _coef8 * _tmp21 - (E_B0B + E_BB + E_BC - E_B0C) * sin_C, E_BX + E_BY + E_BZ + E_A0B * _coef19 + E_AB * _coef15 + _tmp20 * cos_C - E_B0C * _coef5 - _coef16 * _tmp21 - _tmp18 * sin_C);
+    StorePair(_orientation.data(), E_AX + E_AY + E_AZ + E_A0B * _coef11 + E_AB * _coef7 + E_AC * cos_C - E_A0C * _coef5 - _coef8 * _tmp11 - (E_B0B + E_BB + E_BC - E_B0C) * sin_C, E_BX + E_BY + E_BZ + E_A0B * _coef19 + E_AB * _coef15 + _tmp10 * cos_C - E_B0C * _coef5 - _coef16 * _tmp11 - _tmp8 * sin_C);
     _orientation[2] = E_C0C + E_CC + E_CX + E_CY + E_CZ + E_CB * cos_B + (E_A0B - E_AB) * sin_B - E_C0B * _coef23;
   }
 }
@@ -370,113 +553,99 @@ inline void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& ax
   const Scalar pivot_length = params[1];
   const Scalar c_to_b = params[2];
 
-  // Intermediate terms (37)
+  // Intermediate terms (23)
   const Scalar _tmp0 = cos_B * pivot_length;
   const Scalar _tmp1 = cos_B * tool_length;
   const Scalar _tmp2 = _tmp0 + _tmp1 + c_to_b - Z;
-  const Scalar _tmp3 = pivot_length * sin_B * sin_C;
-  const Scalar _tmp4 = sin_B * sin_C * tool_length;
-  const Scalar _tmp5 = _tmp3 + _tmp4;
-  const Scalar _tmp6 = c_to_b * sin_C;
-  const Scalar _tmp7 = cos_B * pivot_length * sin_C;
-  const Scalar _tmp8 = cos_B * sin_C * tool_length;
-  const Scalar _tmp9 = _tmp6 + _tmp7 + _tmp8;
-  const Scalar _tmp10 = c_to_b * cos_C;
-  const Scalar _tmp11 = cos_B * cos_C * pivot_length;
-  const Scalar _tmp12 = cos_B * cos_C * tool_length;
-  const Scalar _tmp13 = cos_C - Scalar(1);
-  const Scalar _tmp14 = _tmp6 + _tmp7 + _tmp8;
-  const Scalar _tmp15 = cos_B * cos_C;
-  const Scalar _tmp16 = cos_C * sin_B;
-  const Scalar _tmp17 = pivot_length * sin_C;
-  const Scalar _tmp18 = sin_C * tool_length;
-  const Scalar _tmp19 = _tmp11 + _tmp12;
-  const Scalar _tmp20 = _tmp15 - cos_C;
-  const Scalar _tmp21 = _tmp0 + _tmp1 + c_to_b - Z;
-  const Scalar _tmp22 = cos_C * pivot_length * sin_B;
-  const Scalar _tmp23 = cos_C * sin_B * tool_length;
-  const Scalar _tmp24 = _tmp22 + _tmp23;
-  const Scalar _tmp25 = cos_B * sin_C;
-  const Scalar _tmp26 = sin_B * sin_C;
-  const Scalar _tmp27 = cos_C * pivot_length;
-  const Scalar _tmp28 = cos_C * tool_length;
-  const Scalar _tmp29 = _tmp7 + _tmp8;
-  const Scalar _tmp30 = _tmp25 - sin_C;
-  const Scalar _tmp31 = _tmp3 + _tmp4;
-  const Scalar _tmp32 = _tmp22 + _tmp23;
-  const Scalar _tmp33 = pivot_length * sin_B;
-  const Scalar _tmp34 = sin_B * tool_length;
-  const Scalar _tmp35 = _tmp33 + _tmp34;
-  const Scalar _tmp36 = cos_B - Scalar(1);
+  const Scalar _tmp3 = -pivot_length - tool_length;
+  const Scalar _tmp4 = _tmp3 * sin_B * sin_C;
+  const Scalar _tmp5 = _tmp0 + _tmp1 + c_to_b;
+  const Scalar _tmp6 = _tmp5 * sin_C;
+  const Scalar _tmp7 = _tmp5 * cos_C;
+  const Scalar _tmp8 = cos_C - Scalar(1);
+  const Scalar _tmp9 = _tmp0 + _tmp1 + c_to_b - c_to_b * cos_C - cos_B * cos_C * pivot_length - cos_B * cos_C * tool_length;
+  const Scalar _tmp10 = cos_B * cos_C;
+  const Scalar _tmp11 = cos_C * sin_B;
+  const Scalar _tmp12 = _tmp3 * cos_B * cos_C;
+  const Scalar _tmp13 = _tmp10 - cos_C;
+  const Scalar _tmp14 = _tmp0 + _tmp1 - pivot_length - tool_length;
+  const Scalar _tmp15 = X - cos_C * pivot_length * sin_B - cos_C * sin_B * tool_length;
+  const Scalar _tmp16 = _tmp3 * cos_C * sin_B;
+  const Scalar _tmp17 = cos_B * sin_C;
+  const Scalar _tmp18 = sin_B * sin_C;
+  const Scalar _tmp19 = _tmp3 * cos_B * sin_C;
+  const Scalar _tmp20 = _tmp17 - sin_C;
+  const Scalar _tmp21 = _tmp3 * sin_B;
+  const Scalar _tmp22 = cos_B - Scalar(1);
 
   // Outputs
   if (position_coeff != nullptr) {
     auto& _position_coeff = *position_coeff;
     StorePair(_position_coeff.data(), Scalar(1), Scalar(0));
     StorePair(_position_coeff.data() + 2, Scalar(0), Scalar(0));
-    StorePair(_position_coeff.data() + 4, -_tmp2, _tmp5);
+    StorePair(_position_coeff.data() + 4, -_tmp2, -_tmp4);
     StorePair(_position_coeff.data() + 6, Scalar(1), Scalar(0));
     StorePair(_position_coeff.data() + 8, Scalar(0), Scalar(0));
-    StorePair(_position_coeff.data() + 10, -_tmp2, _tmp5);
+    StorePair(_position_coeff.data() + 10, -_tmp2, -_tmp4);
     StorePair(_position_coeff.data() + 12, Scalar(0), Scalar(1));
     StorePair(_position_coeff.data() + 14, Scalar(0), Scalar(0));
-    StorePair(_position_coeff.data() + 16, Scalar(0), -_tmp0 - _tmp1 - c_to_b);
-    StorePair(_position_coeff.data() + 18, _tmp5, Scalar(0));
+    StorePair(_position_coeff.data() + 16, Scalar(0), -_tmp5);
+    StorePair(_position_coeff.data() + 18, -_tmp4, Scalar(0));
     StorePair(_position_coeff.data() + 20, Z, cos_C);
     StorePair(_position_coeff.data() + 22, -sin_C, Scalar(0));
-    StorePair(_position_coeff.data() + 24, -_tmp9, -_tmp10 - _tmp11 - _tmp12);
-    StorePair(_position_coeff.data() + 26, _tmp5, -_tmp13);
-    StorePair(_position_coeff.data() + 28, sin_C, _tmp14);
-    StorePair(_position_coeff.data() + 30, _tmp10 + _tmp11 + _tmp12 - _tmp0 - _tmp1 - c_to_b, _tmp5);
-    StorePair(_position_coeff.data() + 32, _tmp15, -sin_C);
-    StorePair(_position_coeff.data() + 34, _tmp16, -_tmp17 - _tmp18);
-    StorePair(_position_coeff.data() + 36, -_tmp19, Scalar(0));
-    StorePair(_position_coeff.data() + 38, -_tmp20, -_tmp16);
-    StorePair(_position_coeff.data() + 40, _tmp17 + _tmp18 - _tmp7 - _tmp8, _tmp5);
-    StorePair(_position_coeff.data() + 42, -_tmp19, Scalar(0));
+    StorePair(_position_coeff.data() + 24, -_tmp6, -_tmp7);
+    StorePair(_position_coeff.data() + 26, -_tmp4, -_tmp8);
+    StorePair(_position_coeff.data() + 28, sin_C, _tmp6);
+    StorePair(_position_coeff.data() + 30, -_tmp9, -_tmp4);
+    StorePair(_position_coeff.data() + 32, _tmp10, -sin_C);
+    StorePair(_position_coeff.data() + 34, _tmp11, _tmp3 * sin_C);
+    StorePair(_position_coeff.data() + 36, _tmp12, Scalar(0));
+    StorePair(_position_coeff.data() + 38, -_tmp13, -_tmp11);
+    StorePair(_position_coeff.data() + 40, -_tmp14 * sin_C, -_tmp4);
+    StorePair(_position_coeff.data() + 42, _tmp12, Scalar(0));
     StorePair(_position_coeff.data() + 44, Scalar(1), Scalar(0));
-    StorePair(_position_coeff.data() + 46, _tmp21, Scalar(0));
-    StorePair(_position_coeff.data() + 48, X - _tmp22 - _tmp23, Scalar(0));
+    StorePair(_position_coeff.data() + 46, _tmp2, Scalar(0));
+    StorePair(_position_coeff.data() + 48, _tmp15, Scalar(0));
     StorePair(_position_coeff.data() + 50, Scalar(1), Scalar(0));
-    StorePair(_position_coeff.data() + 52, _tmp21, Scalar(0));
-    StorePair(_position_coeff.data() + 54, -_tmp24, X);
+    StorePair(_position_coeff.data() + 52, _tmp2, Scalar(0));
+    StorePair(_position_coeff.data() + 54, _tmp16, X);
     StorePair(_position_coeff.data() + 56, Scalar(0), Scalar(1));
-    StorePair(_position_coeff.data() + 58, Scalar(0), _tmp0 + _tmp1 + c_to_b);
-    StorePair(_position_coeff.data() + 60, Scalar(0), -_tmp24);
+    StorePair(_position_coeff.data() + 58, Scalar(0), _tmp5);
+    StorePair(_position_coeff.data() + 60, Scalar(0), _tmp16);
     StorePair(_position_coeff.data() + 62, -Z, Scalar(0));
     StorePair(_position_coeff.data() + 64, sin_C, cos_C);
-    StorePair(_position_coeff.data() + 66, Scalar(0), _tmp10 + _tmp11 + _tmp12);
-    StorePair(_position_coeff.data() + 68, -_tmp9, -_tmp24);
-    StorePair(_position_coeff.data() + 70, -sin_C, -_tmp13);
-    StorePair(_position_coeff.data() + 72, _tmp0 + _tmp1 + c_to_b - _tmp10 - _tmp11 - _tmp12, _tmp14);
-    StorePair(_position_coeff.data() + 74, -_tmp24, _tmp25);
-    StorePair(_position_coeff.data() + 76, cos_C, _tmp26);
-    StorePair(_position_coeff.data() + 78, _tmp27 + _tmp28, -_tmp29);
-    StorePair(_position_coeff.data() + 80, Scalar(0), -_tmp30);
-    StorePair(_position_coeff.data() + 82, -_tmp26, _tmp11 + _tmp12 - _tmp27 - _tmp28);
-    StorePair(_position_coeff.data() + 84, -_tmp24, -_tmp29);
+    StorePair(_position_coeff.data() + 66, Scalar(0), _tmp7);
+    StorePair(_position_coeff.data() + 68, -_tmp6, _tmp16);
+    StorePair(_position_coeff.data() + 70, -sin_C, -_tmp8);
+    StorePair(_position_coeff.data() + 72, _tmp9, _tmp6);
+    StorePair(_position_coeff.data() + 74, _tmp16, _tmp17);
+    StorePair(_position_coeff.data() + 76, cos_C, _tmp18);
+    StorePair(_position_coeff.data() + 78, -_tmp3 * cos_C, _tmp19);
+    StorePair(_position_coeff.data() + 80, Scalar(0), -_tmp20);
+    StorePair(_position_coeff.data() + 82, -_tmp18, _tmp14 * cos_C);
+    StorePair(_position_coeff.data() + 84, _tmp16, _tmp19);
     StorePair(_position_coeff.data() + 86, Scalar(0), Scalar(0));
-    StorePair(_position_coeff.data() + 88, Scalar(1), -_tmp31);
-    StorePair(_position_coeff.data() + 90, _tmp22 + _tmp23 - X, Scalar(0));
+    StorePair(_position_coeff.data() + 88, Scalar(1), _tmp4);
+    StorePair(_position_coeff.data() + 90, -_tmp15, Scalar(0));
     StorePair(_position_coeff.data() + 92, Scalar(0), Scalar(0));
-    StorePair(_position_coeff.data() + 94, Scalar(1), -_tmp31);
-    StorePair(_position_coeff.data() + 96, _tmp32, Scalar(0));
+    StorePair(_position_coeff.data() + 94, Scalar(1), _tmp4);
+    StorePair(_position_coeff.data() + 96, -_tmp16, Scalar(0));
     StorePair(_position_coeff.data() + 98, Scalar(0), Scalar(0));
     StorePair(_position_coeff.data() + 100, Scalar(0), Scalar(1));
-    StorePair(_position_coeff.data() + 102, -_tmp31, _tmp32);
+    StorePair(_position_coeff.data() + 102, _tmp4, -_tmp16);
     StorePair(_position_coeff.data() + 104, Scalar(0), Scalar(0));
     StorePair(_position_coeff.data() + 106, Scalar(0), Scalar(0));
     StorePair(_position_coeff.data() + 108, Scalar(0), Scalar(1));
-    StorePair(_position_coeff.data() + 110, Scalar(0), _tmp35);
+    StorePair(_position_coeff.data() + 110, Scalar(0), -_tmp21);
     StorePair(_position_coeff.data() + 112, Scalar(0), Scalar(0));
-    StorePair(_position_coeff.data() + 114, Scalar(0), -_tmp31);
-    StorePair(_position_coeff.data() + 116, _tmp22 + _tmp23 - _tmp33 - _tmp34, Scalar(0));
+    StorePair(_position_coeff.data() + 114, Scalar(0), _tmp4);
+    StorePair(_position_coeff.data() + 116, -(pivot_length + tool_length - cos_C * pivot_length - cos_C * tool_length) * sin_B, Scalar(0));
     StorePair(_position_coeff.data() + 118, -sin_B, Scalar(0));
     StorePair(_position_coeff.data() + 120, cos_B, Scalar(0));
-    StorePair(_position_coeff.data() + 122, _tmp35, Scalar(0));
-    StorePair(_position_coeff.data() + 124, sin_B, -_tmp36);
+    StorePair(_position_coeff.data() + 122, -_tmp21, Scalar(0));
+    StorePair(_position_coeff.data() + 124, sin_B, -_tmp22);
     StorePair(_position_coeff.data() + 126, Scalar(0), Scalar(0));
-    _position_coeff[128] = _tmp35;
+    _position_coeff[128] = -_tmp21;
   }
   if (orientation_coeff != nullptr) {
     auto& _orientation_coeff = *orientation_coeff;
@@ -494,13 +663,13 @@ inline void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& ax
     StorePair(_orientation_coeff.data() + 22, Scalar(0), Scalar(0));
     StorePair(_orientation_coeff.data() + 24, cos_C, -sin_C);
     StorePair(_orientation_coeff.data() + 26, Scalar(0), Scalar(0));
-    StorePair(_orientation_coeff.data() + 28, Scalar(0), -_tmp13);
+    StorePair(_orientation_coeff.data() + 28, Scalar(0), -_tmp8);
     StorePair(_orientation_coeff.data() + 30, sin_C, Scalar(0));
     StorePair(_orientation_coeff.data() + 32, Scalar(0), Scalar(0));
-    StorePair(_orientation_coeff.data() + 34, Scalar(0), _tmp15);
-    StorePair(_orientation_coeff.data() + 36, -sin_C, _tmp16);
+    StorePair(_orientation_coeff.data() + 34, Scalar(0), _tmp10);
+    StorePair(_orientation_coeff.data() + 36, -sin_C, _tmp11);
     StorePair(_orientation_coeff.data() + 38, Scalar(0), Scalar(0));
-    StorePair(_orientation_coeff.data() + 40, -_tmp20, -_tmp16);
+    StorePair(_orientation_coeff.data() + 40, -_tmp13, -_tmp11);
     StorePair(_orientation_coeff.data() + 42, -sin_C, Scalar(0));
     StorePair(_orientation_coeff.data() + 44, Scalar(0), Scalar(0));
     StorePair(_orientation_coeff.data() + 46, Scalar(0), Scalar(1));
@@ -516,13 +685,13 @@ inline void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& ax
     StorePair(_orientation_coeff.data() + 66, Scalar(0), sin_C);
     StorePair(_orientation_coeff.data() + 68, cos_C, Scalar(0));
     StorePair(_orientation_coeff.data() + 70, Scalar(0), Scalar(0));
-    StorePair(_orientation_coeff.data() + 72, -sin_C, -_tmp13);
+    StorePair(_orientation_coeff.data() + 72, -sin_C, -_tmp8);
     StorePair(_orientation_coeff.data() + 74, Scalar(0), Scalar(0));
     StorePair(_orientation_coeff.data() + 76, Scalar(0), Scalar(0));
-    StorePair(_orientation_coeff.data() + 78, _tmp25, cos_C);
-    StorePair(_orientation_coeff.data() + 80, _tmp26, Scalar(0));
-    StorePair(_orientation_coeff.data() + 82, Scalar(0), -_tmp30);
-    StorePair(_orientation_coeff.data() + 84, -_tmp26, cos_C);
+    StorePair(_orientation_coeff.data() + 78, _tmp17, cos_C);
+    StorePair(_orientation_coeff.data() + 80, _tmp18, Scalar(0));
+    StorePair(_orientation_coeff.data() + 82, Scalar(0), -_tmp20);
+    StorePair(_orientation_coeff.data() + 84, -_tmp18, cos_C);
     StorePair(_orientation_coeff.data() + 86, Scalar(0), Scalar(0));
     StorePair(_orientation_coeff.data() + 88, Scalar(0), Scalar(0));
     StorePair(_orientation_coeff.data() + 90, Scalar(0), Scalar(1));
@@ -543,7 +712,7 @@ inline void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& ax
     StorePair(_orientation_coeff.data() + 120, Scalar(0), -sin_B);
     StorePair(_orientation_coeff.data() + 122, Scalar(0), cos_B);
     StorePair(_orientation_coeff.data() + 124, Scalar(0), Scalar(0));
-    StorePair(_orientation_coeff.data() + 126, sin_B, -_tmp36);
+    StorePair(_orientation_coeff.data() + 126, sin_B, -_tmp22);
     _orientation_coeff[128] = Scalar(0);
   }
 }
@@ -618,65 +787,55 @@ inline void DeviationAndCoefficients(
   const Scalar pivot_length = params[1];
   const Scalar c_to_b = params[2];
 
-  // Intermediate terms (22)
+  // Intermediate terms (12)
   const Scalar _tmp0 = cos_B * pivot_length;
   const Scalar _tmp1 = cos_B * tool_length;
-  const Scalar _tmp2 = cos_B * pivot_length * sin_C;
-  const Scalar _tmp3 = cos_B * sin_C * tool_length;
-  const Scalar _tmp4 = c_to_b * cos_C;
-  const Scalar _tmp5 = cos_B * cos_C * pivot_length;
-  const Scalar _tmp6 = cos_B * cos_C * tool_length;
-  const Scalar _tmp7 = cos_B * cos_C;
-  const Scalar _tmp8 = pivot_length * sin_C;
-  const Scalar _tmp9 = sin_C * tool_length;
-  const Scalar _tmp10 = cos_C * pivot_length * sin_B;
-  const Scalar _tmp11 = cos_C * sin_B * tool_length;
-  const Scalar _tmp12 = cos_B * sin_C;
-  const Scalar _tmp13 = cos_C * pivot_length;
-  const Scalar _tmp14 = cos_C * tool_length;
-  const Scalar _tmp15 = pivot_length * sin_B;
-  const Scalar _tmp16 = sin_B * tool_length;
-  const Scalar _tmp17 = E_B0B + E_BB;
-  const Scalar _tmp18 = E_A0C - E_AC;
-  const Scalar _tmp19 = E_Z0B - E_ZB;
-  const Scalar _tmp20 = E_B0B + E_BB + E_BC;
-  const Scalar _tmp21 = E_C0B - E_CB;
+  const Scalar _tmp2 = -pivot_length - tool_length;
+  const Scalar _tmp3 = _tmp0 + _tmp1 + c_to_b;
+  const Scalar _tmp4 = cos_B * cos_C;
+  const Scalar _tmp5 = _tmp0 + _tmp1 - pivot_length - tool_length;
+  const Scalar _tmp6 = cos_B * sin_C;
+  const Scalar _tmp7 = E_B0B + E_BB;
+  const Scalar _tmp8 = E_A0C - E_AC;
+  const Scalar _tmp9 = E_Z0B - E_ZB;
+  const Scalar _tmp10 = E_B0B + E_BB + E_BC;
+  const Scalar _tmp11 = E_C0B - E_CB;
 
   // Coefficients of the error monomials (24)
   const Scalar _coef0 = _tmp0 + _tmp1 + c_to_b - Z;
-  const Scalar _coef1 = -pivot_length * sin_B * sin_C - sin_B * sin_C * tool_length;
-  const Scalar _coef2 = _tmp0 + _tmp1 + c_to_b;
-  const Scalar _coef3 = -_tmp2 - _tmp3 - c_to_b * sin_C;
-  const Scalar _coef4 = -_tmp4 - _tmp5 - _tmp6;
+  const Scalar _coef1 = _tmp2 * sin_B * sin_C;
+  const Scalar _coef2 = _tmp3;
+  const Scalar _coef3 = -_tmp3 * sin_C;
+  const Scalar _coef4 = -_tmp3 * cos_C;
   const Scalar _coef5 = cos_C - Scalar(1);
-  const Scalar _coef6 = _tmp0 + _tmp1 + c_to_b - _tmp4 - _tmp5 - _tmp6;
-  const Scalar _coef7 = _tmp7;
+  const Scalar _coef6 = _tmp0 + _tmp1 + c_to_b - c_to_b * cos_C - cos_B * cos_C * pivot_length - cos_B * cos_C * tool_length;
+  const Scalar _coef7 = _tmp4;
   const Scalar _coef8 = cos_C * sin_B;
-  const Scalar _coef9 = -_tmp8 - _tmp9;
-  const Scalar _coef10 = -_tmp5 - _tmp6;
-  const Scalar _coef11 = cos_C - _tmp7;
-  const Scalar _coef12 = _tmp8 + _tmp9 - _tmp2 - _tmp3;
-  const Scalar _coef13 = X - _tmp10 - _tmp11;
-  const Scalar _coef14 = -_tmp10 - _tmp11;
-  const Scalar _coef15 = _tmp12;
+  const Scalar _coef9 = _tmp2 * sin_C;
+  const Scalar _coef10 = _tmp2 * cos_B * cos_C;
+  const Scalar _coef11 = cos_C - _tmp4;
+  const Scalar _coef12 = -_tmp5 * sin_C;
+  const Scalar _coef13 = X - cos_C * pivot_length * sin_B - cos_C * sin_B * tool_length;
+  const Scalar _coef14 = _tmp2 * cos_C * sin_B;
+  const Scalar _coef15 = _tmp6;
   const Scalar _coef16 = sin_B * sin_C;
-  const Scalar _coef17 = -_tmp13 - _tmp14;
-  const Scalar _coef18 = -_tmp2 - _tmp3;
-  const Scalar _coef19 = sin_C - _tmp12;
-  const Scalar _coef20 = _tmp13 + _tmp14 - _tmp5 - _tmp6;
-  const Scalar _coef21 = -_tmp15 - _tmp16;
-  const Scalar _coef22 = _tmp15 + _tmp16 - _tmp10 - _tmp11;
+  const Scalar _coef17 = _tmp2 * cos_C;
+  const Scalar _coef18 = _tmp2 * cos_B * sin_C;
+  const Scalar _coef19 = sin_C - _tmp6;
+  const Scalar _coef20 = -_tmp5 * cos_C;
+  const Scalar _coef21 = _tmp2 * sin_B;
+  const Scalar _coef22 = (pivot_length + tool_length - cos_C * pivot_length - cos_C * tool_length) * sin_B;
   const Scalar _coef23 = cos_B - Scalar(1);
 
   // Outputs
   if (position != nullptr) {
     auto& _position = *position;
-    StorePair(_position.data(), E_XX + E_XY + E_XZ + E_A0B * _coef12 + E_AB * _coef9 + E_B0Z * Z + E_BC * _coef4 + E_X0B * _coef11 + E_XB * _coef7 + E_XC * cos_C + _coef10 * _tmp17 + (E_Y0C - E_YB - E_YC) * sin_C - E_B0C * _coef6 - E_BZ * _coef2 - E_X0C * _coef5 - _coef0 * (E_BX + E_BY) - _coef1 * (E_C0B + E_C0C + E_CC + E_CX + E_CY + E_CZ) - _coef3 * _tmp18 - _coef8 * _tmp19, E_YX + E_YY + E_YZ + E_A0C * _coef6 + E_AZ * _coef2 + E_C0X * X + E_CY * _coef13 + E_X0B * _coef19 + E_XB * _coef15 + _coef0 * (E_AX + E_AY) + _coef14 * (E_C0B + E_C0C + E_CC + E_CX + E_CZ) + _coef18 * _tmp17 + (E_YB + E_YC) * cos_C - E_A0B * _coef20 - E_A0Z * Z - E_AB * _coef17 - E_AC * _coef4 - E_Y0C * _coef5 - _coef16 * _tmp19 - _coef3 * (E_B0C - E_BC) - (E_X0C - E_XC) * sin_C);
-    _position[2] = E_ZC + E_ZX + E_ZY + E_ZZ + E_ZB * cos_B + _coef1 * (E_A0C + E_AX + E_AY + E_AZ) + (E_X0B - E_XB) * sin_B - E_B0C * _coef22 - E_BY * _coef13 - E_Z0B * _coef23 - _coef14 * (E_BX + E_BZ) - _coef21 * _tmp20;
+    StorePair(_position.data(), E_XX + E_XY + E_XZ + E_A0B * _coef12 + E_AB * _coef9 + E_B0Z * Z + E_BC * _coef4 + E_X0B * _coef11 + E_XB * _coef7 + E_XC * cos_C + _coef10 * _tmp7 + (E_Y0C - E_YB - E_YC) * sin_C - E_B0C * _coef6 - E_BZ * _coef2 - E_X0C * _coef5 - _coef0 * (E_BX + E_BY) - _coef1 * (E_C0B + E_C0C + E_CC + E_CX + E_CY + E_CZ) - _coef3 * _tmp8 - _coef8 * _tmp9, E_YX + E_YY + E_YZ + E_A0C * _coef6 + E_AZ * _coef2 + E_C0X * X + E_CY * _coef13 + E_X0B * _coef19 + E_XB * _coef15 + _coef0 * (E_AX + E_AY) + _coef14 * (E_C0B + E_C0C + E_CC + E_CX + E_CZ) + _coef18 * _tmp7 + (E_YB + E_YC) * cos_C - E_A0B * _coef20 - E_A0Z * Z - E_AB * _coef17 - E_AC * _coef4 - E_Y0C * _coef5 - _coef16 * _tmp9 - _coef3 * (E_B0C - E_BC) - (E_X0C - E_XC) * sin_C);
+    _position[2] = E_ZC + E_ZX + E_ZY + E_ZZ + E_ZB * cos_B + _coef1 * (E_A0C + E_AX + E_AY + E_AZ) + (E_X0B - E_XB) * sin_B - E_B0C * _coef22 - E_BY * _coef13 - E_Z0B * _coef23 - _coef14 * (E_BX + E_BZ) - _coef21 * _tmp10;
   }
   if (orientation != nullptr) {
     auto& _orientation = *orientation;
-    StorePair(_orientation.data(), E_AX + E_AY + E_AZ + E_A0B * _coef11 + E_AB * _coef7 + E_AC * cos_C - E_A0C * _coef5 - _coef8 * _tmp21 - (E_B0B + E_BB + E_BC - E_B0C) * sin_C, E_BX + E_BY + E_BZ + E_A0B * _coef19 + E_AB * _coef15 + _tmp20 * cos_C - E_B0C * _coef5 - _coef16 * _tmp21 - _tmp18 * sin_C);
+    StorePair(_orientation.data(), E_AX + E_AY + E_AZ + E_A0B * _coef11 + E_AB * _coef7 + E_AC * cos_C - E_A0C * _coef5 - _coef8 * _tmp11 - (E_B0B + E_BB + E_BC - E_B0C) * sin_C, E_BX + E_BY + E_BZ + E_A0B * _coef19 + E_AB * _coef15 + _tmp10 * cos_C - E_B0C * _coef5 - _coef16 * _tmp11 - _tmp8 * sin_C);
     _orientation[2] = E_C0C + E_CC + E_CX + E_CY + E_CZ + E_CB * cos_B + (E_A0B - E_AB) * sin_B - E_C0B * _coef23;
   }
   if (position_coeff != nullptr) {

@@ -4,9 +4,9 @@
 // Units: axes as in kAxes (mm, deg), errors in base units (mm, rad), parameters in mm/deg;
 //        position outputs dx, dy, dz in mm, orientation outputs da, db, dc in rad.
 // Operation counts (after common-subexpression elimination):
-//   Deviation:    604 (adds 240, muls 357, divs 5, functions 2), 54 temporaries
-//   Coefficients: 482 (adds 140, muls 335, divs 5, functions 2), 100 temporaries
-//   DeviationAndCoefficients: 676 (adds 240, muls 429, divs 5, functions 2), 54 temporaries
+//   Deviation:    437 (adds 175, muls 255, divs 5, functions 2), 34 temporaries
+//   Coefficients: 298 (adds 41, muls 250, divs 5, functions 2), 56 temporaries
+//   DeviationAndCoefficients: 509 (adds 175, muls 327, divs 5, functions 2), 34 temporaries
 //   NominalPose:  1 (adds 1, muls 0, divs 0, functions 0), 0 temporaries
 //   NominalJacobian: 0 (adds 0, muls 0, divs 0, functions 0), 0 temporaries
 //   Compensate:   per iteration errors_at + Deviation + NominalPose + 3x5 least-squares step; once per call NominalJacobian + NominalPose + Cholesky
@@ -21,6 +21,199 @@
 #endif
 
 namespace weilgen_models {
+
+// Pack<Lanes>: `Lanes` doubles evaluated together, one pose (or one error sample) per lane, as the
+// Scalar of the evaluation functions: DeviationAndCoefficients<Pack<4>> evaluates 4 poses with one
+// instruction per operation where the target has registers of 4 doubles (AVX2; 8 with AVX-512).
+// Each lane is the double function's result for that lane's inputs: the same operations in the
+// same order, sin/cos/sqrt from the C library lane by lane (docs/generator.md, "Several poses at
+// once"). Compensate needs comparisons and takes double only. Defined once per translation unit,
+// however many model headers it includes.
+#ifndef WEILGEN_MODELS_PACK_DEFINED
+#define WEILGEN_MODELS_PACK_DEFINED
+// GCC's and Clang's vector extension; elsewhere (or with WEILGEN_MODELS_PACK_PORTABLE defined) a
+// plain array, lane by lane, which the optimiser may vectorise.
+#if (defined(__GNUC__) || defined(__clang__)) && !defined(WEILGEN_MODELS_PACK_PORTABLE)
+#define WEILGEN_MODELS_PACK_VECTOR 1
+#else
+#define WEILGEN_MODELS_PACK_VECTOR 0
+#endif
+#if WEILGEN_MODELS_PACK_VECTOR
+// GCC takes no vector_size that depends on a template parameter: one type per lane count.
+template <std::size_t Lanes>
+struct PackVector;
+template <>
+struct PackVector<2> {
+  typedef double type __attribute__((vector_size(16)));
+  typedef long long bits __attribute__((vector_size(16)));
+};
+template <>
+struct PackVector<4> {
+  typedef double type __attribute__((vector_size(32)));
+  typedef long long bits __attribute__((vector_size(32)));
+};
+template <>
+struct PackVector<8> {
+  typedef double type __attribute__((vector_size(64)));
+  typedef long long bits __attribute__((vector_size(64)));
+};
+#endif
+// Each operation lane by lane, as a hidden friend (found by argument-dependent lookup, a double
+// converts to every lane): with the vector extension one instruction where the target has the
+// registers, else a loop.
+#if WEILGEN_MODELS_PACK_VECTOR
+#define WEILGEN_MODELS_PACK_LANES(EXPR) Pack(EXPR)
+#else
+#define WEILGEN_MODELS_PACK_LANES(EXPR) Pack::Map([&](const std::size_t i) { return EXPR; })
+#endif
+template <std::size_t Lanes>
+struct Pack {
+  static_assert(Lanes == 2 || Lanes == 4 || Lanes == 8, "2, 4 or 8 lanes");
+#if WEILGEN_MODELS_PACK_VECTOR
+  using Vector = typename PackVector<Lanes>::type;
+  Vector v;
+  Pack() = default;
+  Pack(const double x) : v(Vector{} + x) {}  // every lane x (implicit: Scalar(0.5) in the code)
+  explicit Pack(const Vector& x) : v(x) {}
+  double Get(const std::size_t i) const { return v[i]; }
+  void Set(const std::size_t i, const double x) { v[i] = x; }
+#define WEILGEN_MODELS_PACK_LANE(P) (P).v
+#else
+  double v[Lanes];
+  Pack() = default;
+  Pack(const double x) {
+    for (std::size_t i = 0; i < Lanes; ++i) v[i] = x;
+  }
+  double Get(const std::size_t i) const { return v[i]; }
+  void Set(const std::size_t i, const double x) { v[i] = x; }
+  template <typename F>
+  static Pack Map(const F& f) {
+    Pack r;
+    for (std::size_t i = 0; i < Lanes; ++i) r.v[i] = f(i);
+    return r;
+  }
+#define WEILGEN_MODELS_PACK_LANE(P) (P).v[i]
+#endif
+  static Pack Load(const double* const from) {  // from[0 .. Lanes)
+    Pack p;
+    for (std::size_t i = 0; i < Lanes; ++i) p.Set(i, from[i]);
+    return p;
+  }
+  void Store(double* const to) const {  // to[0 .. Lanes)
+    for (std::size_t i = 0; i < Lanes; ++i) to[i] = Get(i);
+  }
+
+  friend Pack operator+(const Pack& a, const Pack& b) {
+    return WEILGEN_MODELS_PACK_LANES(WEILGEN_MODELS_PACK_LANE(a) + WEILGEN_MODELS_PACK_LANE(b));
+  }
+  friend Pack operator-(const Pack& a, const Pack& b) {
+    return WEILGEN_MODELS_PACK_LANES(WEILGEN_MODELS_PACK_LANE(a) - WEILGEN_MODELS_PACK_LANE(b));
+  }
+  friend Pack operator*(const Pack& a, const Pack& b) {
+    return WEILGEN_MODELS_PACK_LANES(WEILGEN_MODELS_PACK_LANE(a) * WEILGEN_MODELS_PACK_LANE(b));
+  }
+  friend Pack operator/(const Pack& a, const Pack& b) {
+    return WEILGEN_MODELS_PACK_LANES(WEILGEN_MODELS_PACK_LANE(a) / WEILGEN_MODELS_PACK_LANE(b));
+  }
+  friend Pack operator-(const Pack& a) { return WEILGEN_MODELS_PACK_LANES(-WEILGEN_MODELS_PACK_LANE(a)); }
+  friend Pack& operator+=(Pack& a, const Pack& b) { return a = a + b; }
+  friend Pack& operator-=(Pack& a, const Pack& b) { return a = a - b; }
+  friend Pack& operator*=(Pack& a, const Pack& b) { return a = a * b; }
+  // With 4 or 8 lanes, sin and cos of every lane at once (SinCos below, within 1 ulp of the C
+  // library's); with 2 (no faster than two library calls, measured) or without the vector
+  // extension, the C library's lane by lane, as the double functions call it.
+  friend Pack sin(const Pack& a) {
+#if WEILGEN_MODELS_PACK_VECTOR
+    if constexpr (Lanes >= 4) {
+      Pack s, c;
+      SinCos(a, &s, &c);
+      return s;
+    }
+#endif
+    return Apply(a, [](const double x) { return std::sin(x); });
+  }
+  friend Pack cos(const Pack& a) {
+#if WEILGEN_MODELS_PACK_VECTOR
+    if constexpr (Lanes >= 4) {
+      Pack s, c;
+      SinCos(a, &s, &c);
+      return c;
+    }
+#endif
+    return Apply(a, [](const double x) { return std::cos(x); });
+  }
+  friend Pack sqrt(const Pack& a) { return Apply(a, [](const double x) { return std::sqrt(x); }); }
+
+ private:
+#if WEILGEN_MODELS_PACK_VECTOR
+  // sin and cos of all lanes in vector arithmetic: the lane-by-lane C library calls would be
+  // most of a rotary machine's time. fdlibm's method (e_rem_pio2.c, k_sin.c, k_cos.c): x - n*pi/2
+  // with pi/2 in three 33-bit parts and their tails (good to 151 bits, so x near a multiple of
+  // pi/2 keeps its digits), then the kernels on [-pi/4, pi/4] with the reduced argument's tail,
+  // the quadrant n mod 4 choosing and negating. Within 1 ulp of glibc (correctly rounded) for
+  // |x| <= 1e6 rad; about 15 % of arguments differ by that 1 ulp (tests/test_generated_headers.cpp).
+  // A lane beyond 1e6 rad (n * pi/2 no longer exact), infinite or NaN: the C library, lane by
+  // lane, for the whole pack.
+  static void SinCos(const Pack& a, Pack* const sin_a, Pack* const cos_a) {
+    using Bits = typename PackVector<Lanes>::bits;
+    const Vector x = a.v;
+    const Bits sign = (Bits)(-Vector{});  // -0.0: the sign bit of every lane
+    const double magic = 6755399441055744.0;  // 1.5 * 2^52: (t + magic) - magic rounds t
+    const Vector shifted = x * 6.36619772367581382433e-01 + magic;  // x * 2/pi + magic
+    const Vector n = shifted - magic;
+    const Bits quadrant = (Bits)shifted;  // its low bits are n mod 4
+    Vector r = x - n * 1.57079632673412561417e+00;
+    Vector t = r;
+    Vector w = n * 6.07710050630396597660e-11;
+    r = t - w;
+    w = n * 2.02226624879595063154e-21 - ((t - r) - w);
+    t = r;
+    w = n * 2.02226624871116645580e-21;
+    r = t - w;
+    w = n * 8.47842766036889956997e-32 - ((t - r) - w);
+    const Vector y0 = r - w;         // the reduced argument, |y0| <= pi/4 (about)
+    const Vector y1 = (r - y0) - w;  // and its tail
+    const Vector z = y0 * y0, zz = z * z, v = z * y0;
+    const Vector sr = 8.33333333332248946124e-03 + z * (-1.98412698298579493134e-04 +
+                                                          z * 2.75573137070700676789e-06) +
+                      z * zz * (-2.50507602534068634195e-08 + z * 1.58969099521155010221e-10);
+    const Vector s = y0 - ((z * (0.5 * y1 - v * sr) - y1) - v * -1.66666666666666324348e-01);
+    const Vector cr = z * (4.16666666666666019037e-02 + z * (-1.38888888888741095749e-03 +
+                                                              z * 2.48015872894767294178e-05)) +
+                      zz * zz *
+                          (-2.75573143513906633035e-07 +
+                           z * (2.08757232129817482790e-09 + z * -1.13596475577881948265e-11));
+    const Vector hz = 0.5 * z, w1 = 1.0 - hz;
+    const Vector c = w1 + (((1.0 - w1) - hz) + (z * cr - y0 * y1));
+    // sin x = s, c, -s, -c and cos x = c, -s, -c, s for n mod 4 = 0, 1, 2, 3.
+    const Bits odd = (quadrant & 1) != 0;
+    const Bits s_bits = ((Bits)s & ~odd) | ((Bits)c & odd);
+    const Bits c_bits = ((Bits)c & ~odd) | ((Bits)s & odd);
+    sin_a->v = (Vector)(s_bits ^ (sign & ((quadrant & 2) != 0)));
+    cos_a->v = (Vector)(c_bits ^ (sign & (((quadrant + 1) & 2) != 0)));
+    // The check after the arithmetic, not before: sin(x) and cos(x) of one angle then share all
+    // of it once both are inlined.
+    // |x| > 1e6, inf or NaN: their bits, sign cleared, compare as integers above 1e6's.
+    const Bits outside = ((Bits)x & ~sign) > 0x412E848000000000LL;
+    long long any = 0;
+    for (std::size_t i = 0; i < Lanes; ++i) any |= outside[i];
+    if (any != 0) {
+      *sin_a = Apply(a, [](const double y) { return std::sin(y); });
+      *cos_a = Apply(a, [](const double y) { return std::cos(y); });
+    }
+  }
+#endif
+  template <typename F>
+  static Pack Apply(const Pack& a, const F& f) {
+    Pack r;
+    for (std::size_t i = 0; i < Lanes; ++i) r.Set(i, f(a.Get(i)));
+    return r;
+  }
+};
+#undef WEILGEN_MODELS_PACK_LANE
+#undef WEILGEN_MODELS_PACK_LANES
+#endif  // WEILGEN_MODELS_PACK_DEFINED
+
 namespace pipe_cutter {
 
 inline constexpr const char* kMachineName = "pipe_cutter";
@@ -368,61 +561,41 @@ inline void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
   const Scalar _inv3 = Scalar(1) / (L01 + L23 + X - L04 - grip_feed - grip_main);
   const Scalar _inv4 = Scalar(1) / (L01 + L23 + X - L04);
 
-  // Intermediate terms (54)
-  const Scalar _tmp0 = LW * _inv4 * cos_A04;
-  const Scalar _tmp1 = LW * _inv4 * sin_A04;
-  const Scalar _tmp2 = L01 * _inv4 * sin_A04;
-  const Scalar _tmp3 = L04 * _inv4 * sin_A04;
-  const Scalar _tmp4 = L23 * _inv4 * sin_A04;
-  const Scalar _tmp5 = _inv0 * _inv3 * grip_main * Z453;
-  const Scalar _tmp6 = _inv4 * sin_A04 * X;
-  const Scalar _tmp7 = L01 * _inv4 * jaw_reach * sin_A04;
-  const Scalar _tmp8 = L04 * _inv4 * jaw_reach * sin_A04;
-  const Scalar _tmp9 = L23 * _inv4 * jaw_reach * sin_A04;
-  const Scalar _tmp10 = LW * _inv4 * jaw_reach * sin_A04;
-  const Scalar _tmp11 = _inv0 * _inv3 * grip_main * jaw_reach * Z453;
-  const Scalar _tmp12 = _inv4 * jaw_reach * sin_A04 * X;
-  const Scalar _tmp13 = jaw_reach * sin_A04;
-  const Scalar _tmp14 = LW * _inv4 * cos_A04 * jaw_reach;
-  const Scalar _tmp15 = L01 * _inv4 * sin_A04 * Y231;
-  const Scalar _tmp16 = L04 * _inv4 * sin_A04 * Y231;
-  const Scalar _tmp17 = L23 * _inv4 * sin_A04 * Y231;
-  const Scalar _tmp18 = LW * _inv4 * sin_A04 * Y231;
-  const Scalar _tmp19 = _inv0 * _inv3 * grip_main * Y231 * Z453;
-  const Scalar _tmp20 = _inv4 * sin_A04 * X * Y231;
-  const Scalar _tmp21 = sin_A04 * Y231;
-  const Scalar _tmp22 = L01 * _inv4 * cos_A04;
-  const Scalar _tmp23 = L04 * _inv4 * cos_A04;
-  const Scalar _tmp24 = L23 * _inv4 * cos_A04;
-  const Scalar _tmp25 = _inv4 * cos_A04 * X;
-  const Scalar _tmp26 = L01 * _inv3 * Z453;
-  const Scalar _tmp27 = L04 * _inv3 * Z453;
-  const Scalar _tmp28 = L23 * _inv3 * Z453;
-  const Scalar _tmp29 = _inv3 * grip_feed * Z453;
-  const Scalar _tmp30 = _inv3 * X * Z453;
-  const Scalar _tmp31 = L01 * _inv3;
-  const Scalar _tmp32 = L04 * _inv3;
-  const Scalar _tmp33 = L23 * _inv3;
-  const Scalar _tmp34 = _inv3 * grip_feed;
-  const Scalar _tmp35 = _inv3 * X;
-  const Scalar _tmp36 = E_B0A12 + E_BX;
-  const Scalar _tmp37 = Scalar(2) * (E_YA12 - E_YA04) + E_YY231 + E_YY232 - E_YY451 - E_YY452;
-  const Scalar _tmp38 = Scalar(2) * (E_ZA12 - E_ZA04) + E_ZY231 + E_ZY232 - E_ZZ453 - E_ZZ454;
-  const Scalar _tmp39 = E_BY231 + E_BY232 - E_BZ453 - E_BZ454;
-  const Scalar _tmp40 = E_CY231 + E_CY232 - E_CY451 - E_CY452;
-  const Scalar _tmp41 = E_A0Y231 - E_A0Y232;
-  const Scalar _tmp42 = E_C0A12 + E_CX;
-  const Scalar _tmp43 = Scalar(2) * E_YA12 + E_YY231 + E_YY232;
-  const Scalar _tmp44 = E_CY231 + E_CY232;
-  const Scalar _tmp45 = E_YY451 + E_YY452;
-  const Scalar _tmp46 = E_ZY451 - E_ZY452;
-  const Scalar _tmp47 = E_BY451 - E_BY452;
-  const Scalar _tmp48 = E_CY451 + E_CY452;
-  const Scalar _tmp49 = E_A0Y451 + E_A0Y452 + E_A0Z453 + E_A0Z454;
-  const Scalar _tmp50 = E_YZ453 - E_YZ454;
-  const Scalar _tmp51 = E_ZZ453 + E_ZZ454;
-  const Scalar _tmp52 = E_BZ453 + E_BZ454;
-  const Scalar _tmp53 = E_CZ453 - E_CZ454;
+  // Intermediate terms (34)
+  const Scalar _tmp0 = LW * _inv4 * sin_A04;
+  const Scalar _tmp1 = L01 * _inv4 * sin_A04;
+  const Scalar _tmp2 = L04 * _inv4 * sin_A04;
+  const Scalar _tmp3 = L23 * _inv4 * sin_A04;
+  const Scalar _tmp4 = _inv0 * _inv3 * grip_main * Z453;
+  const Scalar _tmp5 = _inv4 * sin_A04 * X;
+  const Scalar _tmp6 = _tmp0 + _tmp2 + sin_A04 - _tmp1 - _tmp3 - Scalar(2) * _tmp4 - _tmp5;
+  const Scalar _tmp7 = _tmp0 + _tmp2 + Scalar(2) * _tmp4 + sin_A04 - _tmp1 - _tmp3 - _tmp5;
+  const Scalar _tmp8 = L01 + L23 + X - L04 - LW;
+  const Scalar _tmp9 = _inv4 * _tmp8 * cos_A04;
+  const Scalar _tmp10 = _inv4 * _tmp8 * sin_A04;
+  const Scalar _tmp11 = L01 + L23 + X - L04 - grip_feed;
+  const Scalar _tmp12 = _inv3 * _tmp11 * Z453;
+  const Scalar _tmp13 = _inv3 * grip_main;
+  const Scalar _tmp14 = -Scalar(1) - _tmp13;
+  const Scalar _tmp15 = _inv3 * _tmp11;
+  const Scalar _tmp16 = E_B0A12 + E_BX;
+  const Scalar _tmp17 = Scalar(2) * (E_YA12 - E_YA04) + E_YY231 + E_YY232 - E_YY451 - E_YY452;
+  const Scalar _tmp18 = Scalar(2) * (E_ZA12 - E_ZA04) + E_ZY231 + E_ZY232 - E_ZZ453 - E_ZZ454;
+  const Scalar _tmp19 = E_BY231 + E_BY232 - E_BZ453 - E_BZ454;
+  const Scalar _tmp20 = E_CY231 + E_CY232 - E_CY451 - E_CY452;
+  const Scalar _tmp21 = E_A0Y231 - E_A0Y232;
+  const Scalar _tmp22 = E_C0A12 + E_CX;
+  const Scalar _tmp23 = Scalar(2) * E_YA12 + E_YY231 + E_YY232;
+  const Scalar _tmp24 = E_CY231 + E_CY232;
+  const Scalar _tmp25 = E_YY451 + E_YY452;
+  const Scalar _tmp26 = E_ZY451 - E_ZY452;
+  const Scalar _tmp27 = E_BY451 - E_BY452;
+  const Scalar _tmp28 = E_CY451 + E_CY452;
+  const Scalar _tmp29 = E_A0Y451 + E_A0Y452 + E_A0Z453 + E_A0Z454;
+  const Scalar _tmp30 = E_YZ453 - E_YZ454;
+  const Scalar _tmp31 = E_ZZ453 + E_ZZ454;
+  const Scalar _tmp32 = E_BZ453 + E_BZ454;
+  const Scalar _tmp33 = E_CZ453 - E_CZ454;
 
   // Coefficients of the error monomials (63)
   const Scalar _coef0 = _inv4 * Z453;
@@ -440,47 +613,47 @@ inline void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
   const Scalar _coef12 = LW * _inv4;
   const Scalar _coef13 = _inv3 * grip_main * Z453;
   const Scalar _coef14 = L23 * LW * _inv4;
-  const Scalar _coef15 = _tmp0;
-  const Scalar _coef16 = _tmp1;
+  const Scalar _coef15 = LW * _inv4 * cos_A04;
+  const Scalar _coef16 = _tmp0;
   const Scalar _coef17 = L23 * LW * _inv4 * sin_A04;
   const Scalar _coef18 = L23 * LW * _inv4 * cos_A04;
-  const Scalar _coef19 = Scalar(0.5) * (_tmp1 + _tmp3 + sin_A04 - _tmp2 - _tmp4 - _tmp6) - _tmp5;
-  const Scalar _coef20 = Scalar(0.5) * (_tmp10 + _tmp13 + _tmp8 - _tmp12 - _tmp7 - _tmp9) - _tmp11;
-  const Scalar _coef21 = _tmp14;
-  const Scalar _coef22 = Scalar(0.5) * (_tmp16 + _tmp18 + _tmp21 - _tmp15 - _tmp17 - _tmp20) - _tmp19;
-  const Scalar _coef23 = Scalar(0.5) * (_tmp2 + _tmp4 + _tmp6 - _tmp1 - _tmp3 - sin_A04) - _tmp5;
-  const Scalar _coef24 = Scalar(0.5) * (_tmp12 + _tmp7 + _tmp9 - _tmp10 - _tmp13 - _tmp8) - _tmp11;
-  const Scalar _coef25 = Scalar(0.5) * (_tmp15 + _tmp17 + _tmp20 - _tmp16 - _tmp18 - _tmp21) - _tmp19;
-  const Scalar _coef26 = _tmp0 + _tmp23 - _tmp22 - _tmp24 - _tmp25;
-  const Scalar _coef27 = _tmp1 + _tmp3 - _tmp2 - _tmp4 - _tmp6;
-  const Scalar _coef28 = _tmp27 + _tmp29 - _tmp26 - _tmp28 - _tmp30;
-  const Scalar _coef29 = L04 * L45 * _inv4 * sin_A04 + L45 * LW * _inv4 * sin_A04 - L01 * L45 * _inv4 * sin_A04 - L23 * L45 * _inv4 * sin_A04 - L45 * _inv4 * sin_A04 * X;
-  const Scalar _coef30 = L04 * L45 * _inv4 * cos_A04 + L45 * LW * _inv4 * cos_A04 - L01 * L45 * _inv4 * cos_A04 - L23 * L45 * _inv4 * cos_A04 - L45 * _inv4 * cos_A04 * X;
-  const Scalar _coef31 = L04 * L45 * _inv4 + L45 * LW * _inv4 - L01 * L45 * _inv4 - L23 * L45 * _inv4 - L45 * _inv4 * X;
-  const Scalar _coef32 = Scalar(0.5) * (_tmp0 + _tmp23 - _tmp22 - _tmp24 - _tmp25);
-  const Scalar _coef33 = -Scalar(0.25) * (_inv2 * _inv3 * grip_main * Z453 + _inv2 * Z453);
-  const Scalar _coef34 = -Scalar(0.25) * (_inv2 * _inv3 * grip_main * jaw_reach * Z453 + _inv2 * jaw_reach * Z453);
-  const Scalar _coef35 = Scalar(0.5) * (_tmp14 + L04 * _inv4 * cos_A04 * jaw_reach - L01 * _inv4 * cos_A04 * jaw_reach - L23 * _inv4 * cos_A04 * jaw_reach - _inv4 * cos_A04 * jaw_reach * X);
-  const Scalar _coef36 = Scalar(0.25) * (_tmp27 + _tmp29 - _tmp26 - _tmp28 - _tmp30);
-  const Scalar _coef37 = Scalar(0.25) * (_tmp32 + _tmp34 - _tmp31 - _tmp33 - _tmp35);
-  const Scalar _coef38 = Scalar(0.5) * (_tmp1 + _tmp3 - _tmp2 - _tmp4 - _tmp6);
-  const Scalar _coef39 = Scalar(0.5) * (_tmp10 + _tmp8 - _tmp12 - _tmp7 - _tmp9);
-  const Scalar _coef40 = Scalar(0.25) * (L04 * _inv3 * jaw_reach + _inv3 * grip_feed * jaw_reach - L01 * _inv3 * jaw_reach - L23 * _inv3 * jaw_reach - _inv3 * jaw_reach * X);
-  const Scalar _coef41 = _tmp10;
+  const Scalar _coef19 = Scalar(0.5) * (_tmp0 + _tmp2 + sin_A04 - _tmp1 - _tmp3 - _tmp5) - _tmp4;
+  const Scalar _coef20 = Scalar(0.5) * _tmp6 * jaw_reach;
+  const Scalar _coef21 = LW * _inv4 * cos_A04 * jaw_reach;
+  const Scalar _coef22 = Scalar(0.5) * _tmp6 * Y231;
+  const Scalar _coef23 = Scalar(0.5) * (_tmp1 + _tmp3 + _tmp5 - _tmp0 - _tmp2 - sin_A04) - _tmp4;
+  const Scalar _coef24 = -Scalar(0.5) * _tmp7 * jaw_reach;
+  const Scalar _coef25 = -Scalar(0.5) * _tmp7 * Y231;
+  const Scalar _coef26 = -_tmp9;
+  const Scalar _coef27 = -_tmp10;
+  const Scalar _coef28 = -_tmp12;
+  const Scalar _coef29 = -L45 * _inv4 * _tmp8 * sin_A04;
+  const Scalar _coef30 = -L45 * _inv4 * _tmp8 * cos_A04;
+  const Scalar _coef31 = -L45 * _inv4 * _tmp8;
+  const Scalar _coef32 = -Scalar(0.5) * _tmp9;
+  const Scalar _coef33 = Scalar(0.25) * _inv2 * _tmp14 * Z453;
+  const Scalar _coef34 = Scalar(0.25) * _inv2 * _tmp14 * jaw_reach * Z453;
+  const Scalar _coef35 = -Scalar(0.5) * _inv4 * _tmp8 * cos_A04 * jaw_reach;
+  const Scalar _coef36 = -Scalar(0.25) * _tmp12;
+  const Scalar _coef37 = -Scalar(0.25) * _tmp15;
+  const Scalar _coef38 = -Scalar(0.5) * _tmp10;
+  const Scalar _coef39 = -Scalar(0.5) * _inv4 * _tmp8 * jaw_reach * sin_A04;
+  const Scalar _coef40 = -Scalar(0.25) * _inv3 * _tmp11 * jaw_reach;
+  const Scalar _coef41 = LW * _inv4 * jaw_reach * sin_A04;
   const Scalar _coef42 = LW * _inv4 * cos_A04 * Y231;
-  const Scalar _coef43 = _inv3 * grip_main;
+  const Scalar _coef43 = _tmp13;
   const Scalar _coef44 = _inv0 * _inv3 * grip_main;
   const Scalar _coef45 = _inv0 * _inv3 * grip_main * jaw_reach;
-  const Scalar _coef46 = _tmp32 + _tmp34 - _tmp31 - _tmp33 - _tmp35;
-  const Scalar _coef47 = -Scalar(0.25) * (_inv2 + _inv2 * _inv3 * grip_main);
-  const Scalar _coef48 = -Scalar(0.25) * (_inv2 * _inv3 * grip_main * jaw_reach + _inv2 * jaw_reach);
-  const Scalar _coef49 = -Scalar(0.25) * (_inv1 + _inv1 * _inv3 * grip_main);
-  const Scalar _coef50 = -Scalar(0.25) * (_inv1 * _inv3 * grip_main * jaw_reach + _inv1 * jaw_reach);
+  const Scalar _coef46 = -_tmp15;
+  const Scalar _coef47 = Scalar(0.25) * _inv2 * _tmp14;
+  const Scalar _coef48 = Scalar(0.25) * _inv2 * _tmp14 * jaw_reach;
+  const Scalar _coef49 = Scalar(0.25) * _inv1 * _tmp14;
+  const Scalar _coef50 = Scalar(0.25) * _inv1 * _tmp14 * jaw_reach;
   const Scalar _coef51 = L23 * _inv4;
   const Scalar _coef52 = _inv4 * sin_A04;
   const Scalar _coef53 = _inv4 * cos_A04;
-  const Scalar _coef54 = _tmp24;
-  const Scalar _coef55 = _tmp4;
+  const Scalar _coef54 = L23 * _inv4 * cos_A04;
+  const Scalar _coef55 = _tmp3;
   const Scalar _coef56 = _inv4 * cos_A04 * jaw_reach;
   const Scalar _coef57 = _inv4 * jaw_reach * sin_A04;
   const Scalar _coef58 = _inv4 * cos_A04 * Y231;
@@ -492,13 +665,13 @@ inline void Deviation([[maybe_unused]] const std::array<Scalar, kNumAxes>& axes,
   // Outputs
   if (position != nullptr) {
     auto& _position = *position;
-    StorePair(_position.data(), E_XA12 + E_XX + Scalar(0.5) * (E_XY231 + E_XY232 + _coef6 * _tmp39 - _coef2 * _tmp37 - _coef3 * _tmp38 - _coef7 * _tmp40 - _coef8 * _tmp41 - (E_C0Y231 - E_C0Y232) * Y231) + E_BA12 * _coef4 + E_CA04 * _coef10 + _coef1 * _tmp36 - E_B0A04 * _coef11 - E_BA04 * _coef9 - E_CA12 * _coef5 - E_ZX * _coef0, E_AA04 * _coef28 + E_BA12 * _coef17 + E_BY231 * _coef20 + E_CA12 * _coef18 + E_YX * _coef12 + E_ZA04 * _coef27 + E_ZY232 * _coef23 + _coef13 * (E_AA12 + E_AX) + _coef14 * _tmp42 + Scalar(0.5) * (_coef15 * _tmp43 + _coef21 * _tmp44) + _coef33 * _tmp46 + _coef36 * _tmp49 + _coef38 * _tmp51 - E_A0Y231 * _coef22 - E_A0Y232 * _coef25 - E_BA04 * _coef29 - E_BY232 * _coef24 - E_C0A04 * _coef31 - E_CA04 * _coef30 - E_YA04 * _coef26 - E_ZA12 * _coef16 - E_ZY231 * _coef19 - _coef32 * _tmp45 - _coef34 * _tmp47 - _coef35 * _tmp48 - _coef37 * _tmp50 - _coef39 * _tmp52 - _coef40 * _tmp53);
-    _position[2] = E_B0A04 * _coef31 + E_BA04 * _coef30 + E_CA12 * _coef17 + E_ZX * _coef12 + Scalar(0.5) * (_coef15 * (Scalar(2) * E_ZA12 + E_ZY231 + E_ZY232) + _coef16 * _tmp43 + _coef41 * _tmp44 + _coef42 * _tmp41 - _coef21 * (E_BY231 + E_BY232)) + _coef35 * _tmp52 - E_BA12 * _coef18 - E_CA04 * _coef29 - E_YA04 * _coef27 - E_ZA04 * _coef26 - _coef14 * _tmp36 - _coef32 * _tmp51 - _coef38 * _tmp45 - _coef39 * _tmp48;
+    StorePair(_position.data(), E_XA12 + E_XX + Scalar(0.5) * (E_XY231 + E_XY232 + _coef6 * _tmp19 - _coef2 * _tmp17 - _coef3 * _tmp18 - _coef7 * _tmp20 - _coef8 * _tmp21 - (E_C0Y231 - E_C0Y232) * Y231) + E_BA12 * _coef4 + E_CA04 * _coef10 + _coef1 * _tmp16 - E_B0A04 * _coef11 - E_BA04 * _coef9 - E_CA12 * _coef5 - E_ZX * _coef0, E_AA04 * _coef28 + E_BA12 * _coef17 + E_BY231 * _coef20 + E_CA12 * _coef18 + E_YX * _coef12 + E_ZA04 * _coef27 + E_ZY232 * _coef23 + _coef13 * (E_AA12 + E_AX) + _coef14 * _tmp22 + Scalar(0.5) * (_coef15 * _tmp23 + _coef21 * _tmp24) + _coef33 * _tmp26 + _coef36 * _tmp29 + _coef38 * _tmp31 - E_A0Y231 * _coef22 - E_A0Y232 * _coef25 - E_BA04 * _coef29 - E_BY232 * _coef24 - E_C0A04 * _coef31 - E_CA04 * _coef30 - E_YA04 * _coef26 - E_ZA12 * _coef16 - E_ZY231 * _coef19 - _coef32 * _tmp25 - _coef34 * _tmp27 - _coef35 * _tmp28 - _coef37 * _tmp30 - _coef39 * _tmp32 - _coef40 * _tmp33);
+    _position[2] = E_B0A04 * _coef31 + E_BA04 * _coef30 + E_CA12 * _coef17 + E_ZX * _coef12 + Scalar(0.5) * (_coef15 * (Scalar(2) * E_ZA12 + E_ZY231 + E_ZY232) + _coef16 * _tmp23 + _coef41 * _tmp24 + _coef42 * _tmp21 - _coef21 * (E_BY231 + E_BY232)) + _coef35 * _tmp32 - E_BA12 * _coef18 - E_CA04 * _coef29 - E_YA04 * _coef27 - E_ZA04 * _coef26 - _coef14 * _tmp16 - _coef32 * _tmp31 - _coef38 * _tmp25 - _coef39 * _tmp28;
   }
   if (orientation != nullptr) {
     auto& _orientation = *orientation;
-    StorePair(_orientation.data(), _coef45 * (E_BY231 - E_BY232) + _coef48 * _tmp47 + _coef49 * _tmp50 + _coef50 * _tmp53 - E_AA04 * _coef46 - _coef37 * _tmp49 - Scalar(0.5) * _coef43 * (E_A0Y231 + E_A0Y232 + Scalar(2) * (E_AA12 + E_AX)) - _coef44 * (E_ZY231 - E_ZY232) - _coef47 * _tmp46, E_BA12 * _coef54 + E_CA04 * _coef60 + _coef51 * _tmp36 + Scalar(0.5) * (_coef56 * _tmp39 - _coef52 * _tmp37 - _coef53 * _tmp38 - _coef57 * _tmp40 - _coef58 * _tmp41) - E_B0A04 * _coef61 - E_BA04 * _coef59 - E_CA12 * _coef55 - E_ZX * _inv4);
-    _orientation[2] = E_BA12 * _coef55 + E_CA12 * _coef54 + E_YX * _inv4 + _coef51 * _tmp42 + Scalar(0.5) * (_coef53 * _tmp37 + _coef56 * _tmp40 + _coef57 * _tmp39 - _coef52 * _tmp38 - _coef62 * _tmp41) - E_BA04 * _coef60 - E_C0A04 * _coef61 - E_CA04 * _coef59;
+    StorePair(_orientation.data(), _coef45 * (E_BY231 - E_BY232) + _coef48 * _tmp27 + _coef49 * _tmp30 + _coef50 * _tmp33 - E_AA04 * _coef46 - _coef37 * _tmp29 - Scalar(0.5) * _coef43 * (E_A0Y231 + E_A0Y232 + Scalar(2) * (E_AA12 + E_AX)) - _coef44 * (E_ZY231 - E_ZY232) - _coef47 * _tmp26, E_BA12 * _coef54 + E_CA04 * _coef60 + _coef51 * _tmp16 + Scalar(0.5) * (_coef56 * _tmp19 - _coef52 * _tmp17 - _coef53 * _tmp18 - _coef57 * _tmp20 - _coef58 * _tmp21) - E_B0A04 * _coef61 - E_BA04 * _coef59 - E_CA12 * _coef55 - E_ZX * _inv4);
+    _orientation[2] = E_BA12 * _coef55 + E_CA12 * _coef54 + E_YX * _inv4 + _coef51 * _tmp22 + Scalar(0.5) * (_coef53 * _tmp17 + _coef56 * _tmp20 + _coef57 * _tmp19 - _coef52 * _tmp18 - _coef62 * _tmp21) - E_BA04 * _coef60 - E_C0A04 * _coef61 - E_CA04 * _coef59;
   }
 }
 
@@ -535,7 +708,7 @@ inline void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& ax
   const Scalar _inv3 = Scalar(1) / (L01 + L23 + X - L04 - grip_feed - grip_main);
   const Scalar _inv4 = Scalar(1) / (L01 + L23 + X - L04);
 
-  // Intermediate terms (100)
+  // Intermediate terms (56)
   const Scalar _tmp0 = L23 * _inv4 * Z453;
   const Scalar _tmp1 = _inv4 * sin_A04 * Z453;
   const Scalar _tmp2 = _inv4 * cos_A04 * Z453;
@@ -554,88 +727,44 @@ inline void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& ax
   const Scalar _tmp15 = L23 * _inv4 * sin_A04;
   const Scalar _tmp16 = _inv0 * _inv3 * grip_main * Z453;
   const Scalar _tmp17 = _inv4 * sin_A04 * X;
-  const Scalar _tmp18 = L01 * _inv4 * jaw_reach * sin_A04;
-  const Scalar _tmp19 = L04 * _inv4 * jaw_reach * sin_A04;
-  const Scalar _tmp20 = L23 * _inv4 * jaw_reach * sin_A04;
-  const Scalar _tmp21 = LW * _inv4 * jaw_reach * sin_A04;
-  const Scalar _tmp22 = _inv0 * _inv3 * grip_main * jaw_reach * Z453;
-  const Scalar _tmp23 = _inv4 * jaw_reach * sin_A04 * X;
-  const Scalar _tmp24 = jaw_reach * sin_A04;
-  const Scalar _tmp25 = LW * _inv4 * cos_A04 * jaw_reach;
-  const Scalar _tmp26 = L01 * _inv4 * sin_A04 * Y231;
-  const Scalar _tmp27 = L04 * _inv4 * sin_A04 * Y231;
-  const Scalar _tmp28 = L23 * _inv4 * sin_A04 * Y231;
-  const Scalar _tmp29 = LW * _inv4 * sin_A04 * Y231;
-  const Scalar _tmp30 = _inv0 * _inv3 * grip_main * Y231 * Z453;
-  const Scalar _tmp31 = _inv4 * sin_A04 * X * Y231;
-  const Scalar _tmp32 = sin_A04 * Y231;
-  const Scalar _tmp33 = L01 * _inv4 * cos_A04;
-  const Scalar _tmp34 = L04 * _inv4 * cos_A04;
-  const Scalar _tmp35 = L23 * _inv4 * cos_A04;
-  const Scalar _tmp36 = _inv4 * cos_A04 * X;
-  const Scalar _tmp37 = _tmp33 + _tmp35 + _tmp36 - _tmp34 - _tmp9;
-  const Scalar _tmp38 = L01 * _inv3 * Z453;
-  const Scalar _tmp39 = L04 * _inv3 * Z453;
-  const Scalar _tmp40 = L23 * _inv3 * Z453;
-  const Scalar _tmp41 = _inv3 * grip_feed * Z453;
-  const Scalar _tmp42 = _inv3 * X * Z453;
-  const Scalar _tmp43 = L04 * L45 * _inv4 * sin_A04 + L45 * LW * _inv4 * sin_A04 - L01 * L45 * _inv4 * sin_A04 - L23 * L45 * _inv4 * sin_A04 - L45 * _inv4 * sin_A04 * X;
-  const Scalar _tmp44 = L01 * L45 * _inv4 * cos_A04;
-  const Scalar _tmp45 = L04 * L45 * _inv4 * cos_A04;
-  const Scalar _tmp46 = L23 * L45 * _inv4 * cos_A04;
-  const Scalar _tmp47 = L45 * LW * _inv4 * cos_A04;
-  const Scalar _tmp48 = L45 * _inv4 * cos_A04 * X;
-  const Scalar _tmp49 = L01 * L45 * _inv4;
-  const Scalar _tmp50 = L04 * L45 * _inv4;
-  const Scalar _tmp51 = L23 * L45 * _inv4;
-  const Scalar _tmp52 = L45 * LW * _inv4;
-  const Scalar _tmp53 = L45 * _inv4 * X;
-  const Scalar _tmp54 = Scalar(0.5) * (_tmp34 + _tmp9 - _tmp33 - _tmp35 - _tmp36);
-  const Scalar _tmp55 = _inv2 * _inv3 * grip_main * Z453;
-  const Scalar _tmp56 = _inv2 * Z453;
-  const Scalar _tmp57 = _inv2 * _inv3 * grip_main * jaw_reach * Z453;
-  const Scalar _tmp58 = _inv2 * jaw_reach * Z453;
-  const Scalar _tmp59 = L01 * _inv4 * cos_A04 * jaw_reach;
-  const Scalar _tmp60 = L04 * _inv4 * cos_A04 * jaw_reach;
-  const Scalar _tmp61 = L23 * _inv4 * cos_A04 * jaw_reach;
-  const Scalar _tmp62 = _inv4 * cos_A04 * jaw_reach * X;
-  const Scalar _tmp63 = Scalar(0.5) * (_tmp59 + _tmp61 + _tmp62 - _tmp25 - _tmp60);
-  const Scalar _tmp64 = Scalar(0.25) * (_tmp39 + _tmp41 - _tmp38 - _tmp40 - _tmp42);
-  const Scalar _tmp65 = L01 * _inv3;
-  const Scalar _tmp66 = L04 * _inv3;
-  const Scalar _tmp67 = L23 * _inv3;
-  const Scalar _tmp68 = _inv3 * grip_feed;
-  const Scalar _tmp69 = _inv3 * X;
-  const Scalar _tmp70 = Scalar(0.25) * (_tmp66 + _tmp68 - _tmp65 - _tmp67 - _tmp69);
-  const Scalar _tmp71 = Scalar(0.5) * (_tmp13 + _tmp15 + _tmp17 - _tmp10 - _tmp14);
-  const Scalar _tmp72 = Scalar(0.5) * (_tmp19 + _tmp21 - _tmp18 - _tmp20 - _tmp23);
-  const Scalar _tmp73 = L01 * _inv3 * jaw_reach;
-  const Scalar _tmp74 = L04 * _inv3 * jaw_reach;
-  const Scalar _tmp75 = L23 * _inv3 * jaw_reach;
-  const Scalar _tmp76 = _inv3 * grip_feed * jaw_reach;
-  const Scalar _tmp77 = _inv3 * jaw_reach * X;
-  const Scalar _tmp78 = LW * _inv4 * cos_A04 * Y231;
-  const Scalar _tmp79 = Scalar(0.5) * (_tmp13 + _tmp15 + _tmp17 - _tmp10 - _tmp14);
-  const Scalar _tmp80 = Scalar(0.5) * (_tmp59 + _tmp61 + _tmp62 - _tmp25 - _tmp60);
-  const Scalar _tmp81 = _inv3 * grip_main;
-  const Scalar _tmp82 = _inv0 * _inv3 * grip_main;
-  const Scalar _tmp83 = _inv0 * _inv3 * grip_main * jaw_reach;
-  const Scalar _tmp84 = _inv2 * _inv3 * grip_main;
-  const Scalar _tmp85 = _inv2 * _inv3 * grip_main * jaw_reach;
-  const Scalar _tmp86 = _inv2 * jaw_reach;
-  const Scalar _tmp87 = _inv1 * _inv3 * grip_main;
-  const Scalar _tmp88 = _inv1 * _inv3 * grip_main * jaw_reach;
-  const Scalar _tmp89 = _inv1 * jaw_reach;
-  const Scalar _tmp90 = L23 * _inv4;
-  const Scalar _tmp91 = _inv4 * sin_A04;
-  const Scalar _tmp92 = _inv4 * cos_A04;
-  const Scalar _tmp93 = _inv4 * cos_A04 * jaw_reach;
-  const Scalar _tmp94 = _inv4 * jaw_reach * sin_A04;
-  const Scalar _tmp95 = _inv4 * cos_A04 * Y231;
-  const Scalar _tmp96 = L45 * _inv4 * cos_A04;
-  const Scalar _tmp97 = L45 * _inv4 * sin_A04;
-  const Scalar _tmp98 = L45 * _inv4;
-  const Scalar _tmp99 = _inv4 * sin_A04 * Y231;
+  const Scalar _tmp18 = _tmp10 + _tmp14 + sin_A04 - _tmp13 - _tmp15 - Scalar(2) * _tmp16 - _tmp17;
+  const Scalar _tmp19 = LW * _inv4 * cos_A04 * jaw_reach;
+  const Scalar _tmp20 = _tmp10 + _tmp14 + Scalar(2) * _tmp16 + sin_A04 - _tmp13 - _tmp15 - _tmp17;
+  const Scalar _tmp21 = L01 + L23 + X - L04 - LW;
+  const Scalar _tmp22 = _inv4 * _tmp21 * cos_A04;
+  const Scalar _tmp23 = _inv4 * _tmp21 * sin_A04;
+  const Scalar _tmp24 = L01 + L23 + X - L04 - grip_feed;
+  const Scalar _tmp25 = _inv3 * _tmp24 * Z453;
+  const Scalar _tmp26 = L45 * _inv4 * _tmp21 * sin_A04;
+  const Scalar _tmp27 = L45 * _inv4 * _tmp21 * cos_A04;
+  const Scalar _tmp28 = L45 * _inv4 * _tmp21;
+  const Scalar _tmp29 = _inv3 * grip_main;
+  const Scalar _tmp30 = -Scalar(1) - _tmp29;
+  const Scalar _tmp31 = _inv2 * _tmp30 * Z453;
+  const Scalar _tmp32 = _inv2 * _tmp30 * jaw_reach * Z453;
+  const Scalar _tmp33 = _inv4 * _tmp21 * cos_A04 * jaw_reach;
+  const Scalar _tmp34 = _inv3 * _tmp24;
+  const Scalar _tmp35 = _inv4 * _tmp21 * jaw_reach * sin_A04;
+  const Scalar _tmp36 = _inv3 * _tmp24 * jaw_reach;
+  const Scalar _tmp37 = LW * _inv4 * jaw_reach * sin_A04;
+  const Scalar _tmp38 = LW * _inv4 * cos_A04 * Y231;
+  const Scalar _tmp39 = _inv0 * _inv3 * grip_main;
+  const Scalar _tmp40 = _inv0 * _inv3 * grip_main * jaw_reach;
+  const Scalar _tmp41 = _inv2 * _tmp30;
+  const Scalar _tmp42 = _inv2 * _tmp30 * jaw_reach;
+  const Scalar _tmp43 = _inv1 * _tmp30;
+  const Scalar _tmp44 = _inv1 * _tmp30 * jaw_reach;
+  const Scalar _tmp45 = L23 * _inv4;
+  const Scalar _tmp46 = _inv4 * sin_A04;
+  const Scalar _tmp47 = _inv4 * cos_A04;
+  const Scalar _tmp48 = L23 * _inv4 * cos_A04;
+  const Scalar _tmp49 = _inv4 * cos_A04 * jaw_reach;
+  const Scalar _tmp50 = _inv4 * jaw_reach * sin_A04;
+  const Scalar _tmp51 = _inv4 * cos_A04 * Y231;
+  const Scalar _tmp52 = L45 * _inv4 * cos_A04;
+  const Scalar _tmp53 = L45 * _inv4 * sin_A04;
+  const Scalar _tmp54 = L45 * _inv4;
+  const Scalar _tmp55 = _inv4 * sin_A04 * Y231;
 
   // Outputs
   if (position_coeff != nullptr) {
@@ -684,32 +813,32 @@ inline void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& ax
     StorePair(_position_coeff.data() + 82, Scalar(0), _tmp8);
     StorePair(_position_coeff.data() + 84, Scalar(0), Scalar(0.5) * _tmp9);
     StorePair(_position_coeff.data() + 86, Scalar(0.5) * (_tmp13 + _tmp15 + _tmp17 - _tmp10 - _tmp14 - sin_A04) + _tmp16, Scalar(0));
-    StorePair(_position_coeff.data() + 88, Scalar(0.5) * (_tmp19 + _tmp21 + _tmp24 - _tmp18 - _tmp20 - _tmp23) - _tmp22, Scalar(0.5) * _tmp25);
-    StorePair(_position_coeff.data() + 90, Scalar(0), Scalar(0.5) * (_tmp26 + _tmp28 + _tmp31 - _tmp27 - _tmp29 - _tmp32) + _tmp30);
+    StorePair(_position_coeff.data() + 88, Scalar(0.5) * _tmp18 * jaw_reach, Scalar(0.5) * _tmp19);
+    StorePair(_position_coeff.data() + 90, Scalar(0), -Scalar(0.5) * _tmp18 * Y231);
     StorePair(_position_coeff.data() + 92, Scalar(0), Scalar(0.5) * _tmp9);
     StorePair(_position_coeff.data() + 94, Scalar(0.5) * (_tmp13 + _tmp15 + _tmp17 - _tmp10 - _tmp14 - sin_A04) - _tmp16, Scalar(0));
-    StorePair(_position_coeff.data() + 96, Scalar(0.5) * (_tmp19 + _tmp21 + _tmp24 - _tmp18 - _tmp20 - _tmp23) + _tmp22, Scalar(0.5) * _tmp25);
-    StorePair(_position_coeff.data() + 98, Scalar(0), Scalar(0.5) * (_tmp27 + _tmp29 + _tmp32 - _tmp26 - _tmp28 - _tmp31) + _tmp30);
-    StorePair(_position_coeff.data() + 100, Scalar(0), _tmp37);
-    StorePair(_position_coeff.data() + 102, _tmp10 + _tmp14 - _tmp13 - _tmp15 - _tmp17, _tmp39 + _tmp41 - _tmp38 - _tmp40 - _tmp42);
-    StorePair(_position_coeff.data() + 104, -_tmp43, _tmp44 + _tmp46 + _tmp48 - _tmp45 - _tmp47);
-    StorePair(_position_coeff.data() + 106, Scalar(0), _tmp49 + _tmp51 + _tmp53 - _tmp50 - _tmp52);
-    StorePair(_position_coeff.data() + 108, Scalar(0), -_tmp54);
-    StorePair(_position_coeff.data() + 110, -Scalar(0.25) * (_tmp55 + _tmp56), Scalar(0));
-    StorePair(_position_coeff.data() + 112, Scalar(0.25) * (_tmp57 + _tmp58), _tmp63);
-    StorePair(_position_coeff.data() + 114, Scalar(0), _tmp64);
-    StorePair(_position_coeff.data() + 116, Scalar(0), -_tmp54);
-    StorePair(_position_coeff.data() + 118, Scalar(0.25) * (_tmp55 + _tmp56), Scalar(0));
-    StorePair(_position_coeff.data() + 120, -Scalar(0.25) * (_tmp57 + _tmp58), _tmp63);
-    StorePair(_position_coeff.data() + 122, Scalar(0), _tmp64);
-    StorePair(_position_coeff.data() + 124, Scalar(0), -_tmp70);
-    StorePair(_position_coeff.data() + 126, -_tmp71, Scalar(0));
-    StorePair(_position_coeff.data() + 128, -_tmp72, Scalar(0.25) * (_tmp73 + _tmp75 + _tmp77 - _tmp74 - _tmp76));
-    StorePair(_position_coeff.data() + 130, Scalar(0), _tmp64);
-    StorePair(_position_coeff.data() + 132, Scalar(0), Scalar(0.25) * (_tmp66 + _tmp68 - _tmp65 - _tmp67 - _tmp69));
-    StorePair(_position_coeff.data() + 134, -_tmp71, Scalar(0));
-    StorePair(_position_coeff.data() + 136, -_tmp72, Scalar(0.25) * (_tmp74 + _tmp76 - _tmp73 - _tmp75 - _tmp77));
-    StorePair(_position_coeff.data() + 138, Scalar(0), _tmp64);
+    StorePair(_position_coeff.data() + 96, Scalar(0.5) * _tmp20 * jaw_reach, Scalar(0.5) * _tmp19);
+    StorePair(_position_coeff.data() + 98, Scalar(0), Scalar(0.5) * _tmp20 * Y231);
+    StorePair(_position_coeff.data() + 100, Scalar(0), _tmp22);
+    StorePair(_position_coeff.data() + 102, -_tmp23, -_tmp25);
+    StorePair(_position_coeff.data() + 104, _tmp26, _tmp27);
+    StorePair(_position_coeff.data() + 106, Scalar(0), _tmp28);
+    StorePair(_position_coeff.data() + 108, Scalar(0), Scalar(0.5) * _tmp22);
+    StorePair(_position_coeff.data() + 110, Scalar(0.25) * _tmp31, Scalar(0));
+    StorePair(_position_coeff.data() + 112, -Scalar(0.25) * _tmp32, Scalar(0.5) * _tmp33);
+    StorePair(_position_coeff.data() + 114, Scalar(0), -Scalar(0.25) * _tmp25);
+    StorePair(_position_coeff.data() + 116, Scalar(0), Scalar(0.5) * _tmp22);
+    StorePair(_position_coeff.data() + 118, -Scalar(0.25) * _tmp31, Scalar(0));
+    StorePair(_position_coeff.data() + 120, Scalar(0.25) * _tmp32, Scalar(0.5) * _tmp33);
+    StorePair(_position_coeff.data() + 122, Scalar(0), -Scalar(0.25) * _tmp25);
+    StorePair(_position_coeff.data() + 124, Scalar(0), Scalar(0.25) * _tmp34);
+    StorePair(_position_coeff.data() + 126, -Scalar(0.5) * _tmp23, Scalar(0));
+    StorePair(_position_coeff.data() + 128, Scalar(0.5) * _tmp35, Scalar(0.25) * _tmp36);
+    StorePair(_position_coeff.data() + 130, Scalar(0), -Scalar(0.25) * _tmp25);
+    StorePair(_position_coeff.data() + 132, Scalar(0), -Scalar(0.25) * _tmp34);
+    StorePair(_position_coeff.data() + 134, -Scalar(0.5) * _tmp23, Scalar(0));
+    StorePair(_position_coeff.data() + 136, Scalar(0.5) * _tmp35, -Scalar(0.25) * _tmp36);
+    StorePair(_position_coeff.data() + 138, Scalar(0), -Scalar(0.25) * _tmp25);
     StorePair(_position_coeff.data() + 140, Scalar(0), Scalar(0));
     StorePair(_position_coeff.data() + 142, _tmp6, Scalar(0));
     StorePair(_position_coeff.data() + 144, -_tmp8, Scalar(0));
@@ -719,139 +848,139 @@ inline void Coefficients([[maybe_unused]] const std::array<Scalar, kNumAxes>& ax
     StorePair(_position_coeff.data() + 152, -_tmp8, Scalar(0));
     StorePair(_position_coeff.data() + 154, Scalar(0), Scalar(0.5) * _tmp10);
     StorePair(_position_coeff.data() + 156, Scalar(0.5) * _tmp9, Scalar(0));
-    StorePair(_position_coeff.data() + 158, -Scalar(0.5) * _tmp25, Scalar(0.5) * _tmp21);
-    StorePair(_position_coeff.data() + 160, Scalar(0), Scalar(0.5) * _tmp78);
+    StorePair(_position_coeff.data() + 158, -Scalar(0.5) * _tmp19, Scalar(0.5) * _tmp37);
+    StorePair(_position_coeff.data() + 160, Scalar(0), Scalar(0.5) * _tmp38);
     StorePair(_position_coeff.data() + 162, Scalar(0), Scalar(0.5) * _tmp10);
     StorePair(_position_coeff.data() + 164, Scalar(0.5) * _tmp9, Scalar(0));
-    StorePair(_position_coeff.data() + 166, -Scalar(0.5) * _tmp25, Scalar(0.5) * _tmp21);
-    StorePair(_position_coeff.data() + 168, Scalar(0), -Scalar(0.5) * _tmp78);
-    StorePair(_position_coeff.data() + 170, Scalar(0), _tmp13 + _tmp15 + _tmp17 - _tmp10 - _tmp14);
-    StorePair(_position_coeff.data() + 172, _tmp37, Scalar(0));
-    StorePair(_position_coeff.data() + 174, _tmp45 + _tmp47 - _tmp44 - _tmp46 - _tmp48, -_tmp43);
-    StorePair(_position_coeff.data() + 176, _tmp50 + _tmp52 - _tmp49 - _tmp51 - _tmp53, Scalar(0));
-    StorePair(_position_coeff.data() + 178, Scalar(0), _tmp79);
+    StorePair(_position_coeff.data() + 166, -Scalar(0.5) * _tmp19, Scalar(0.5) * _tmp37);
+    StorePair(_position_coeff.data() + 168, Scalar(0), -Scalar(0.5) * _tmp38);
+    StorePair(_position_coeff.data() + 170, Scalar(0), _tmp23);
+    StorePair(_position_coeff.data() + 172, _tmp22, Scalar(0));
+    StorePair(_position_coeff.data() + 174, -_tmp27, _tmp26);
+    StorePair(_position_coeff.data() + 176, -_tmp28, Scalar(0));
+    StorePair(_position_coeff.data() + 178, Scalar(0), Scalar(0.5) * _tmp23);
     StorePair(_position_coeff.data() + 180, Scalar(0), Scalar(0));
-    StorePair(_position_coeff.data() + 182, Scalar(0), -_tmp72);
+    StorePair(_position_coeff.data() + 182, Scalar(0), Scalar(0.5) * _tmp35);
     StorePair(_position_coeff.data() + 184, Scalar(0), Scalar(0));
-    StorePair(_position_coeff.data() + 186, Scalar(0), _tmp79);
+    StorePair(_position_coeff.data() + 186, Scalar(0), Scalar(0.5) * _tmp23);
     StorePair(_position_coeff.data() + 188, Scalar(0), Scalar(0));
-    StorePair(_position_coeff.data() + 190, Scalar(0), -_tmp72);
+    StorePair(_position_coeff.data() + 190, Scalar(0), Scalar(0.5) * _tmp35);
     StorePair(_position_coeff.data() + 192, Scalar(0), Scalar(0));
     StorePair(_position_coeff.data() + 194, Scalar(0), Scalar(0));
-    StorePair(_position_coeff.data() + 196, -_tmp54, Scalar(0));
-    StorePair(_position_coeff.data() + 198, -_tmp80, Scalar(0));
+    StorePair(_position_coeff.data() + 196, Scalar(0.5) * _tmp22, Scalar(0));
+    StorePair(_position_coeff.data() + 198, -Scalar(0.5) * _tmp33, Scalar(0));
     StorePair(_position_coeff.data() + 200, Scalar(0), Scalar(0));
     StorePair(_position_coeff.data() + 202, Scalar(0), Scalar(0));
-    StorePair(_position_coeff.data() + 204, -_tmp54, Scalar(0));
-    StorePair(_position_coeff.data() + 206, -_tmp80, Scalar(0));
+    StorePair(_position_coeff.data() + 204, Scalar(0.5) * _tmp22, Scalar(0));
+    StorePair(_position_coeff.data() + 206, -Scalar(0.5) * _tmp33, Scalar(0));
     StorePair(_position_coeff.data() + 208, Scalar(0), Scalar(0));
   }
   if (orientation_coeff != nullptr) {
     auto& _orientation_coeff = *orientation_coeff;
     StorePair(_orientation_coeff.data(), Scalar(0), Scalar(0));
-    StorePair(_orientation_coeff.data() + 2, Scalar(0), -_tmp81);
+    StorePair(_orientation_coeff.data() + 2, Scalar(0), -_tmp29);
     StorePair(_orientation_coeff.data() + 4, Scalar(0), Scalar(0));
     StorePair(_orientation_coeff.data() + 6, Scalar(0), Scalar(0));
-    StorePair(_orientation_coeff.data() + 8, Scalar(0), -_tmp81);
+    StorePair(_orientation_coeff.data() + 8, Scalar(0), -_tmp29);
     StorePair(_orientation_coeff.data() + 10, Scalar(0), Scalar(0));
     StorePair(_orientation_coeff.data() + 12, Scalar(0), Scalar(0));
     StorePair(_orientation_coeff.data() + 14, Scalar(0), Scalar(0));
-    StorePair(_orientation_coeff.data() + 16, -_tmp82, Scalar(0));
-    StorePair(_orientation_coeff.data() + 18, _tmp83, Scalar(0));
-    StorePair(_orientation_coeff.data() + 20, Scalar(0), -Scalar(0.5) * _tmp81);
+    StorePair(_orientation_coeff.data() + 16, -_tmp39, Scalar(0));
+    StorePair(_orientation_coeff.data() + 18, _tmp40, Scalar(0));
+    StorePair(_orientation_coeff.data() + 20, Scalar(0), -Scalar(0.5) * _tmp29);
     StorePair(_orientation_coeff.data() + 22, Scalar(0), Scalar(0));
-    StorePair(_orientation_coeff.data() + 24, _tmp82, Scalar(0));
-    StorePair(_orientation_coeff.data() + 26, -_tmp83, Scalar(0));
-    StorePair(_orientation_coeff.data() + 28, Scalar(0), -Scalar(0.5) * _tmp81);
+    StorePair(_orientation_coeff.data() + 24, _tmp39, Scalar(0));
+    StorePair(_orientation_coeff.data() + 26, -_tmp40, Scalar(0));
+    StorePair(_orientation_coeff.data() + 28, Scalar(0), -Scalar(0.5) * _tmp29);
     StorePair(_orientation_coeff.data() + 30, Scalar(0), Scalar(0));
-    StorePair(_orientation_coeff.data() + 32, Scalar(0), _tmp65 + _tmp67 + _tmp69 - _tmp66 - _tmp68);
+    StorePair(_orientation_coeff.data() + 32, Scalar(0), _tmp34);
     StorePair(_orientation_coeff.data() + 34, Scalar(0), Scalar(0));
     StorePair(_orientation_coeff.data() + 36, Scalar(0), Scalar(0));
     StorePair(_orientation_coeff.data() + 38, Scalar(0), Scalar(0));
-    StorePair(_orientation_coeff.data() + 40, Scalar(0.25) * (_inv2 + _tmp84), Scalar(0));
-    StorePair(_orientation_coeff.data() + 42, -Scalar(0.25) * (_tmp85 + _tmp86), Scalar(0));
-    StorePair(_orientation_coeff.data() + 44, Scalar(0), -_tmp70);
+    StorePair(_orientation_coeff.data() + 40, -Scalar(0.25) * _tmp41, Scalar(0));
+    StorePair(_orientation_coeff.data() + 42, Scalar(0.25) * _tmp42, Scalar(0));
+    StorePair(_orientation_coeff.data() + 44, Scalar(0), Scalar(0.25) * _tmp34);
     StorePair(_orientation_coeff.data() + 46, Scalar(0), Scalar(0));
-    StorePair(_orientation_coeff.data() + 48, -Scalar(0.25) * (_inv2 + _tmp84), Scalar(0));
-    StorePair(_orientation_coeff.data() + 50, Scalar(0.25) * (_tmp85 + _tmp86), Scalar(0));
-    StorePair(_orientation_coeff.data() + 52, Scalar(0), -_tmp70);
-    StorePair(_orientation_coeff.data() + 54, Scalar(0), -Scalar(0.25) * (_inv1 + _tmp87));
+    StorePair(_orientation_coeff.data() + 48, Scalar(0.25) * _tmp41, Scalar(0));
+    StorePair(_orientation_coeff.data() + 50, -Scalar(0.25) * _tmp42, Scalar(0));
+    StorePair(_orientation_coeff.data() + 52, Scalar(0), Scalar(0.25) * _tmp34);
+    StorePair(_orientation_coeff.data() + 54, Scalar(0), Scalar(0.25) * _tmp43);
     StorePair(_orientation_coeff.data() + 56, Scalar(0), Scalar(0));
-    StorePair(_orientation_coeff.data() + 58, Scalar(0), -Scalar(0.25) * (_tmp88 + _tmp89));
-    StorePair(_orientation_coeff.data() + 60, Scalar(0), -_tmp70);
-    StorePair(_orientation_coeff.data() + 62, Scalar(0), Scalar(0.25) * (_inv1 + _tmp87));
+    StorePair(_orientation_coeff.data() + 58, Scalar(0), Scalar(0.25) * _tmp44);
+    StorePair(_orientation_coeff.data() + 60, Scalar(0), Scalar(0.25) * _tmp34);
+    StorePair(_orientation_coeff.data() + 62, Scalar(0), -Scalar(0.25) * _tmp43);
     StorePair(_orientation_coeff.data() + 64, Scalar(0), Scalar(0));
-    StorePair(_orientation_coeff.data() + 66, Scalar(0), Scalar(0.25) * (_tmp88 + _tmp89));
-    StorePair(_orientation_coeff.data() + 68, Scalar(0), -_tmp70);
+    StorePair(_orientation_coeff.data() + 66, Scalar(0), -Scalar(0.25) * _tmp44);
+    StorePair(_orientation_coeff.data() + 68, Scalar(0), Scalar(0.25) * _tmp34);
     StorePair(_orientation_coeff.data() + 70, Scalar(0), Scalar(0));
     StorePair(_orientation_coeff.data() + 72, -_inv4, Scalar(0));
-    StorePair(_orientation_coeff.data() + 74, _tmp90, Scalar(0));
-    StorePair(_orientation_coeff.data() + 76, Scalar(0), -_tmp91);
-    StorePair(_orientation_coeff.data() + 78, -_tmp92, Scalar(0));
-    StorePair(_orientation_coeff.data() + 80, _tmp35, -_tmp15);
-    StorePair(_orientation_coeff.data() + 82, _tmp90, Scalar(0));
-    StorePair(_orientation_coeff.data() + 84, Scalar(0), -Scalar(0.5) * _tmp91);
-    StorePair(_orientation_coeff.data() + 86, -Scalar(0.5) * _tmp92, Scalar(0));
-    StorePair(_orientation_coeff.data() + 88, Scalar(0.5) * _tmp93, -Scalar(0.5) * _tmp94);
-    StorePair(_orientation_coeff.data() + 90, Scalar(0), -Scalar(0.5) * _tmp95);
-    StorePair(_orientation_coeff.data() + 92, Scalar(0), -Scalar(0.5) * _tmp91);
-    StorePair(_orientation_coeff.data() + 94, -Scalar(0.5) * _tmp92, Scalar(0));
-    StorePair(_orientation_coeff.data() + 96, Scalar(0.5) * _tmp93, -Scalar(0.5) * _tmp94);
-    StorePair(_orientation_coeff.data() + 98, Scalar(0), Scalar(0.5) * _tmp95);
-    StorePair(_orientation_coeff.data() + 100, Scalar(0), _tmp91);
-    StorePair(_orientation_coeff.data() + 102, _tmp92, Scalar(0));
-    StorePair(_orientation_coeff.data() + 104, -_tmp96, _tmp97);
-    StorePair(_orientation_coeff.data() + 106, -_tmp98, Scalar(0));
-    StorePair(_orientation_coeff.data() + 108, Scalar(0), Scalar(0.5) * _tmp91);
+    StorePair(_orientation_coeff.data() + 74, _tmp45, Scalar(0));
+    StorePair(_orientation_coeff.data() + 76, Scalar(0), -_tmp46);
+    StorePair(_orientation_coeff.data() + 78, -_tmp47, Scalar(0));
+    StorePair(_orientation_coeff.data() + 80, _tmp48, -_tmp15);
+    StorePair(_orientation_coeff.data() + 82, _tmp45, Scalar(0));
+    StorePair(_orientation_coeff.data() + 84, Scalar(0), -Scalar(0.5) * _tmp46);
+    StorePair(_orientation_coeff.data() + 86, -Scalar(0.5) * _tmp47, Scalar(0));
+    StorePair(_orientation_coeff.data() + 88, Scalar(0.5) * _tmp49, -Scalar(0.5) * _tmp50);
+    StorePair(_orientation_coeff.data() + 90, Scalar(0), -Scalar(0.5) * _tmp51);
+    StorePair(_orientation_coeff.data() + 92, Scalar(0), -Scalar(0.5) * _tmp46);
+    StorePair(_orientation_coeff.data() + 94, -Scalar(0.5) * _tmp47, Scalar(0));
+    StorePair(_orientation_coeff.data() + 96, Scalar(0.5) * _tmp49, -Scalar(0.5) * _tmp50);
+    StorePair(_orientation_coeff.data() + 98, Scalar(0), Scalar(0.5) * _tmp51);
+    StorePair(_orientation_coeff.data() + 100, Scalar(0), _tmp46);
+    StorePair(_orientation_coeff.data() + 102, _tmp47, Scalar(0));
+    StorePair(_orientation_coeff.data() + 104, -_tmp52, _tmp53);
+    StorePair(_orientation_coeff.data() + 106, -_tmp54, Scalar(0));
+    StorePair(_orientation_coeff.data() + 108, Scalar(0), Scalar(0.5) * _tmp46);
     StorePair(_orientation_coeff.data() + 110, Scalar(0), Scalar(0));
-    StorePair(_orientation_coeff.data() + 112, Scalar(0), Scalar(0.5) * _tmp94);
+    StorePair(_orientation_coeff.data() + 112, Scalar(0), Scalar(0.5) * _tmp50);
     StorePair(_orientation_coeff.data() + 114, Scalar(0), Scalar(0));
-    StorePair(_orientation_coeff.data() + 116, Scalar(0), Scalar(0.5) * _tmp91);
+    StorePair(_orientation_coeff.data() + 116, Scalar(0), Scalar(0.5) * _tmp46);
     StorePair(_orientation_coeff.data() + 118, Scalar(0), Scalar(0));
-    StorePair(_orientation_coeff.data() + 120, Scalar(0), Scalar(0.5) * _tmp94);
+    StorePair(_orientation_coeff.data() + 120, Scalar(0), Scalar(0.5) * _tmp50);
     StorePair(_orientation_coeff.data() + 122, Scalar(0), Scalar(0));
     StorePair(_orientation_coeff.data() + 124, Scalar(0), Scalar(0));
-    StorePair(_orientation_coeff.data() + 126, Scalar(0.5) * _tmp92, Scalar(0));
-    StorePair(_orientation_coeff.data() + 128, -Scalar(0.5) * _tmp93, Scalar(0));
+    StorePair(_orientation_coeff.data() + 126, Scalar(0.5) * _tmp47, Scalar(0));
+    StorePair(_orientation_coeff.data() + 128, -Scalar(0.5) * _tmp49, Scalar(0));
     StorePair(_orientation_coeff.data() + 130, Scalar(0), Scalar(0));
     StorePair(_orientation_coeff.data() + 132, Scalar(0), Scalar(0));
-    StorePair(_orientation_coeff.data() + 134, Scalar(0.5) * _tmp92, Scalar(0));
-    StorePair(_orientation_coeff.data() + 136, -Scalar(0.5) * _tmp93, Scalar(0));
+    StorePair(_orientation_coeff.data() + 134, Scalar(0.5) * _tmp47, Scalar(0));
+    StorePair(_orientation_coeff.data() + 136, -Scalar(0.5) * _tmp49, Scalar(0));
     StorePair(_orientation_coeff.data() + 138, Scalar(0), Scalar(0));
     StorePair(_orientation_coeff.data() + 140, Scalar(0), _inv4);
     StorePair(_orientation_coeff.data() + 142, Scalar(0), Scalar(0));
-    StorePair(_orientation_coeff.data() + 144, Scalar(0), _tmp90);
-    StorePair(_orientation_coeff.data() + 146, Scalar(0), _tmp92);
-    StorePair(_orientation_coeff.data() + 148, -_tmp91, Scalar(0));
-    StorePair(_orientation_coeff.data() + 150, _tmp15, _tmp35);
-    StorePair(_orientation_coeff.data() + 152, Scalar(0), _tmp90);
-    StorePair(_orientation_coeff.data() + 154, Scalar(0), Scalar(0.5) * _tmp92);
-    StorePair(_orientation_coeff.data() + 156, -Scalar(0.5) * _tmp91, Scalar(0));
-    StorePair(_orientation_coeff.data() + 158, Scalar(0.5) * _tmp94, Scalar(0.5) * _tmp93);
-    StorePair(_orientation_coeff.data() + 160, Scalar(0), -Scalar(0.5) * _tmp99);
-    StorePair(_orientation_coeff.data() + 162, Scalar(0), Scalar(0.5) * _tmp92);
-    StorePair(_orientation_coeff.data() + 164, -Scalar(0.5) * _tmp91, Scalar(0));
-    StorePair(_orientation_coeff.data() + 166, Scalar(0.5) * _tmp94, Scalar(0.5) * _tmp93);
-    StorePair(_orientation_coeff.data() + 168, Scalar(0), Scalar(0.5) * _tmp99);
-    StorePair(_orientation_coeff.data() + 170, Scalar(0), -_tmp92);
-    StorePair(_orientation_coeff.data() + 172, _tmp91, Scalar(0));
-    StorePair(_orientation_coeff.data() + 174, -_tmp97, -_tmp96);
-    StorePair(_orientation_coeff.data() + 176, Scalar(0), -_tmp98);
-    StorePair(_orientation_coeff.data() + 178, Scalar(0), -Scalar(0.5) * _tmp92);
+    StorePair(_orientation_coeff.data() + 144, Scalar(0), _tmp45);
+    StorePair(_orientation_coeff.data() + 146, Scalar(0), _tmp47);
+    StorePair(_orientation_coeff.data() + 148, -_tmp46, Scalar(0));
+    StorePair(_orientation_coeff.data() + 150, _tmp15, _tmp48);
+    StorePair(_orientation_coeff.data() + 152, Scalar(0), _tmp45);
+    StorePair(_orientation_coeff.data() + 154, Scalar(0), Scalar(0.5) * _tmp47);
+    StorePair(_orientation_coeff.data() + 156, -Scalar(0.5) * _tmp46, Scalar(0));
+    StorePair(_orientation_coeff.data() + 158, Scalar(0.5) * _tmp50, Scalar(0.5) * _tmp49);
+    StorePair(_orientation_coeff.data() + 160, Scalar(0), -Scalar(0.5) * _tmp55);
+    StorePair(_orientation_coeff.data() + 162, Scalar(0), Scalar(0.5) * _tmp47);
+    StorePair(_orientation_coeff.data() + 164, -Scalar(0.5) * _tmp46, Scalar(0));
+    StorePair(_orientation_coeff.data() + 166, Scalar(0.5) * _tmp50, Scalar(0.5) * _tmp49);
+    StorePair(_orientation_coeff.data() + 168, Scalar(0), Scalar(0.5) * _tmp55);
+    StorePair(_orientation_coeff.data() + 170, Scalar(0), -_tmp47);
+    StorePair(_orientation_coeff.data() + 172, _tmp46, Scalar(0));
+    StorePair(_orientation_coeff.data() + 174, -_tmp53, -_tmp52);
+    StorePair(_orientation_coeff.data() + 176, Scalar(0), -_tmp54);
+    StorePair(_orientation_coeff.data() + 178, Scalar(0), -Scalar(0.5) * _tmp47);
     StorePair(_orientation_coeff.data() + 180, Scalar(0), Scalar(0));
-    StorePair(_orientation_coeff.data() + 182, Scalar(0), -Scalar(0.5) * _tmp93);
+    StorePair(_orientation_coeff.data() + 182, Scalar(0), -Scalar(0.5) * _tmp49);
     StorePair(_orientation_coeff.data() + 184, Scalar(0), Scalar(0));
-    StorePair(_orientation_coeff.data() + 186, Scalar(0), -Scalar(0.5) * _tmp92);
+    StorePair(_orientation_coeff.data() + 186, Scalar(0), -Scalar(0.5) * _tmp47);
     StorePair(_orientation_coeff.data() + 188, Scalar(0), Scalar(0));
-    StorePair(_orientation_coeff.data() + 190, Scalar(0), -Scalar(0.5) * _tmp93);
+    StorePair(_orientation_coeff.data() + 190, Scalar(0), -Scalar(0.5) * _tmp49);
     StorePair(_orientation_coeff.data() + 192, Scalar(0), Scalar(0));
     StorePair(_orientation_coeff.data() + 194, Scalar(0), Scalar(0));
-    StorePair(_orientation_coeff.data() + 196, Scalar(0.5) * _tmp91, Scalar(0));
-    StorePair(_orientation_coeff.data() + 198, -Scalar(0.5) * _tmp94, Scalar(0));
+    StorePair(_orientation_coeff.data() + 196, Scalar(0.5) * _tmp46, Scalar(0));
+    StorePair(_orientation_coeff.data() + 198, -Scalar(0.5) * _tmp50, Scalar(0));
     StorePair(_orientation_coeff.data() + 200, Scalar(0), Scalar(0));
     StorePair(_orientation_coeff.data() + 202, Scalar(0), Scalar(0));
-    StorePair(_orientation_coeff.data() + 204, Scalar(0.5) * _tmp91, Scalar(0));
-    StorePair(_orientation_coeff.data() + 206, -Scalar(0.5) * _tmp94, Scalar(0));
+    StorePair(_orientation_coeff.data() + 204, Scalar(0.5) * _tmp46, Scalar(0));
+    StorePair(_orientation_coeff.data() + 206, -Scalar(0.5) * _tmp50, Scalar(0));
     StorePair(_orientation_coeff.data() + 208, Scalar(0), Scalar(0));
   }
 }
@@ -947,61 +1076,41 @@ inline void DeviationAndCoefficients(
   const Scalar _inv3 = Scalar(1) / (L01 + L23 + X - L04 - grip_feed - grip_main);
   const Scalar _inv4 = Scalar(1) / (L01 + L23 + X - L04);
 
-  // Intermediate terms (54)
-  const Scalar _tmp0 = LW * _inv4 * cos_A04;
-  const Scalar _tmp1 = LW * _inv4 * sin_A04;
-  const Scalar _tmp2 = L01 * _inv4 * sin_A04;
-  const Scalar _tmp3 = L04 * _inv4 * sin_A04;
-  const Scalar _tmp4 = L23 * _inv4 * sin_A04;
-  const Scalar _tmp5 = _inv0 * _inv3 * grip_main * Z453;
-  const Scalar _tmp6 = _inv4 * sin_A04 * X;
-  const Scalar _tmp7 = L01 * _inv4 * jaw_reach * sin_A04;
-  const Scalar _tmp8 = L04 * _inv4 * jaw_reach * sin_A04;
-  const Scalar _tmp9 = L23 * _inv4 * jaw_reach * sin_A04;
-  const Scalar _tmp10 = LW * _inv4 * jaw_reach * sin_A04;
-  const Scalar _tmp11 = _inv0 * _inv3 * grip_main * jaw_reach * Z453;
-  const Scalar _tmp12 = _inv4 * jaw_reach * sin_A04 * X;
-  const Scalar _tmp13 = jaw_reach * sin_A04;
-  const Scalar _tmp14 = LW * _inv4 * cos_A04 * jaw_reach;
-  const Scalar _tmp15 = L01 * _inv4 * sin_A04 * Y231;
-  const Scalar _tmp16 = L04 * _inv4 * sin_A04 * Y231;
-  const Scalar _tmp17 = L23 * _inv4 * sin_A04 * Y231;
-  const Scalar _tmp18 = LW * _inv4 * sin_A04 * Y231;
-  const Scalar _tmp19 = _inv0 * _inv3 * grip_main * Y231 * Z453;
-  const Scalar _tmp20 = _inv4 * sin_A04 * X * Y231;
-  const Scalar _tmp21 = sin_A04 * Y231;
-  const Scalar _tmp22 = L01 * _inv4 * cos_A04;
-  const Scalar _tmp23 = L04 * _inv4 * cos_A04;
-  const Scalar _tmp24 = L23 * _inv4 * cos_A04;
-  const Scalar _tmp25 = _inv4 * cos_A04 * X;
-  const Scalar _tmp26 = L01 * _inv3 * Z453;
-  const Scalar _tmp27 = L04 * _inv3 * Z453;
-  const Scalar _tmp28 = L23 * _inv3 * Z453;
-  const Scalar _tmp29 = _inv3 * grip_feed * Z453;
-  const Scalar _tmp30 = _inv3 * X * Z453;
-  const Scalar _tmp31 = L01 * _inv3;
-  const Scalar _tmp32 = L04 * _inv3;
-  const Scalar _tmp33 = L23 * _inv3;
-  const Scalar _tmp34 = _inv3 * grip_feed;
-  const Scalar _tmp35 = _inv3 * X;
-  const Scalar _tmp36 = E_B0A12 + E_BX;
-  const Scalar _tmp37 = Scalar(2) * (E_YA12 - E_YA04) + E_YY231 + E_YY232 - E_YY451 - E_YY452;
-  const Scalar _tmp38 = Scalar(2) * (E_ZA12 - E_ZA04) + E_ZY231 + E_ZY232 - E_ZZ453 - E_ZZ454;
-  const Scalar _tmp39 = E_BY231 + E_BY232 - E_BZ453 - E_BZ454;
-  const Scalar _tmp40 = E_CY231 + E_CY232 - E_CY451 - E_CY452;
-  const Scalar _tmp41 = E_A0Y231 - E_A0Y232;
-  const Scalar _tmp42 = E_C0A12 + E_CX;
-  const Scalar _tmp43 = Scalar(2) * E_YA12 + E_YY231 + E_YY232;
-  const Scalar _tmp44 = E_CY231 + E_CY232;
-  const Scalar _tmp45 = E_YY451 + E_YY452;
-  const Scalar _tmp46 = E_ZY451 - E_ZY452;
-  const Scalar _tmp47 = E_BY451 - E_BY452;
-  const Scalar _tmp48 = E_CY451 + E_CY452;
-  const Scalar _tmp49 = E_A0Y451 + E_A0Y452 + E_A0Z453 + E_A0Z454;
-  const Scalar _tmp50 = E_YZ453 - E_YZ454;
-  const Scalar _tmp51 = E_ZZ453 + E_ZZ454;
-  const Scalar _tmp52 = E_BZ453 + E_BZ454;
-  const Scalar _tmp53 = E_CZ453 - E_CZ454;
+  // Intermediate terms (34)
+  const Scalar _tmp0 = LW * _inv4 * sin_A04;
+  const Scalar _tmp1 = L01 * _inv4 * sin_A04;
+  const Scalar _tmp2 = L04 * _inv4 * sin_A04;
+  const Scalar _tmp3 = L23 * _inv4 * sin_A04;
+  const Scalar _tmp4 = _inv0 * _inv3 * grip_main * Z453;
+  const Scalar _tmp5 = _inv4 * sin_A04 * X;
+  const Scalar _tmp6 = _tmp0 + _tmp2 + sin_A04 - _tmp1 - _tmp3 - Scalar(2) * _tmp4 - _tmp5;
+  const Scalar _tmp7 = _tmp0 + _tmp2 + Scalar(2) * _tmp4 + sin_A04 - _tmp1 - _tmp3 - _tmp5;
+  const Scalar _tmp8 = L01 + L23 + X - L04 - LW;
+  const Scalar _tmp9 = _inv4 * _tmp8 * cos_A04;
+  const Scalar _tmp10 = _inv4 * _tmp8 * sin_A04;
+  const Scalar _tmp11 = L01 + L23 + X - L04 - grip_feed;
+  const Scalar _tmp12 = _inv3 * _tmp11 * Z453;
+  const Scalar _tmp13 = _inv3 * grip_main;
+  const Scalar _tmp14 = -Scalar(1) - _tmp13;
+  const Scalar _tmp15 = _inv3 * _tmp11;
+  const Scalar _tmp16 = E_B0A12 + E_BX;
+  const Scalar _tmp17 = Scalar(2) * (E_YA12 - E_YA04) + E_YY231 + E_YY232 - E_YY451 - E_YY452;
+  const Scalar _tmp18 = Scalar(2) * (E_ZA12 - E_ZA04) + E_ZY231 + E_ZY232 - E_ZZ453 - E_ZZ454;
+  const Scalar _tmp19 = E_BY231 + E_BY232 - E_BZ453 - E_BZ454;
+  const Scalar _tmp20 = E_CY231 + E_CY232 - E_CY451 - E_CY452;
+  const Scalar _tmp21 = E_A0Y231 - E_A0Y232;
+  const Scalar _tmp22 = E_C0A12 + E_CX;
+  const Scalar _tmp23 = Scalar(2) * E_YA12 + E_YY231 + E_YY232;
+  const Scalar _tmp24 = E_CY231 + E_CY232;
+  const Scalar _tmp25 = E_YY451 + E_YY452;
+  const Scalar _tmp26 = E_ZY451 - E_ZY452;
+  const Scalar _tmp27 = E_BY451 - E_BY452;
+  const Scalar _tmp28 = E_CY451 + E_CY452;
+  const Scalar _tmp29 = E_A0Y451 + E_A0Y452 + E_A0Z453 + E_A0Z454;
+  const Scalar _tmp30 = E_YZ453 - E_YZ454;
+  const Scalar _tmp31 = E_ZZ453 + E_ZZ454;
+  const Scalar _tmp32 = E_BZ453 + E_BZ454;
+  const Scalar _tmp33 = E_CZ453 - E_CZ454;
 
   // Coefficients of the error monomials (63)
   const Scalar _coef0 = _inv4 * Z453;
@@ -1019,47 +1128,47 @@ inline void DeviationAndCoefficients(
   const Scalar _coef12 = LW * _inv4;
   const Scalar _coef13 = _inv3 * grip_main * Z453;
   const Scalar _coef14 = L23 * LW * _inv4;
-  const Scalar _coef15 = _tmp0;
-  const Scalar _coef16 = _tmp1;
+  const Scalar _coef15 = LW * _inv4 * cos_A04;
+  const Scalar _coef16 = _tmp0;
   const Scalar _coef17 = L23 * LW * _inv4 * sin_A04;
   const Scalar _coef18 = L23 * LW * _inv4 * cos_A04;
-  const Scalar _coef19 = Scalar(0.5) * (_tmp1 + _tmp3 + sin_A04 - _tmp2 - _tmp4 - _tmp6) - _tmp5;
-  const Scalar _coef20 = Scalar(0.5) * (_tmp10 + _tmp13 + _tmp8 - _tmp12 - _tmp7 - _tmp9) - _tmp11;
-  const Scalar _coef21 = _tmp14;
-  const Scalar _coef22 = Scalar(0.5) * (_tmp16 + _tmp18 + _tmp21 - _tmp15 - _tmp17 - _tmp20) - _tmp19;
-  const Scalar _coef23 = Scalar(0.5) * (_tmp2 + _tmp4 + _tmp6 - _tmp1 - _tmp3 - sin_A04) - _tmp5;
-  const Scalar _coef24 = Scalar(0.5) * (_tmp12 + _tmp7 + _tmp9 - _tmp10 - _tmp13 - _tmp8) - _tmp11;
-  const Scalar _coef25 = Scalar(0.5) * (_tmp15 + _tmp17 + _tmp20 - _tmp16 - _tmp18 - _tmp21) - _tmp19;
-  const Scalar _coef26 = _tmp0 + _tmp23 - _tmp22 - _tmp24 - _tmp25;
-  const Scalar _coef27 = _tmp1 + _tmp3 - _tmp2 - _tmp4 - _tmp6;
-  const Scalar _coef28 = _tmp27 + _tmp29 - _tmp26 - _tmp28 - _tmp30;
-  const Scalar _coef29 = L04 * L45 * _inv4 * sin_A04 + L45 * LW * _inv4 * sin_A04 - L01 * L45 * _inv4 * sin_A04 - L23 * L45 * _inv4 * sin_A04 - L45 * _inv4 * sin_A04 * X;
-  const Scalar _coef30 = L04 * L45 * _inv4 * cos_A04 + L45 * LW * _inv4 * cos_A04 - L01 * L45 * _inv4 * cos_A04 - L23 * L45 * _inv4 * cos_A04 - L45 * _inv4 * cos_A04 * X;
-  const Scalar _coef31 = L04 * L45 * _inv4 + L45 * LW * _inv4 - L01 * L45 * _inv4 - L23 * L45 * _inv4 - L45 * _inv4 * X;
-  const Scalar _coef32 = Scalar(0.5) * (_tmp0 + _tmp23 - _tmp22 - _tmp24 - _tmp25);
-  const Scalar _coef33 = -Scalar(0.25) * (_inv2 * _inv3 * grip_main * Z453 + _inv2 * Z453);
-  const Scalar _coef34 = -Scalar(0.25) * (_inv2 * _inv3 * grip_main * jaw_reach * Z453 + _inv2 * jaw_reach * Z453);
-  const Scalar _coef35 = Scalar(0.5) * (_tmp14 + L04 * _inv4 * cos_A04 * jaw_reach - L01 * _inv4 * cos_A04 * jaw_reach - L23 * _inv4 * cos_A04 * jaw_reach - _inv4 * cos_A04 * jaw_reach * X);
-  const Scalar _coef36 = Scalar(0.25) * (_tmp27 + _tmp29 - _tmp26 - _tmp28 - _tmp30);
-  const Scalar _coef37 = Scalar(0.25) * (_tmp32 + _tmp34 - _tmp31 - _tmp33 - _tmp35);
-  const Scalar _coef38 = Scalar(0.5) * (_tmp1 + _tmp3 - _tmp2 - _tmp4 - _tmp6);
-  const Scalar _coef39 = Scalar(0.5) * (_tmp10 + _tmp8 - _tmp12 - _tmp7 - _tmp9);
-  const Scalar _coef40 = Scalar(0.25) * (L04 * _inv3 * jaw_reach + _inv3 * grip_feed * jaw_reach - L01 * _inv3 * jaw_reach - L23 * _inv3 * jaw_reach - _inv3 * jaw_reach * X);
-  const Scalar _coef41 = _tmp10;
+  const Scalar _coef19 = Scalar(0.5) * (_tmp0 + _tmp2 + sin_A04 - _tmp1 - _tmp3 - _tmp5) - _tmp4;
+  const Scalar _coef20 = Scalar(0.5) * _tmp6 * jaw_reach;
+  const Scalar _coef21 = LW * _inv4 * cos_A04 * jaw_reach;
+  const Scalar _coef22 = Scalar(0.5) * _tmp6 * Y231;
+  const Scalar _coef23 = Scalar(0.5) * (_tmp1 + _tmp3 + _tmp5 - _tmp0 - _tmp2 - sin_A04) - _tmp4;
+  const Scalar _coef24 = -Scalar(0.5) * _tmp7 * jaw_reach;
+  const Scalar _coef25 = -Scalar(0.5) * _tmp7 * Y231;
+  const Scalar _coef26 = -_tmp9;
+  const Scalar _coef27 = -_tmp10;
+  const Scalar _coef28 = -_tmp12;
+  const Scalar _coef29 = -L45 * _inv4 * _tmp8 * sin_A04;
+  const Scalar _coef30 = -L45 * _inv4 * _tmp8 * cos_A04;
+  const Scalar _coef31 = -L45 * _inv4 * _tmp8;
+  const Scalar _coef32 = -Scalar(0.5) * _tmp9;
+  const Scalar _coef33 = Scalar(0.25) * _inv2 * _tmp14 * Z453;
+  const Scalar _coef34 = Scalar(0.25) * _inv2 * _tmp14 * jaw_reach * Z453;
+  const Scalar _coef35 = -Scalar(0.5) * _inv4 * _tmp8 * cos_A04 * jaw_reach;
+  const Scalar _coef36 = -Scalar(0.25) * _tmp12;
+  const Scalar _coef37 = -Scalar(0.25) * _tmp15;
+  const Scalar _coef38 = -Scalar(0.5) * _tmp10;
+  const Scalar _coef39 = -Scalar(0.5) * _inv4 * _tmp8 * jaw_reach * sin_A04;
+  const Scalar _coef40 = -Scalar(0.25) * _inv3 * _tmp11 * jaw_reach;
+  const Scalar _coef41 = LW * _inv4 * jaw_reach * sin_A04;
   const Scalar _coef42 = LW * _inv4 * cos_A04 * Y231;
-  const Scalar _coef43 = _inv3 * grip_main;
+  const Scalar _coef43 = _tmp13;
   const Scalar _coef44 = _inv0 * _inv3 * grip_main;
   const Scalar _coef45 = _inv0 * _inv3 * grip_main * jaw_reach;
-  const Scalar _coef46 = _tmp32 + _tmp34 - _tmp31 - _tmp33 - _tmp35;
-  const Scalar _coef47 = -Scalar(0.25) * (_inv2 + _inv2 * _inv3 * grip_main);
-  const Scalar _coef48 = -Scalar(0.25) * (_inv2 * _inv3 * grip_main * jaw_reach + _inv2 * jaw_reach);
-  const Scalar _coef49 = -Scalar(0.25) * (_inv1 + _inv1 * _inv3 * grip_main);
-  const Scalar _coef50 = -Scalar(0.25) * (_inv1 * _inv3 * grip_main * jaw_reach + _inv1 * jaw_reach);
+  const Scalar _coef46 = -_tmp15;
+  const Scalar _coef47 = Scalar(0.25) * _inv2 * _tmp14;
+  const Scalar _coef48 = Scalar(0.25) * _inv2 * _tmp14 * jaw_reach;
+  const Scalar _coef49 = Scalar(0.25) * _inv1 * _tmp14;
+  const Scalar _coef50 = Scalar(0.25) * _inv1 * _tmp14 * jaw_reach;
   const Scalar _coef51 = L23 * _inv4;
   const Scalar _coef52 = _inv4 * sin_A04;
   const Scalar _coef53 = _inv4 * cos_A04;
-  const Scalar _coef54 = _tmp24;
-  const Scalar _coef55 = _tmp4;
+  const Scalar _coef54 = L23 * _inv4 * cos_A04;
+  const Scalar _coef55 = _tmp3;
   const Scalar _coef56 = _inv4 * cos_A04 * jaw_reach;
   const Scalar _coef57 = _inv4 * jaw_reach * sin_A04;
   const Scalar _coef58 = _inv4 * cos_A04 * Y231;
@@ -1071,13 +1180,13 @@ inline void DeviationAndCoefficients(
   // Outputs
   if (position != nullptr) {
     auto& _position = *position;
-    StorePair(_position.data(), E_XA12 + E_XX + Scalar(0.5) * (E_XY231 + E_XY232 + _coef6 * _tmp39 - _coef2 * _tmp37 - _coef3 * _tmp38 - _coef7 * _tmp40 - _coef8 * _tmp41 - (E_C0Y231 - E_C0Y232) * Y231) + E_BA12 * _coef4 + E_CA04 * _coef10 + _coef1 * _tmp36 - E_B0A04 * _coef11 - E_BA04 * _coef9 - E_CA12 * _coef5 - E_ZX * _coef0, E_AA04 * _coef28 + E_BA12 * _coef17 + E_BY231 * _coef20 + E_CA12 * _coef18 + E_YX * _coef12 + E_ZA04 * _coef27 + E_ZY232 * _coef23 + _coef13 * (E_AA12 + E_AX) + _coef14 * _tmp42 + Scalar(0.5) * (_coef15 * _tmp43 + _coef21 * _tmp44) + _coef33 * _tmp46 + _coef36 * _tmp49 + _coef38 * _tmp51 - E_A0Y231 * _coef22 - E_A0Y232 * _coef25 - E_BA04 * _coef29 - E_BY232 * _coef24 - E_C0A04 * _coef31 - E_CA04 * _coef30 - E_YA04 * _coef26 - E_ZA12 * _coef16 - E_ZY231 * _coef19 - _coef32 * _tmp45 - _coef34 * _tmp47 - _coef35 * _tmp48 - _coef37 * _tmp50 - _coef39 * _tmp52 - _coef40 * _tmp53);
-    _position[2] = E_B0A04 * _coef31 + E_BA04 * _coef30 + E_CA12 * _coef17 + E_ZX * _coef12 + Scalar(0.5) * (_coef15 * (Scalar(2) * E_ZA12 + E_ZY231 + E_ZY232) + _coef16 * _tmp43 + _coef41 * _tmp44 + _coef42 * _tmp41 - _coef21 * (E_BY231 + E_BY232)) + _coef35 * _tmp52 - E_BA12 * _coef18 - E_CA04 * _coef29 - E_YA04 * _coef27 - E_ZA04 * _coef26 - _coef14 * _tmp36 - _coef32 * _tmp51 - _coef38 * _tmp45 - _coef39 * _tmp48;
+    StorePair(_position.data(), E_XA12 + E_XX + Scalar(0.5) * (E_XY231 + E_XY232 + _coef6 * _tmp19 - _coef2 * _tmp17 - _coef3 * _tmp18 - _coef7 * _tmp20 - _coef8 * _tmp21 - (E_C0Y231 - E_C0Y232) * Y231) + E_BA12 * _coef4 + E_CA04 * _coef10 + _coef1 * _tmp16 - E_B0A04 * _coef11 - E_BA04 * _coef9 - E_CA12 * _coef5 - E_ZX * _coef0, E_AA04 * _coef28 + E_BA12 * _coef17 + E_BY231 * _coef20 + E_CA12 * _coef18 + E_YX * _coef12 + E_ZA04 * _coef27 + E_ZY232 * _coef23 + _coef13 * (E_AA12 + E_AX) + _coef14 * _tmp22 + Scalar(0.5) * (_coef15 * _tmp23 + _coef21 * _tmp24) + _coef33 * _tmp26 + _coef36 * _tmp29 + _coef38 * _tmp31 - E_A0Y231 * _coef22 - E_A0Y232 * _coef25 - E_BA04 * _coef29 - E_BY232 * _coef24 - E_C0A04 * _coef31 - E_CA04 * _coef30 - E_YA04 * _coef26 - E_ZA12 * _coef16 - E_ZY231 * _coef19 - _coef32 * _tmp25 - _coef34 * _tmp27 - _coef35 * _tmp28 - _coef37 * _tmp30 - _coef39 * _tmp32 - _coef40 * _tmp33);
+    _position[2] = E_B0A04 * _coef31 + E_BA04 * _coef30 + E_CA12 * _coef17 + E_ZX * _coef12 + Scalar(0.5) * (_coef15 * (Scalar(2) * E_ZA12 + E_ZY231 + E_ZY232) + _coef16 * _tmp23 + _coef41 * _tmp24 + _coef42 * _tmp21 - _coef21 * (E_BY231 + E_BY232)) + _coef35 * _tmp32 - E_BA12 * _coef18 - E_CA04 * _coef29 - E_YA04 * _coef27 - E_ZA04 * _coef26 - _coef14 * _tmp16 - _coef32 * _tmp31 - _coef38 * _tmp25 - _coef39 * _tmp28;
   }
   if (orientation != nullptr) {
     auto& _orientation = *orientation;
-    StorePair(_orientation.data(), _coef45 * (E_BY231 - E_BY232) + _coef48 * _tmp47 + _coef49 * _tmp50 + _coef50 * _tmp53 - E_AA04 * _coef46 - _coef37 * _tmp49 - Scalar(0.5) * _coef43 * (E_A0Y231 + E_A0Y232 + Scalar(2) * (E_AA12 + E_AX)) - _coef44 * (E_ZY231 - E_ZY232) - _coef47 * _tmp46, E_BA12 * _coef54 + E_CA04 * _coef60 + _coef51 * _tmp36 + Scalar(0.5) * (_coef56 * _tmp39 - _coef52 * _tmp37 - _coef53 * _tmp38 - _coef57 * _tmp40 - _coef58 * _tmp41) - E_B0A04 * _coef61 - E_BA04 * _coef59 - E_CA12 * _coef55 - E_ZX * _inv4);
-    _orientation[2] = E_BA12 * _coef55 + E_CA12 * _coef54 + E_YX * _inv4 + _coef51 * _tmp42 + Scalar(0.5) * (_coef53 * _tmp37 + _coef56 * _tmp40 + _coef57 * _tmp39 - _coef52 * _tmp38 - _coef62 * _tmp41) - E_BA04 * _coef60 - E_C0A04 * _coef61 - E_CA04 * _coef59;
+    StorePair(_orientation.data(), _coef45 * (E_BY231 - E_BY232) + _coef48 * _tmp27 + _coef49 * _tmp30 + _coef50 * _tmp33 - E_AA04 * _coef46 - _coef37 * _tmp29 - Scalar(0.5) * _coef43 * (E_A0Y231 + E_A0Y232 + Scalar(2) * (E_AA12 + E_AX)) - _coef44 * (E_ZY231 - E_ZY232) - _coef47 * _tmp26, E_BA12 * _coef54 + E_CA04 * _coef60 + _coef51 * _tmp16 + Scalar(0.5) * (_coef56 * _tmp19 - _coef52 * _tmp17 - _coef53 * _tmp18 - _coef57 * _tmp20 - _coef58 * _tmp21) - E_B0A04 * _coef61 - E_BA04 * _coef59 - E_CA12 * _coef55 - E_ZX * _inv4);
+    _orientation[2] = E_BA12 * _coef55 + E_CA12 * _coef54 + E_YX * _inv4 + _coef51 * _tmp22 + Scalar(0.5) * (_coef53 * _tmp17 + _coef56 * _tmp20 + _coef57 * _tmp19 - _coef52 * _tmp18 - _coef62 * _tmp21) - E_BA04 * _coef60 - E_C0A04 * _coef61 - E_CA04 * _coef59;
   }
   if (position_coeff != nullptr) {
     auto& _position_coeff = *position_coeff;

@@ -21,6 +21,199 @@
 #endif
 
 namespace weilgen_models {
+
+// Pack<Lanes>: `Lanes` doubles evaluated together, one pose (or one error sample) per lane, as the
+// Scalar of the evaluation functions: DeviationAndCoefficients<Pack<4>> evaluates 4 poses with one
+// instruction per operation where the target has registers of 4 doubles (AVX2; 8 with AVX-512).
+// Each lane is the double function's result for that lane's inputs: the same operations in the
+// same order, sin/cos/sqrt from the C library lane by lane (docs/generator.md, "Several poses at
+// once"). Compensate needs comparisons and takes double only. Defined once per translation unit,
+// however many model headers it includes.
+#ifndef WEILGEN_MODELS_PACK_DEFINED
+#define WEILGEN_MODELS_PACK_DEFINED
+// GCC's and Clang's vector extension; elsewhere (or with WEILGEN_MODELS_PACK_PORTABLE defined) a
+// plain array, lane by lane, which the optimiser may vectorise.
+#if (defined(__GNUC__) || defined(__clang__)) && !defined(WEILGEN_MODELS_PACK_PORTABLE)
+#define WEILGEN_MODELS_PACK_VECTOR 1
+#else
+#define WEILGEN_MODELS_PACK_VECTOR 0
+#endif
+#if WEILGEN_MODELS_PACK_VECTOR
+// GCC takes no vector_size that depends on a template parameter: one type per lane count.
+template <std::size_t Lanes>
+struct PackVector;
+template <>
+struct PackVector<2> {
+  typedef double type __attribute__((vector_size(16)));
+  typedef long long bits __attribute__((vector_size(16)));
+};
+template <>
+struct PackVector<4> {
+  typedef double type __attribute__((vector_size(32)));
+  typedef long long bits __attribute__((vector_size(32)));
+};
+template <>
+struct PackVector<8> {
+  typedef double type __attribute__((vector_size(64)));
+  typedef long long bits __attribute__((vector_size(64)));
+};
+#endif
+// Each operation lane by lane, as a hidden friend (found by argument-dependent lookup, a double
+// converts to every lane): with the vector extension one instruction where the target has the
+// registers, else a loop.
+#if WEILGEN_MODELS_PACK_VECTOR
+#define WEILGEN_MODELS_PACK_LANES(EXPR) Pack(EXPR)
+#else
+#define WEILGEN_MODELS_PACK_LANES(EXPR) Pack::Map([&](const std::size_t i) { return EXPR; })
+#endif
+template <std::size_t Lanes>
+struct Pack {
+  static_assert(Lanes == 2 || Lanes == 4 || Lanes == 8, "2, 4 or 8 lanes");
+#if WEILGEN_MODELS_PACK_VECTOR
+  using Vector = typename PackVector<Lanes>::type;
+  Vector v;
+  Pack() = default;
+  Pack(const double x) : v(Vector{} + x) {}  // every lane x (implicit: Scalar(0.5) in the code)
+  explicit Pack(const Vector& x) : v(x) {}
+  double Get(const std::size_t i) const { return v[i]; }
+  void Set(const std::size_t i, const double x) { v[i] = x; }
+#define WEILGEN_MODELS_PACK_LANE(P) (P).v
+#else
+  double v[Lanes];
+  Pack() = default;
+  Pack(const double x) {
+    for (std::size_t i = 0; i < Lanes; ++i) v[i] = x;
+  }
+  double Get(const std::size_t i) const { return v[i]; }
+  void Set(const std::size_t i, const double x) { v[i] = x; }
+  template <typename F>
+  static Pack Map(const F& f) {
+    Pack r;
+    for (std::size_t i = 0; i < Lanes; ++i) r.v[i] = f(i);
+    return r;
+  }
+#define WEILGEN_MODELS_PACK_LANE(P) (P).v[i]
+#endif
+  static Pack Load(const double* const from) {  // from[0 .. Lanes)
+    Pack p;
+    for (std::size_t i = 0; i < Lanes; ++i) p.Set(i, from[i]);
+    return p;
+  }
+  void Store(double* const to) const {  // to[0 .. Lanes)
+    for (std::size_t i = 0; i < Lanes; ++i) to[i] = Get(i);
+  }
+
+  friend Pack operator+(const Pack& a, const Pack& b) {
+    return WEILGEN_MODELS_PACK_LANES(WEILGEN_MODELS_PACK_LANE(a) + WEILGEN_MODELS_PACK_LANE(b));
+  }
+  friend Pack operator-(const Pack& a, const Pack& b) {
+    return WEILGEN_MODELS_PACK_LANES(WEILGEN_MODELS_PACK_LANE(a) - WEILGEN_MODELS_PACK_LANE(b));
+  }
+  friend Pack operator*(const Pack& a, const Pack& b) {
+    return WEILGEN_MODELS_PACK_LANES(WEILGEN_MODELS_PACK_LANE(a) * WEILGEN_MODELS_PACK_LANE(b));
+  }
+  friend Pack operator/(const Pack& a, const Pack& b) {
+    return WEILGEN_MODELS_PACK_LANES(WEILGEN_MODELS_PACK_LANE(a) / WEILGEN_MODELS_PACK_LANE(b));
+  }
+  friend Pack operator-(const Pack& a) { return WEILGEN_MODELS_PACK_LANES(-WEILGEN_MODELS_PACK_LANE(a)); }
+  friend Pack& operator+=(Pack& a, const Pack& b) { return a = a + b; }
+  friend Pack& operator-=(Pack& a, const Pack& b) { return a = a - b; }
+  friend Pack& operator*=(Pack& a, const Pack& b) { return a = a * b; }
+  // With 4 or 8 lanes, sin and cos of every lane at once (SinCos below, within 1 ulp of the C
+  // library's); with 2 (no faster than two library calls, measured) or without the vector
+  // extension, the C library's lane by lane, as the double functions call it.
+  friend Pack sin(const Pack& a) {
+#if WEILGEN_MODELS_PACK_VECTOR
+    if constexpr (Lanes >= 4) {
+      Pack s, c;
+      SinCos(a, &s, &c);
+      return s;
+    }
+#endif
+    return Apply(a, [](const double x) { return std::sin(x); });
+  }
+  friend Pack cos(const Pack& a) {
+#if WEILGEN_MODELS_PACK_VECTOR
+    if constexpr (Lanes >= 4) {
+      Pack s, c;
+      SinCos(a, &s, &c);
+      return c;
+    }
+#endif
+    return Apply(a, [](const double x) { return std::cos(x); });
+  }
+  friend Pack sqrt(const Pack& a) { return Apply(a, [](const double x) { return std::sqrt(x); }); }
+
+ private:
+#if WEILGEN_MODELS_PACK_VECTOR
+  // sin and cos of all lanes in vector arithmetic: the lane-by-lane C library calls would be
+  // most of a rotary machine's time. fdlibm's method (e_rem_pio2.c, k_sin.c, k_cos.c): x - n*pi/2
+  // with pi/2 in three 33-bit parts and their tails (good to 151 bits, so x near a multiple of
+  // pi/2 keeps its digits), then the kernels on [-pi/4, pi/4] with the reduced argument's tail,
+  // the quadrant n mod 4 choosing and negating. Within 1 ulp of glibc (correctly rounded) for
+  // |x| <= 1e6 rad; about 15 % of arguments differ by that 1 ulp (tests/test_generated_headers.cpp).
+  // A lane beyond 1e6 rad (n * pi/2 no longer exact), infinite or NaN: the C library, lane by
+  // lane, for the whole pack.
+  static void SinCos(const Pack& a, Pack* const sin_a, Pack* const cos_a) {
+    using Bits = typename PackVector<Lanes>::bits;
+    const Vector x = a.v;
+    const Bits sign = (Bits)(-Vector{});  // -0.0: the sign bit of every lane
+    const double magic = 6755399441055744.0;  // 1.5 * 2^52: (t + magic) - magic rounds t
+    const Vector shifted = x * 6.36619772367581382433e-01 + magic;  // x * 2/pi + magic
+    const Vector n = shifted - magic;
+    const Bits quadrant = (Bits)shifted;  // its low bits are n mod 4
+    Vector r = x - n * 1.57079632673412561417e+00;
+    Vector t = r;
+    Vector w = n * 6.07710050630396597660e-11;
+    r = t - w;
+    w = n * 2.02226624879595063154e-21 - ((t - r) - w);
+    t = r;
+    w = n * 2.02226624871116645580e-21;
+    r = t - w;
+    w = n * 8.47842766036889956997e-32 - ((t - r) - w);
+    const Vector y0 = r - w;         // the reduced argument, |y0| <= pi/4 (about)
+    const Vector y1 = (r - y0) - w;  // and its tail
+    const Vector z = y0 * y0, zz = z * z, v = z * y0;
+    const Vector sr = 8.33333333332248946124e-03 + z * (-1.98412698298579493134e-04 +
+                                                          z * 2.75573137070700676789e-06) +
+                      z * zz * (-2.50507602534068634195e-08 + z * 1.58969099521155010221e-10);
+    const Vector s = y0 - ((z * (0.5 * y1 - v * sr) - y1) - v * -1.66666666666666324348e-01);
+    const Vector cr = z * (4.16666666666666019037e-02 + z * (-1.38888888888741095749e-03 +
+                                                              z * 2.48015872894767294178e-05)) +
+                      zz * zz *
+                          (-2.75573143513906633035e-07 +
+                           z * (2.08757232129817482790e-09 + z * -1.13596475577881948265e-11));
+    const Vector hz = 0.5 * z, w1 = 1.0 - hz;
+    const Vector c = w1 + (((1.0 - w1) - hz) + (z * cr - y0 * y1));
+    // sin x = s, c, -s, -c and cos x = c, -s, -c, s for n mod 4 = 0, 1, 2, 3.
+    const Bits odd = (quadrant & 1) != 0;
+    const Bits s_bits = ((Bits)s & ~odd) | ((Bits)c & odd);
+    const Bits c_bits = ((Bits)c & ~odd) | ((Bits)s & odd);
+    sin_a->v = (Vector)(s_bits ^ (sign & ((quadrant & 2) != 0)));
+    cos_a->v = (Vector)(c_bits ^ (sign & (((quadrant + 1) & 2) != 0)));
+    // The check after the arithmetic, not before: sin(x) and cos(x) of one angle then share all
+    // of it once both are inlined.
+    // |x| > 1e6, inf or NaN: their bits, sign cleared, compare as integers above 1e6's.
+    const Bits outside = ((Bits)x & ~sign) > 0x412E848000000000LL;
+    long long any = 0;
+    for (std::size_t i = 0; i < Lanes; ++i) any |= outside[i];
+    if (any != 0) {
+      *sin_a = Apply(a, [](const double y) { return std::sin(y); });
+      *cos_a = Apply(a, [](const double y) { return std::cos(y); });
+    }
+  }
+#endif
+  template <typename F>
+  static Pack Apply(const Pack& a, const F& f) {
+    Pack r;
+    for (std::size_t i = 0; i < Lanes; ++i) r.Set(i, f(a.Get(i)));
+    return r;
+  }
+};
+#undef WEILGEN_MODELS_PACK_LANE
+#undef WEILGEN_MODELS_PACK_LANES
+#endif  // WEILGEN_MODELS_PACK_DEFINED
+
 namespace two_axis {
 
 inline constexpr const char* kMachineName = "two_axis";

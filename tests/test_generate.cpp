@@ -125,7 +125,7 @@ TEST_CASE("topology edit: X moved from the workpiece branch to the tool branch")
   CHECK(header != text_of(std::string(WEILGEN_SOURCE_DIR) + "/generated/vmc_3axis.hpp"));
 }
 
-TEST_CASE("order-2 header compiles standalone (C++20, no exceptions) and matches the chain") {
+TEST_CASE("order-2 header compiles standalone (C++20, no exceptions), matches the chain, packs") {
   const fs::path dir = fresh_dir("order2");
   const Run g = run(cli("generate five_axis_ac --order 2 --out " + dir.string()));
   REQUIRE_MESSAGE(g.status == 0, g.out);
@@ -160,7 +160,42 @@ int main(int argc, char** argv) {
     }
     std::printf("%.17g %.17g\n", o < 3 ? pos[o] : rot[o - 3], v);
   }
-  return 0;
+  // The same functions over Pack<4>, lane l at the errors times (1 + l / 8): every lane must be
+  // what the double functions give at its inputs, to 1e-12 of the largest value of its output
+  // array (Pack's vector sin/cos is within 1 ulp of the C library's; exit 3 otherwise).
+  using P = weilgen_models::Pack<4>;
+  std::array<P, m::kNumAxes> pq{};
+  std::array<P, m::kNumErrors> pe{};
+  std::array<P, m::kNumParams> pp{};
+  for (std::size_t i = 0; i < q.size(); ++i) pq[i] = P(q[i]);
+  for (std::size_t i = 0; i < p.size(); ++i) pp[i] = P(p[i]);
+  for (std::size_t l = 0; l < 4; ++l)
+    for (std::size_t i = 0; i < e.size(); ++i) pe[i].Set(l, e[i] * (1.0 + double(l) / 8));
+  std::array<P, 3> ppos{}, prot{};
+  std::array<P, 3 * m::kNumErrors> pcp{}, pcr{};
+  std::array<P, m::kNumOutputs * m::kNumHigherTerms> ph{};
+  m::Deviation(pq, pe, pp, &ppos, &prot);
+  m::Coefficients(pq, pp, &pcp, &pcr);
+  m::HigherOrder(pq, pp, &ph);
+  double worst = 0;
+  const auto compare = [&](const auto& packs, const auto& doubles, std::size_t l) {
+    double scale = 1e-300;
+    for (double b : doubles) scale = std::fmax(scale, std::fabs(b));
+    for (std::size_t k = 0; k < doubles.size(); ++k)
+      worst = std::fmax(worst, std::fabs(packs[k].Get(l) - doubles[k]) / scale);
+  };
+  for (std::size_t l = 0; l < 4; ++l) {
+    std::array<double, m::kNumErrors> el{};
+    for (std::size_t i = 0; i < e.size(); ++i) el[i] = e[i] * (1.0 + double(l) / 8);
+    m::Deviation(q, el, p, &pos, &rot);
+    compare(ppos, pos, l);
+    compare(prot, rot, l);
+    compare(pcp, cp, l);
+    compare(pcr, cr, l);
+    compare(ph, h, l);
+  }
+  std::printf("pack %.3g\n", worst);
+  return worst < 1e-12 ? 0 : 3;
 })";
   const Description d = load_machine_file(test::machine_path("five_axis_ac"));
   // The same model with Deviation summing the higher terms by its loop over kHigherTable (the
@@ -182,14 +217,20 @@ int main(int argc, char** argv) {
           std::string::npos);
   REQUIRE(split_header.find("  _s[0] = ") != std::string::npos);
   write_file_atomically((split_dir / "five_axis_ac_o2.hpp").string(), split_header);
-  for (const fs::path& include : {dir, loop_dir, split_dir}) {
+  // The last: Pack without the vector extension (the plain array other compilers get).
+  const fs::path portable_dir = dir / "portable";
+  fs::create_directories(portable_dir);
+  fs::copy_file(dir / "five_axis_ac_o2.hpp", portable_dir / "five_axis_ac_o2.hpp");
+  for (const fs::path& include : {dir, loop_dir, split_dir, portable_dir}) {
     CAPTURE(include.string());
     // Beside the header: a quoted include looks in the driver's directory first.
     write_file_atomically((include / "driver.cpp").string(), driver);
     const std::string exe = (include / "driver").string();
-    const Run c = run(std::string(WEILGEN_CXX) +
-                      " -std=c++20 -O1 -Wall -Wextra -Werror -fno-exceptions -fno-rtti -I" +
-                      include.string() + " " + (include / "driver.cpp").string() + " -o " + exe);
+    const std::string portable = include == portable_dir ? " -DWEILGEN_MODELS_PACK_PORTABLE" : "";
+    const Run c =
+        run(std::string(WEILGEN_CXX) +
+            " -std=c++20 -O1 -Wall -Wextra -Werror -fno-exceptions -fno-rtti" + portable + " -I" +
+            include.string() + " " + (include / "driver.cpp").string() + " -o " + exe);
     REQUIRE_MESSAGE(c.status == 0, c.out);
 
     const NumericChain chain(d);
@@ -204,7 +245,8 @@ int main(int argc, char** argv) {
       for (double v : q) args << " " << v;
       for (double v : e) args << " " << v;
       const Run r = run(exe + args.str());
-      REQUIRE_MESSAGE(r.status == 0, r.out);
+      REQUIRE_MESSAGE(r.status == 0, r.out);  // 3: a Pack lane differs from the double result
+      CHECK(r.out.find("\npack ") != std::string::npos);
       std::istringstream in(r.out);
       std::array<double, 6> dev{};
       for (int o = 0; o < 6; ++o) {

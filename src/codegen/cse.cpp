@@ -27,6 +27,61 @@ bool is_integer_power_of_sum(const ex& e) {
 }
 }  // namespace
 
+std::size_t operation_count(const ex& e) {
+  if (is_atom(e)) return 0;
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < e.nops(); ++i) n += operation_count(e.op(i));
+  if (GiNaC::is_a<GiNaC::add>(e)) return n + e.nops() - 1;
+  if (GiNaC::is_a<GiNaC::mul>(e)) {
+    std::size_t factors = 0;
+    for (std::size_t i = 0; i < e.nops(); ++i) {
+      const ex& op = e.op(i);
+      const bool sign_only = GiNaC::is_a<GiNaC::numeric>(op) && (op.is_equal(1) || op.is_equal(-1));
+      if (!sign_only) ++factors;
+    }
+    return n + (factors > 0 ? factors - 1 : 0);
+  }
+  if (GiNaC::is_a<GiNaC::power>(e) && GiNaC::is_a<GiNaC::numeric>(e.op(1)) &&
+      GiNaC::ex_to<GiNaC::numeric>(e.op(1)).is_integer()) {
+    const long k = GiNaC::ex_to<GiNaC::numeric>(e.op(1)).to_long();
+    return n + static_cast<std::size_t>(k < 0 ? -k : k - 1);  // |k| − 1 products, 1 division
+  }
+  return n + 1;  // a function call
+}
+
+namespace {
+ex canonical_signs(const ex& e, CanonicalText& canon) {
+  if (is_atom(e)) return e;
+  if (GiNaC::is_a<GiNaC::mul>(e)) {
+    GiNaC::numeric sign = 1;
+    GiNaC::exvector factors;
+    for (std::size_t i = 0; i < e.nops(); ++i) {
+      const ex op = canonical_signs(e.op(i), canon);
+      if (!GiNaC::is_a<GiNaC::add>(op)) {
+        factors.push_back(op);
+        continue;
+      }
+      const CanonicalText::Signed r = canon.canonical_sign(op);
+      if (r.negated) sign = -sign;
+      factors.push_back(r.value);
+    }
+    return GiNaC::mul(factors) * sign;
+  }
+  if (GiNaC::is_a<GiNaC::add>(e)) {
+    GiNaC::exvector terms;
+    for (std::size_t i = 0; i < e.nops(); ++i) terms.push_back(canonical_signs(e.op(i), canon));
+    return GiNaC::add(terms);
+  }
+  return e;
+}
+}  // namespace
+
+ex with_common_factors(const ex& e, CanonicalText& canon) {
+  if (!GiNaC::is_a<GiNaC::add>(e)) return e;
+  const ex factored = GiNaC::collect_common_factors(e);
+  return operation_count(factored) < operation_count(e) ? canonical_signs(factored, canon) : e;
+}
+
 const std::string& CanonicalText::of(const ex& e) {
   auto it = memo_.find(e);
   if (it != memo_.end()) return it->second;
@@ -90,6 +145,14 @@ const std::string& CanonicalText::of(const ex& e) {
 }
 
 CanonicalText::Signed CanonicalText::canonical_sign(const ex& sum) {
+  auto it = sign_memo_.find(sum);
+  if (it != sign_memo_.end()) return it->second;
+  const Signed r = compute_canonical_sign(sum);
+  sign_memo_.emplace(sum, r);
+  return r;
+}
+
+CanonicalText::Signed CanonicalText::compute_canonical_sign(const ex& sum) {
   // Term by term, not expand(): a nested (factored) sum keeps its form.
   ex neg;
   if (GiNaC::is_a<GiNaC::add>(sum)) {
@@ -140,14 +203,19 @@ struct Eliminator {
   CseResult result;
   std::string prefix;
 
-  // A product's key ignores its sign: GiNaC may hold x·(a − b) in one run and −x·(b − a) in the
-  // next (the sign of a sum inside a product follows hash order), and both must share one
-  // temporary whose value has the canonical sign.
+  // A product's or a sum's key ignores its sign: GiNaC may hold x·(a − b) in one run and
+  // −x·(b − a) in the next (the sign of a sum inside a product follows hash order), and a
+  // coefficient a − b of one output may be b − a of another; each pair must share one temporary
+  // whose value has the canonical sign.
   std::string key_of(const ex& node) {
-    return GiNaC::is_a<GiNaC::mul>(node) ? canon.unsigned_text(node) : canon.of(node);
+    if (GiNaC::is_a<GiNaC::mul>(node)) return canon.unsigned_text(node);
+    if (GiNaC::is_a<GiNaC::add>(node)) return canon.of(canon.canonical_sign(node).value);
+    return canon.of(node);
   }
-  // −1 when the canonical text of a product has a negative coefficient, else 1.
+  // −1 when the canonical text of a product has a negative coefficient or a sum is the negation
+  // of its canonical sign, else 1.
   int canonical_sign_of(const ex& node) {
+    if (GiNaC::is_a<GiNaC::add>(node)) return canon.canonical_sign(node).negated ? -1 : 1;
     if (!GiNaC::is_a<GiNaC::mul>(node)) return 1;
     const std::string& t = canon.of(node);
     return t.size() > 4 && t[4] == '-' ? -1 : 1;
@@ -190,7 +258,7 @@ struct Eliminator {
       } rewriter(this);
       rebuilt = node.map(rewriter);
     }
-    // A product is stored with the canonical sign (positive coefficient) and used as sign·value.
+    // A product or a sum is stored with the canonical sign and used as sign·value.
     if (sign < 0) rebuilt = -rebuilt;
     if (count[key] >= 2) {
       GiNaC::symbol t(prefix + std::to_string(result.temps.size()));

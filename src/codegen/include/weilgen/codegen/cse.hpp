@@ -32,7 +32,9 @@ class CanonicalText {
   std::vector<GiNaC::ex> sorted_ops(const GiNaC::ex& e);
 
  private:
+  Signed compute_canonical_sign(const GiNaC::ex& sum);
   std::map<GiNaC::ex, std::string, GiNaC::ex_is_less> memo_;
+  std::map<GiNaC::ex, Signed, GiNaC::ex_is_less> sign_memo_;  // the CSE asks once per sum node
 };
 
 struct CseResult {
@@ -43,6 +45,18 @@ struct CseResult {
   std::vector<Temp> temps;
   std::vector<GiNaC::ex> outputs;  // rewritten in terms of temporaries
 };
+
+// Operations to evaluate e as written (additions, multiplications by a symbol or a number other
+// than ±1, divisions, function calls): the measure by which with_common_factors chooses.
+std::size_t operation_count(const GiNaC::ex& e);
+
+// e, or GiNaC::collect_common_factors(e) when that needs fewer operations: a·b·x + a·b·y − a·b·z
+// becomes a·b·(x + y − z), 3 operations instead of 8, and the sum (x + y − z) is then a candidate
+// for sharing by the CSE. Every sum inside a product is taken in canonical sign (the sign moved
+// to the product's number): GiNaC's choice follows its hash order, which differs between runs and
+// binaries, and the CSE must see the same sum in every coefficient. Applied to each coefficient
+// before the CSE (docs/generator.md §5).
+GiNaC::ex with_common_factors(const GiNaC::ex& e, CanonicalText& canon);
 
 CseResult eliminate_common_subexpressions(const std::vector<GiNaC::ex>& outputs,
                                           const std::string& prefix = "_tmp");
