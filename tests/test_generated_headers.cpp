@@ -128,6 +128,22 @@ WEILGEN_MODEL_ADAPTER(five_axis_ac)
 WEILGEN_MODEL_ADAPTER(pipe_cutter)
 WEILGEN_MODEL_ADAPTER(head_head_bc)
 
+// n values got(k) against want[k]: counts them into `total`, those not bit for bit equal into
+// `differing`, and raises `worst` to the largest difference relative to want's largest magnitude.
+template <typename Got>
+void tally_agreement(const double* want, std::size_t n, const Got& got, std::size_t& differing,
+                     std::size_t& total, double& worst) {
+  double scale = 0;
+  for (std::size_t k = 0; k < n; ++k) scale = std::max(scale, std::abs(want[k]));
+  for (std::size_t k = 0; k < n; ++k) {
+    ++total;
+    const double v = got(k);
+    if (v == want[k]) continue;
+    ++differing;
+    worst = std::max(worst, std::abs(v - want[k]) / std::max(scale, 1e-300));
+  }
+}
+
 // DeviationAndCoefficients against Deviation and Coefficients called separately, on random poses
 // and errors: returns the largest difference relative to the output's magnitude (0 when every
 // value is bit for bit the same) and counts the values that differ at all. Every combination
@@ -153,14 +169,8 @@ double combined_vs_separate(const std::string& name, std::size_t& differing, std
     M::template Coefficients<double>(axes, params, &cp, &cr);
     M::template DeviationAndCoefficients<double>(axes, errors, params, &pos2, &rot2, &cp2, &cr2);
     const auto compare = [&](const double* a, const double* b, std::size_t n) {
-      double scale = 0;
-      for (std::size_t k = 0; k < n; ++k) scale = std::max(scale, std::abs(a[k]));
-      for (std::size_t k = 0; k < n; ++k) {
-        ++total;
-        if (a[k] == b[k]) continue;
-        ++differing;
-        worst = std::max(worst, std::abs(a[k] - b[k]) / std::max(scale, 1e-300));
-      }
+      tally_agreement(
+          a, n, [&](std::size_t k) { return b[k]; }, differing, total, worst);
     };
     compare(pos.data(), pos2.data(), 3);
     compare(rot.data(), rot2.data(), 3);
@@ -241,15 +251,9 @@ double pack_vs_double(const std::string& name, std::size_t& differing, std::size
       M::template NominalPose<double>(axes[l], params[l], &dnominal_pos, &dnominal_rot);
       M::template NominalJacobian<double>(axes[l], params[l], &djac);
       const auto compare = [&](const auto& packs, const auto& doubles) {
-        double scale = 0;
-        for (const double v : doubles) scale = std::max(scale, std::abs(v));
-        for (std::size_t k = 0; k < doubles.size(); ++k) {
-          ++total;
-          const double v = packs[k].Get(l);
-          if (v == doubles[k]) continue;
-          ++differing;
-          worst = std::max(worst, std::abs(v - doubles[k]) / std::max(scale, 1e-300));
-        }
+        tally_agreement(
+            doubles.data(), doubles.size(), [&](std::size_t k) { return packs[k].Get(l); },
+            differing, total, worst);
       };
       compare(pos, dpos);
       compare(rot, drot);

@@ -39,9 +39,9 @@ namespace weilgen_models {
 // Scalar of the evaluation functions: DeviationAndCoefficients<Pack<4>> evaluates 4 poses with one
 // instruction per operation where the target has registers of 4 doubles (AVX2; 8 with AVX-512).
 // Each lane is the double function's result for that lane's inputs: the same operations in the
-// same order, sin/cos/sqrt from the C library lane by lane (docs/generator.md, "Several poses at
-// once"). Compensate needs comparisons and takes double only. Defined once per translation unit,
-// however many model headers it includes.
+// same order, sqrt from the C library lane by lane, sin/cos within 1 ulp of it (SinCos below;
+// docs/generator.md, "Several poses at once"). Compensate needs comparisons and takes double
+// only. Defined once per translation unit, however many model headers it includes.
 #ifndef WEILGEN_MODELS_PACK_DEFINED
 #define WEILGEN_MODELS_PACK_DEFINED
 // GCC's and Clang's vector extension; elsewhere (or with WEILGEN_MODELS_PACK_PORTABLE defined) a
@@ -204,9 +204,9 @@ struct Pack {
     const Bits c_bits = ((Bits)c & ~odd) | ((Bits)s & odd);
     sin_a->v = (Vector)(s_bits ^ (sign & ((quadrant & 2) != 0)));
     cos_a->v = (Vector)(c_bits ^ (sign & (((quadrant + 1) & 2) != 0)));
-    // The check after the arithmetic, not before: sin(x) and cos(x) of one angle then share all
-    // of it once both are inlined.
-    // |x| > 1e6, inf or NaN: their bits, sign cleared, compare as integers above 1e6's.
+    // The range check after the arithmetic, not before: sin(x) and cos(x) of one angle then
+    // share all of it once both are inlined. |x| > 1e6, inf or NaN: their bits, sign cleared,
+    // compare as integers above 1e6's.
     const Bits outside = ((Bits)x & ~sign) > 0x412E848000000000LL;
     long long any = 0;
     for (std::size_t i = 0; i < Lanes; ++i) any |= outside[i];
